@@ -1,0 +1,37 @@
+"""slamtrials: repeatable SLAM evaluation.
+
+Simulate a robot that explores a floor plan on its own, many times; run a SLAM algorithm on every run;
+measure the localization error against ground truth; add runs until each building's mean error is
+known to a stated confidence (Amigoni, Castelli and Luperto, IROS 2018).
+
+The public API is imported lazily so that ``import slamtrials`` stays fast.
+"""
+
+from __future__ import annotations
+
+from importlib import import_module
+from typing import Any
+
+from slamtrials.__about__ import __version__
+
+_PUBLIC = {
+    "load_world": "slamtrials.worlds",
+    "World": "slamtrials.worlds",
+    "generate_world": "slamtrials.worlds.generate",
+    "Simulator": "slamtrials.sim",
+    "SimConfig": "slamtrials.sim",
+    "simulate_waypoints": "slamtrials.sim",
+    "Frame": "slamtrials.record",
+    "RunRecord": "slamtrials.record",
+    "write_run": "slamtrials.io.runfolder",
+    "read_run": "slamtrials.io.runfolder",
+    "SlamtrialsError": "slamtrials.errors",
+}
+
+__all__ = ["__version__", *_PUBLIC]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _PUBLIC:
+        return getattr(import_module(_PUBLIC[name]), name)
+    raise AttributeError(f"module 'slamtrials' has no attribute {name!r}")

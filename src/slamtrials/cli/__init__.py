@@ -1,0 +1,1 @@
+"""The ``slamtrials`` command line: thin typer wrappers over library functions."""

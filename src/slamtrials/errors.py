@@ -1,0 +1,62 @@
+"""The exception hierarchy of slamtrials.
+
+Every error the library raises on purpose is a :class:`SlamtrialsError`. Messages are one line and name
+the file, line or field at fault and what was expected, so the CLI can print them as they are and exit
+with status 2.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+__all__ = [
+    "SlamtrialsError",
+    "ConfigError",
+    "FormatError",
+    "WorldError",
+    "SimulationError",
+]
+
+
+class SlamtrialsError(Exception):
+    """Base class of every error slamtrials raises on purpose."""
+
+
+class ConfigError(SlamtrialsError):
+    """A configuration value is missing, malformed or out of its allowed range."""
+
+
+class FormatError(SlamtrialsError):
+    """A file does not follow the format it claims to be in.
+
+    Parameters
+    ----------
+    path:
+        The file at fault.
+    problem:
+        What is wrong and what was expected.
+    line:
+        1-based line number, for text formats.
+    offset:
+        Byte offset, for binary formats.
+    """
+
+    def __init__(self, path: str | Path, problem: str, *, line: int | None = None, offset: int | None = None):
+        self.path = Path(path)
+        self.problem = problem
+        self.line = line
+        self.offset = offset
+        where = str(self.path)
+        if line is not None:
+            where += f":{line}"
+        elif offset is not None:
+            where += f" (byte {offset})"
+        super().__init__(f"{where}: {problem}")
+
+
+class WorldError(SlamtrialsError):
+    """A floor plan cannot be used as a world (no free space, bad resolution, unknown name, ...)."""
+
+
+class SimulationError(SlamtrialsError):
+    """The simulator was asked for something it cannot do (e.g. a start pose inside a wall)."""

@@ -1,0 +1,68 @@
+"""SE(2) poses as float64 arrays of shape ``[..., 3]`` holding (x, y, theta).
+
+x and y are in metres, theta in radians, counter-clockwise from the x axis. All functions broadcast
+over leading dimensions and never loop in Python.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+__all__ = ["wrap_angle", "compose", "inverse", "ominus", "transform_points", "as_poses"]
+
+
+def as_poses(poses: ArrayLike) -> NDArray[np.float64]:
+    """Return ``poses`` as a float64 array whose last axis has length 3."""
+    array = np.asarray(poses, dtype=np.float64)
+    if array.shape[-1:] != (3,):
+        raise ValueError(f"poses must have shape [..., 3], got {array.shape}")
+    return array
+
+
+def wrap_angle(angle: ArrayLike) -> NDArray[np.float64]:
+    """Wrap angles (rad) into [-pi, pi)."""
+    a = np.asarray(angle, dtype=np.float64)
+    return (a + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def compose(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
+    """Pose composition ``a (+) b``: ``b`` expressed in the frame of ``a``, returned in a's parent frame.
+
+    Shapes ``[..., 3]`` broadcast against each other.
+    """
+    a = as_poses(a)
+    b = as_poses(b)
+    c, s = np.cos(a[..., 2]), np.sin(a[..., 2])
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a[..., 0] + c * b[..., 0] - s * b[..., 1]
+    out[..., 1] = a[..., 1] + s * b[..., 0] + c * b[..., 1]
+    out[..., 2] = wrap_angle(a[..., 2] + b[..., 2])
+    return out
+
+
+def inverse(a: ArrayLike) -> NDArray[np.float64]:
+    """Inverse pose ``(-) a`` such that ``compose(a, inverse(a))`` is the identity."""
+    a = as_poses(a)
+    c, s = np.cos(a[..., 2]), np.sin(a[..., 2])
+    out = np.empty(a.shape)
+    out[..., 0] = -c * a[..., 0] - s * a[..., 1]
+    out[..., 1] = s * a[..., 0] - c * a[..., 1]
+    out[..., 2] = wrap_angle(-a[..., 2])
+    return out
+
+
+def ominus(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
+    """Relative pose ``(-) a (+) b``: pose ``b`` seen from the frame of pose ``a``."""
+    return compose(inverse(a), b)
+
+
+def transform_points(pose: ArrayLike, points: ArrayLike) -> NDArray[np.float64]:
+    """Map points ``[..., 2]`` given in the frame of ``pose`` (shape ``[3]``) into the parent frame."""
+    pose = as_poses(pose)
+    pts = np.asarray(points, dtype=np.float64)
+    c, s = np.cos(pose[2]), np.sin(pose[2])
+    out = np.empty(pts.shape)
+    out[..., 0] = pose[0] + c * pts[..., 0] - s * pts[..., 1]
+    out[..., 1] = pose[1] + s * pts[..., 0] + c * pts[..., 1]
+    return out

@@ -1,0 +1,101 @@
+"""The data that flows between layers: one simulator step (:class:`Frame`) and one run (:class:`RunRecord`).
+
+Plain containers with no behaviour beyond shape checks. Poses are ``(x, y, theta)`` in metres and
+radians; ground truth is in the world frame, odometry in the odometry frame (which starts at
+``(0, 0, 0)`` at the first frame, as in Stage and ROS).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["Frame", "RunRecord"]
+
+
+@dataclass(frozen=True, eq=False)
+class Frame:
+    """What the robot senses at one simulator step.
+
+    Attributes
+    ----------
+    t:
+        Time in seconds since the start of the run.
+    ranges:
+        float32 ``[B]`` laser ranges in metres, beam 0 at the laser's ``angle_min``, counter-clockwise;
+        a beam that hits nothing within the laser's max range reads exactly ``max_range``.
+    odometry:
+        float64 ``[3]`` pose of the robot base in the odometry frame.
+    truth:
+        float64 ``[3]`` true pose of the robot base in the world frame.
+    stalled:
+        True when the robot bumped into a wall during the step that led to this frame (it did not move).
+    """
+
+    t: float
+    ranges: NDArray[np.float32]
+    odometry: NDArray[np.float64]
+    truth: NDArray[np.float64]
+    stalled: bool = False
+
+
+@dataclass(eq=False)
+class RunRecord:
+    """All frames of one run as stacked arrays, plus the metadata needed to interpret them.
+
+    Attributes
+    ----------
+    t:
+        float64 ``[T]`` timestamps in seconds, strictly increasing.
+    scans:
+        float32 ``[T, B]`` laser ranges in metres.
+    odometry:
+        float64 ``[T, 3]`` odometry poses.
+    truth:
+        float64 ``[T, 3]`` ground-truth poses in the world frame.
+    stalled:
+        bool ``[T]`` collision flag per frame.
+    laser:
+        Laser geometry: ``angle_min``, ``angle_increment`` (rad), ``range_min``, ``range_max`` (m) and
+        ``mount`` (x, y, theta of the laser in the base frame).
+    metadata:
+        Free-form JSON-serialisable facts about the run (world name, seed, drawn odometry bias, ...).
+    estimate:
+        Optional float64 ``[T, 3]`` SLAM pose estimates, filled in by later stages.
+    """
+
+    t: NDArray[np.float64]
+    scans: NDArray[np.float32]
+    odometry: NDArray[np.float64]
+    truth: NDArray[np.float64]
+    stalled: NDArray[np.bool_]
+    laser: dict[str, Any]
+    metadata: dict[str, Any] = field(default_factory=dict)
+    estimate: NDArray[np.float64] | None = None
+
+    def __post_init__(self) -> None:
+        n = len(self.t)
+        expected = {"scans": (n,), "odometry": (n, 3), "truth": (n, 3), "stalled": (n,)}
+        for name, shape in expected.items():
+            got = getattr(self, name).shape[: len(shape)]
+            if got != shape:
+                raise ValueError(f"RunRecord.{name} has shape {getattr(self, name).shape}, expected {shape}[...]")
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    @classmethod
+    def from_frames(cls, frames: list[Frame], laser: dict[str, Any], metadata: dict[str, Any] | None = None) -> "RunRecord":
+        """Stack a list of frames into a record."""
+        return cls(
+            t=np.array([f.t for f in frames], dtype=np.float64),
+            scans=np.stack([f.ranges for f in frames]).astype(np.float32, copy=False),
+            odometry=np.stack([f.odometry for f in frames]).astype(np.float64, copy=False),
+            truth=np.stack([f.truth for f in frames]).astype(np.float64, copy=False),
+            stalled=np.array([f.stalled for f in frames], dtype=bool),
+            laser=dict(laser),
+            metadata=dict(metadata or {}),
+        )

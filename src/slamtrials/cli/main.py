@@ -10,7 +10,6 @@ from __future__ import annotations
 import logging
 from typing import Annotated
 
-import click
 import typer
 from typer.core import TyperGroup
 
@@ -23,16 +22,16 @@ EXIT_BAD_INPUT = 2
 class ErrorReportingGroup(TyperGroup):
     """A command group that turns expected errors into one line and exit status 2."""
 
-    def invoke(self, ctx: click.Context):
+    def invoke(self, ctx):  # ctx: typer's (vendored) click Context
         try:
             return super().invoke(ctx)
         except SlamtrialsError as exc:
-            click.echo(f"error: {exc}", err=True)
-            raise click.exceptions.Exit(EXIT_BAD_INPUT) from None
+            typer.echo(f"error: {exc}", err=True)
+            raise typer.Exit(EXIT_BAD_INPUT) from None
         except OSError as exc:  # missing, unreadable or unwritable files named on the command line
             where = f"{exc.filename}: " if exc.filename else ""
-            click.echo(f"error: {where}{exc.strerror or exc}", err=True)
-            raise click.exceptions.Exit(EXIT_BAD_INPUT) from None
+            typer.echo(f"error: {where}{exc.strerror or exc}", err=True)
+            raise typer.Exit(EXIT_BAD_INPUT) from None
 
 
 def make_app(**kwargs) -> typer.Typer:

@@ -7,32 +7,19 @@ a ``slamtrials`` block with the world's name, start pose and metadata, which map
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import yaml
 from PIL import Image
 
+from slamtrials.atomicfile import atomic_write, atomic_write_text
 from slamtrials.worlds.world import World
 
 __all__ = ["save_rosmap"]
 
 FREE_GREY = 254
 OCCUPIED_GREY = 0
-
-
-def _atomic_write_bytes(path: Path, write) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            write(handle)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def save_rosmap(world: World, yaml_path: str | Path, image_name: str | None = None) -> Path:
@@ -43,7 +30,7 @@ def save_rosmap(world: World, yaml_path: str | Path, image_name: str | None = No
     yaml_path = Path(yaml_path)
     image_name = image_name or yaml_path.with_suffix(".png").name
     grey = np.where(world.occupied, OCCUPIED_GREY, FREE_GREY).astype(np.uint8)
-    _atomic_write_bytes(yaml_path.parent / image_name, lambda h: Image.fromarray(grey, mode="L").save(h, format="PNG", optimize=True))
+    atomic_write(yaml_path.parent / image_name, lambda h: Image.fromarray(grey, mode="L").save(h, format="PNG", optimize=True))
     doc = {
         "image": image_name,
         "resolution": float(world.resolution),
@@ -58,5 +45,5 @@ def save_rosmap(world: World, yaml_path: str | Path, image_name: str | None = No
         },
     }
     text = yaml.safe_dump(doc, sort_keys=False)
-    _atomic_write_bytes(yaml_path, lambda h: h.write(text.encode()))
+    atomic_write_text(yaml_path, text)
     return yaml_path

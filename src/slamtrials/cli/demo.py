@@ -1,0 +1,44 @@
+"""``slamtrials demo``: the README's main job (scripted tours through bundled worlds)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from slamtrials.demo import DEMO_WORLDS
+
+
+def demo(
+    out: Annotated[Path, typer.Option("--out", "-o", help="Folder for the run folders and pictures.")] = Path("results/demo"),
+    world: Annotated[list[str] | None, typer.Option("--world", "-w", help="Bundled world or floor-plan file (repeatable).")] = None,
+    seed: Annotated[int, typer.Option("--seed", "-s", help="Seed of every random draw.")] = 1,
+) -> None:
+    """Simulate a scripted tour through a few bundled worlds; write run folders and pictures."""
+    from rich.console import Console
+    from rich.table import Table
+
+    from slamtrials.demo import run_demo
+
+    console = Console()
+    table = Table(title="slamtrials demo: scripted tours (paper robot, laser and odometry)")
+    for column in ("world", "frames", "simulated", "wall", "speed-up", "distance", "odometry drift", "outcome"):
+        table.add_column(column, justify="left" if column in ("world", "outcome") else "right")
+
+    def show(run) -> None:
+        console.print(f"  {run.world}: {run.frames} frames -> {run.folder}")
+        table.add_row(
+            run.world, str(run.frames), f"{run.simulated_s:.0f} s", f"{run.wall_s:.1f} s",
+            f"{run.simulated_s / max(run.wall_s, 1e-9):.0f}x", f"{run.distance_m:.1f} m",
+            f"{run.odometry_drift_m:.2f} m", run.outcome,
+        )
+
+    run_demo(out, tuple(world) if world else DEMO_WORLDS, seed=seed, on_run=show)
+    console.print(table)
+    console.print(f"Pictures: {out}/runs/<world>/000/run.png")
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``demo`` command to ``app``."""
+    app.command("demo")(demo)

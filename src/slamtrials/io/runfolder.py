@@ -1,0 +1,134 @@
+"""The run folder of DESIGN.md: ``frames.npz`` (the recorded data) and ``run.json`` (what produced it).
+
+``frames.npz`` holds ``t`` float64 [T] (s), ``scans`` float32 [T, B] (m), ``odometry`` float64 [T, 3]
+(odometry frame), ``truth`` float64 [T, 3] (world frame) and ``stalled`` bool [T].
+``run.json`` holds the laser geometry, the run's metadata (world, seed, drawn odometry bias, outcome,
+timings, resolved config) and the versions that produced it.
+
+Every file is written atomically and ``run.json`` is written last, so a folder with a ``run.json`` is a
+complete run; a crash mid-write leaves a folder that :func:`read_run` rejects rather than misreads.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import platform
+import zipfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from slamtrials.__about__ import __version__
+from slamtrials.atomicfile import atomic_write, atomic_write_text
+from slamtrials.errors import FormatError
+from slamtrials.record import RunRecord
+
+__all__ = ["write_run", "read_run", "FRAMES_FILE", "RUN_FILE", "RUN_FORMAT"]
+
+FRAMES_FILE = "frames.npz"
+RUN_FILE = "run.json"
+RUN_FORMAT = "slamtrials-run/1"
+
+_ARRAYS: dict[str, tuple[type, int | None]] = {  # name -> (dtype, size of the last axis or None)
+    "t": (np.float64, None),
+    "scans": (np.float32, None),
+    "odometry": (np.float64, 3),
+    "truth": (np.float64, 3),
+    "stalled": (np.bool_, None),
+}
+_LASER_KEYS = ("angle_min", "angle_increment", "range_min", "range_max")
+
+
+def _json_default(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, Path):
+        return str(value)
+    raise TypeError(f"cannot store {type(value).__name__} in run.json")
+
+
+def write_run(folder: str | Path, record: RunRecord) -> Path:
+    """Write ``record`` as a run folder (created if needed) and return the folder's path.
+
+    ``frames.npz`` is compressed; ``run.json`` is written last and marks the run complete. An existing
+    run in ``folder`` is replaced file by file, each replacement atomic.
+    """
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / RUN_FILE).unlink(missing_ok=True)  # the folder is incomplete until run.json is back
+    arrays = {name: np.asarray(getattr(record, name), dtype=dtype) for name, (dtype, _) in _ARRAYS.items()}
+    atomic_write(folder / FRAMES_FILE, lambda handle: np.savez_compressed(handle, **arrays))
+    doc = {
+        "format": RUN_FORMAT,
+        "versions": {"slamtrials": __version__, "python": platform.python_version(), "numpy": np.__version__},
+        "frames": len(record),
+        "beams": int(record.scans.shape[1]) if record.scans.ndim == 2 else 0,
+        "laser": record.laser,
+        **record.metadata,
+    }
+    atomic_write_text(folder / RUN_FILE, json.dumps(doc, indent=2, default=_json_default) + "\n")
+    return folder
+
+
+def _read_run_json(path: Path) -> dict[str, Any]:
+    if not path.is_file():
+        raise FormatError(path, "missing: not a complete run folder (run.json is written last)")
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except json.JSONDecodeError as exc:
+        raise FormatError(path, f"not valid JSON: {exc.msg}", line=exc.lineno) from None
+    except UnicodeDecodeError:
+        raise FormatError(path, "not UTF-8 text") from None
+    if not isinstance(doc, dict) or doc.get("format") != RUN_FORMAT:
+        raise FormatError(path, f"expected a JSON object with \"format\": \"{RUN_FORMAT}\"")
+    laser = doc.get("laser")
+    if not isinstance(laser, dict) or any(not isinstance(laser.get(k), (int, float)) for k in _LASER_KEYS):
+        raise FormatError(path, f"field 'laser' must be an object with numbers {', '.join(_LASER_KEYS)}")
+    return doc
+
+
+def _read_frames(path: Path) -> dict[str, np.ndarray]:
+    if not path.is_file():
+        raise FormatError(path, "missing: every run folder has frames.npz")
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            arrays = {name: npz[name] for name in npz.files if name in _ARRAYS}
+    except (zipfile.BadZipFile, ValueError, OSError, EOFError, io.UnsupportedOperation) as exc:
+        raise FormatError(path, f"not a readable .npz archive ({exc})") from None
+    for name, (dtype, last) in _ARRAYS.items():
+        if name not in arrays:
+            raise FormatError(path, f"array '{name}' is missing")
+        if arrays[name].dtype != dtype:
+            raise FormatError(path, f"array '{name}' has dtype {arrays[name].dtype}, expected {np.dtype(dtype)}")
+        if last is not None and (arrays[name].ndim != 2 or arrays[name].shape[1] != last):
+            raise FormatError(path, f"array '{name}' has shape {arrays[name].shape}, expected [T, {last}]")
+    n = len(arrays["t"])
+    if arrays["scans"].ndim != 2 or any(len(a) != n for a in arrays.values()):
+        raise FormatError(path, f"arrays disagree on the number of frames: { {k: v.shape for k, v in arrays.items()} }")
+    if n > 1 and not np.all(np.diff(arrays["t"]) > 0):
+        raise FormatError(path, "timestamps 't' are not strictly increasing")
+    return arrays
+
+
+def read_run(folder: str | Path) -> RunRecord:
+    """Read a run folder written by :func:`write_run`.
+
+    Raises
+    ------
+    FormatError
+        A file is missing, unreadable, or its arrays have the wrong names, dtypes or shapes.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise FormatError(folder, "not a run folder (no such directory)")
+    doc = _read_run_json(folder / RUN_FILE)
+    arrays = _read_frames(folder / FRAMES_FILE)
+    if arrays["scans"].shape[1] != doc.get("beams", arrays["scans"].shape[1]):
+        raise FormatError(folder / RUN_FILE, f"says {doc['beams']} beams but frames.npz has {arrays['scans'].shape[1]}")
+    laser = doc.pop("laser")
+    metadata = {k: v for k, v in doc.items() if k not in ("format", "frames", "beams")}
+    return RunRecord(**arrays, laser=laser, metadata=metadata)

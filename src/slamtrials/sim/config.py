@@ -1,0 +1,249 @@
+"""Configuration of the simulated robot, laser and odometry (pydantic models, SI units).
+
+All lengths are in metres, angles in radians, times in seconds. The defaults are the settings of the
+paper (Amigoni, Castelli and Luperto, IROS 2018) and of its Stage set-up, so ``SimConfig()`` and
+``SimConfig.paper()`` are the same. Every model is frozen and rejects unknown keys; a bad value raises a
+``pydantic.ValidationError`` that names the field, the value and the allowed range
+(:meth:`SimConfig.from_dict` turns that into a one-line :class:`~slamtrials.errors.ConfigError`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+from slamtrials.errors import ConfigError
+
+__all__ = ["RobotConfig", "LaserConfig", "OdometryConfig", "SimConfig"]
+
+_MODEL_CONFIG = ConfigDict(extra="forbid", frozen=True)
+
+
+def _check_finite(name: str, values: tuple[float, ...]) -> None:
+    if not all(math.isfinite(v) for v in values):
+        raise ValueError(f"{name} must be finite numbers, got {values}")
+
+
+class RobotConfig(BaseModel):
+    """A differential-drive base with a disc footprint.
+
+    Attributes
+    ----------
+    radius:
+        Footprint radius (m). The paper's robot is a 0.2 x 0.2 m Pioneer-like square base; the disc that
+        circumscribes it has radius ``0.1 * sqrt(2) = 0.141`` m, rounded up to 0.15 m. Using the
+        circumscribed disc means the simulated robot never fits where the square one would not.
+    max_linear_speed:
+        Largest forward speed (m/s), 0.7 m/s as the paper's planner limit.
+    max_angular_speed:
+        Largest turn rate (rad/s), 70 deg/s as in the paper.
+    max_linear_accel:
+        Largest change of linear speed (m/s^2), used for acceleration and braking alike. 0.5 m/s^2:
+        a Pioneer's controller ships with a few tenths of m/s^2 (about 0.3) and allows more; 0.5 reaches
+        the top speed of 0.7 m/s in 1.4 s and stops from it within 0.49 m.
+    max_angular_accel:
+        Largest change of turn rate (rad/s^2), 100 deg/s^2 (the order of a Pioneer controller's
+        rotational acceleration setting): full turn rate in 0.7 s.
+    allow_reverse:
+        Whether negative linear speeds are obeyed (otherwise they are clipped to 0).
+    max_reverse_speed:
+        Largest backward speed (m/s, positive number). ``None`` means the same as ``max_linear_speed``.
+    """
+
+    model_config = _MODEL_CONFIG
+
+    radius: float = Field(0.15, gt=0.0, le=5.0, description="footprint disc radius (m)")
+    max_linear_speed: float = Field(0.7, gt=0.0, le=10.0, description="largest forward speed (m/s)")
+    max_angular_speed: float = Field(math.radians(70.0), gt=0.0, le=4.0 * math.pi, description="largest turn rate (rad/s)")
+    max_linear_accel: float = Field(0.5, gt=0.0, le=100.0, description="largest linear acceleration (m/s^2)")
+    max_angular_accel: float = Field(math.radians(100.0), gt=0.0, le=100.0, description="largest angular acceleration (rad/s^2)")
+    allow_reverse: bool = Field(True, description="obey negative linear speeds")
+    max_reverse_speed: float | None = Field(None, gt=0.0, le=10.0, description="largest backward speed (m/s); None = max_linear_speed")
+
+    @property
+    def reverse_speed_limit(self) -> float:
+        """Largest backward speed actually allowed (m/s, >= 0): 0 when reversing is off."""
+        if not self.allow_reverse:
+            return 0.0
+        return self.max_linear_speed if self.max_reverse_speed is None else self.max_reverse_speed
+
+
+class LaserConfig(BaseModel):
+    """A planar laser range finder (Stage ``ranger``-like), noise-free by default.
+
+    Beams are spread evenly over the field of view, counter-clockwise, from ``angle_min = -fov / 2`` to
+    ``+fov / 2`` in the laser frame. The beam count is ``round(fov / angular_resolution) + 1`` and the
+    actual increment is ``fov / (num_beams - 1)``, so the beams always span exactly the field of view
+    (270 deg at 0.5 deg gives 541 beams, increment exactly 0.5 deg up to rounding).
+
+    Attributes
+    ----------
+    fov:
+        Field of view (rad), in (0, 2 pi]. Default 270 deg.
+    angular_resolution:
+        Requested angle between beams (rad). Default 0.5 deg.
+    max_range:
+        Largest range (m). A beam that hits nothing within it reads exactly ``max_range``. Default 30 m.
+    min_range:
+        Smallest reportable range (m); readings are clipped up to it. Default 0: the simulator never
+        reports less than the true distance, and the robot's footprint keeps a centred laser at least
+        the robot radius away from walls. Set it (e.g. 0.02 m) to mimic a real scanner's dead zone.
+    mount:
+        Pose (x, y, theta) of the laser in the robot base frame (m, m, rad). Default (0, 0, 0).
+    range_noise_std:
+        Standard deviation (m) of zero-mean Gaussian noise added to every reading that hit something.
+        Max-range readings (no return) stay exactly ``max_range``. Default 0, as Stage's laser.
+    """
+
+    model_config = _MODEL_CONFIG
+
+    fov: float = Field(math.radians(270.0), gt=0.0, le=2.0 * math.pi, description="field of view (rad)")
+    angular_resolution: float = Field(math.radians(0.5), gt=0.0, le=2.0 * math.pi, description="angle between beams (rad)")
+    max_range: float = Field(30.0, gt=0.0, le=1000.0, description="largest range (m)")
+    min_range: float = Field(0.0, ge=0.0, le=1000.0, description="smallest range (m)")
+    mount: tuple[float, float, float] = Field((0.0, 0.0, 0.0), description="laser pose (x, y, theta) in the base frame")
+    range_noise_std: float = Field(0.0, ge=0.0, le=10.0, description="Gaussian range noise std (m)")
+
+    @field_validator("mount")
+    @classmethod
+    def _mount_finite(cls, value: tuple[float, float, float]) -> tuple[float, float, float]:
+        _check_finite("mount", value)
+        return value
+
+    @model_validator(mode="after")
+    def _consistent(self) -> "LaserConfig":
+        if self.angular_resolution > self.fov:
+            raise ValueError(
+                f"angular_resolution ({self.angular_resolution:g} rad) must not exceed fov ({self.fov:g} rad)"
+            )
+        if self.min_range >= self.max_range:
+            raise ValueError(f"min_range ({self.min_range:g} m) must be smaller than max_range ({self.max_range:g} m)")
+        if self.num_beams > 100_000:
+            raise ValueError(f"fov / angular_resolution gives {self.num_beams} beams; at most 100000 are allowed")
+        return self
+
+    @property
+    def num_beams(self) -> int:
+        """Number of beams B = ``round(fov / angular_resolution) + 1``."""
+        return int(round(self.fov / self.angular_resolution)) + 1
+
+    @property
+    def angle_min(self) -> float:
+        """Angle (rad) of beam 0 in the laser frame: ``-fov / 2``."""
+        return -0.5 * self.fov
+
+    @property
+    def angle_increment(self) -> float:
+        """Angle (rad) between consecutive beams: ``fov / (num_beams - 1)``."""
+        return self.fov / (self.num_beams - 1)
+
+    @property
+    def angles(self) -> NDArray[np.float64]:
+        """float64 ``[B]`` beam angles (rad) in the laser frame, counter-clockwise from ``angle_min``."""
+        return self.angle_min + np.arange(self.num_beams, dtype=np.float64) * self.angle_increment
+
+    def laser_info(self) -> dict[str, Any]:
+        """The laser geometry in the form :meth:`slamtrials.record.RunRecord.from_frames` expects."""
+        return {
+            "angle_min": self.angle_min,
+            "angle_increment": self.angle_increment,
+            "range_min": self.min_range,
+            "range_max": self.max_range,
+            "mount": [float(v) for v in self.mount],
+        }
+
+
+class OdometryConfig(BaseModel):
+    """The odometry error model of the paper: a constant per-run scale bias, plus optional noise.
+
+    Once per run, ``e_lin`` is drawn uniformly from ``bias_linear_range`` (m/m) and ``e_ang`` from
+    ``bias_angular_range`` (rad/rad). Every step, the odometry measures the true arc length times
+    ``1 + e_lin`` and the true heading change times ``1 + e_ang`` (see :mod:`slamtrials.sim.odometry`).
+
+    Optional random noise (off by default, as in the paper): zero-mean Gaussian noise added to each
+    step's measured arc length, with standard deviation ``noise_linear_per_m * |arc length|``, and to
+    each step's heading change, with standard deviation ``noise_angular_per_rad * |heading change|``.
+    The standard deviations are proportional to the step's motion (the "alpha" model of Thrun et al.,
+    Probabilistic Robotics), so a robot that stands still gets no noise; the accumulated noise of a
+    given path therefore depends on the step length ``dt``.
+
+    Attributes
+    ----------
+    bias_linear_range:
+        (low, high) of the uniform draw of ``e_lin`` (m/m). Paper: (-0.005, 0.005).
+    bias_angular_range:
+        (low, high) of the uniform draw of ``e_ang`` (rad/rad). Paper: +-1 deg/rad = +-0.017453.
+    bias_linear, bias_angular:
+        Fixed values that replace the draws (the draws are still made, so the random stream of the
+        rest of the run does not change). ``None`` (default) uses the draw.
+    noise_linear_per_m:
+        Arc-length noise std per metre of the step's arc length (m/m). Default 0.
+    noise_angular_per_rad:
+        Heading noise std per radian of the step's heading change (rad/rad). Default 0.
+    """
+
+    model_config = _MODEL_CONFIG
+
+    bias_linear_range: tuple[float, float] = Field((-0.005, 0.005), description="uniform range of e_lin (m/m)")
+    bias_angular_range: tuple[float, float] = Field(
+        (-math.radians(1.0), math.radians(1.0)), description="uniform range of e_ang (rad/rad)"
+    )
+    bias_linear: float | None = Field(None, gt=-0.5, lt=0.5, description="fixed e_lin (m/m), overrides the draw")
+    bias_angular: float | None = Field(None, gt=-0.5, lt=0.5, description="fixed e_ang (rad/rad), overrides the draw")
+    noise_linear_per_m: float = Field(0.0, ge=0.0, le=1.0, description="arc-length noise std per metre (m/m)")
+    noise_angular_per_rad: float = Field(0.0, ge=0.0, le=1.0, description="heading noise std per radian (rad/rad)")
+
+    @field_validator("bias_linear_range", "bias_angular_range")
+    @classmethod
+    def _range_ok(cls, value: tuple[float, float], info: Any) -> tuple[float, float]:
+        _check_finite(info.field_name, value)
+        low, high = value
+        if low > high:
+            raise ValueError(f"{info.field_name} must be (low, high) with low <= high, got {value}")
+        if low <= -0.5 or high >= 0.5:
+            raise ValueError(f"{info.field_name} must lie inside (-0.5, 0.5), got {value}")
+        return value
+
+
+class SimConfig(BaseModel):
+    """Everything the :class:`~slamtrials.sim.Simulator` needs besides the world and the random stream.
+
+    Attributes
+    ----------
+    dt:
+        Simulation step (s): one laser scan, odometry reading and ground-truth pose per step.
+        Default 0.1 s (10 Hz), as the paper.
+    robot, laser, odometry:
+        The sub-configurations.
+    """
+
+    model_config = _MODEL_CONFIG
+
+    dt: float = Field(0.1, gt=0.0, le=1.0, description="simulation step (s)")
+    robot: RobotConfig = Field(default_factory=RobotConfig)
+    laser: LaserConfig = Field(default_factory=LaserConfig)
+    odometry: OdometryConfig = Field(default_factory=OdometryConfig)
+
+    @classmethod
+    def paper(cls) -> "SimConfig":
+        """The settings of the paper (270 deg / 0.5 deg / 30 m laser, 10 Hz, +-0.5 % and +-1 deg/rad bias).
+
+        These are the defaults.
+        """
+        return cls()
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> "SimConfig":
+        """Validate a plain dict (e.g. loaded from YAML); raise :class:`ConfigError` with a one-line message."""
+        try:
+            return cls.model_validate(data)
+        except ValidationError as exc:
+            problems = []
+            for err in exc.errors():
+                field = ".".join(str(p) for p in err["loc"]) or "<root>"
+                problems.append(f"{field}: {err['msg']} (got {err.get('input')!r})")
+            raise ConfigError("simulation config: " + "; ".join(problems)) from None

@@ -1,0 +1,55 @@
+"""``slamtrials simulate`` end to end: a run folder that reads back, and nothing stored is overwritten."""
+
+from __future__ import annotations
+
+import numpy as np
+from typer.testing import CliRunner
+
+from slamtrials.cli.main import app
+from slamtrials.io.runfolder import read_run
+from slamtrials.worlds import World
+from slamtrials.worlds.formats.rosmap_save import save_rosmap
+
+runner = CliRunner()
+
+
+def _corridor_world(tmp_path):
+    occ = np.ones((60, 200), bool)
+    occ[10:50, 10:190] = False  # a 9 m x 2 m room
+    world = World(occ, 0.05, name="corridor", start=np.array([1.0, 1.5, 0.0]))
+    return save_rosmap(world, tmp_path / "corridor.yaml")
+
+
+def test_simulate_writes_a_run_that_follows_the_waypoints(tmp_path):
+    world_file = _corridor_world(tmp_path)
+    (tmp_path / "w.yaml").write_text("waypoints:\n  - [4.0, 1.5]\n  - [8.0, 1.5]\n")
+    out = tmp_path / "run"
+    result = runner.invoke(app, ["simulate", "-w", str(world_file), "-p", str(tmp_path / "w.yaml"), "-s", "4", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    record = read_run(out)
+    assert (out / "run.png").stat().st_size > 1000
+    assert abs(record.truth[-1, 0] - 8.0) < 0.3 and abs(record.truth[-1, 1] - 1.5) < 0.3
+    assert record.scans.shape == (len(record.t), 541)
+    assert record.metadata["seed"] == 4
+
+
+def test_simulate_refuses_to_overwrite_a_stored_run(tmp_path):
+    world_file = _corridor_world(tmp_path)
+    (tmp_path / "w.yaml").write_text("waypoints:\n  - [3.0, 1.5]\n")
+    out = tmp_path / "run"
+    args = ["simulate", "-w", str(world_file), "-p", str(tmp_path / "w.yaml"), "-o", str(out)]
+    assert runner.invoke(app, [*args, "-s", "1"]).exit_code == 0
+    before = (out / "frames.npz").read_bytes()
+    result = runner.invoke(app, [*args, "-s", "2"])
+    assert result.exit_code == 2 and "--overwrite" in result.output
+    assert (out / "frames.npz").read_bytes() == before
+    assert runner.invoke(app, [*args, "-s", "2", "--overwrite"]).exit_code == 0
+    assert read_run(out).metadata["seed"] == 2
+
+
+def test_bad_waypoint_file_is_one_line_with_its_name(tmp_path):
+    world_file = _corridor_world(tmp_path)
+    (tmp_path / "w.yaml").write_text("waypoints:\n  - [3.0]\n")
+    result = runner.invoke(app, ["simulate", "-w", str(world_file), "-p", str(tmp_path / "w.yaml"), "-o", str(tmp_path / "r")])
+    assert result.exit_code == 2
+    assert "w.yaml:2" in result.output and "Traceback" not in result.output

@@ -99,4 +99,9 @@ def load_world(source: str | Path, *, fmt: str | None = None, **options: Any) ->
         raise WorldError(
             f"{path}: unknown floor-plan format {fmt or path.suffix!r}; expected one of {', '.join(sorted(SUFFIX_FORMATS))}"
         )
-    return WORLD_FORMATS[fmt](path, **options)
+    try:
+        return WORLD_FORMATS[fmt](path, **options)
+    except TypeError as exc:
+        if "unexpected keyword argument" not in str(exc):
+            raise
+        raise WorldError(f"{path}: option not valid for the {fmt} format ({exc})") from None

@@ -108,9 +108,14 @@ class World:
         Cells outside the grid count as occupied, so free cells on the image border have clearance
         of one cell. Occupied cells have clearance 0.
         """
-        padded = np.pad(~self.occupied, 1, constant_values=False)
-        dist = ndimage.distance_transform_edt(padded)[1:-1, 1:-1]
-        out = np.asarray(dist, dtype=np.float64) * self.resolution
+        # Only the bounding box of the free cells (plus a ring of occupied cells) needs the transform:
+        # everything outside it is occupied, and the ring is nearer than any occupied cell beyond it.
+        rows = np.flatnonzero((~self.occupied).any(axis=1))
+        cols = np.flatnonzero((~self.occupied).any(axis=0))
+        r0, r1, c0, c1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+        padded = np.pad(~self.occupied[r0:r1, c0:c1], 1, constant_values=False)
+        out = np.zeros(self.occupied.shape, dtype=np.float64)
+        out[r0:r1, c0:c1] = ndimage.distance_transform_edt(padded)[1:-1, 1:-1] * self.resolution
         out.setflags(write=False)
         return out
 

@@ -1,0 +1,131 @@
+"""The odometry error model: a constant per-run scale bias on distance and rotation, plus optional noise.
+
+As in the paper (and Stage's odometry error), odometry multiplies the distance travelled by
+``1 + e_lin`` and the rotation by ``1 + e_ang``, with ``e_lin`` and ``e_ang`` drawn once per run.
+
+How a step is scaled
+--------------------
+Each step, the true motion is the relative pose ``delta = ominus(truth_prev, truth_new) = (dx, dy, phi)``
+in the robot frame at the start of the step. The simulator's steps are circular arcs (or turns in
+place), so ``delta`` is read as an arc: heading change ``phi`` and arc length
+``L = c / sinc(phi / 2)``, where ``c = |(dx, dy)|`` is the chord and ``sinc(x) = sin(x) / x``; the chord
+points at ``phi / 2`` from the start heading (``phi / 2 + pi`` when driving backwards).
+
+The odometry measures the arc length ``L' = (1 + e_lin) L (+ noise)`` and the heading change
+``phi' = (1 + e_ang) phi (+ noise)``, as a differential drive whose encoders over-read distance and
+rotation would, and integrates them exactly as an arc: the measured chord has length
+``c' = L' sinc(phi' / 2)`` and points at ``phi' / 2`` (the true chord rotated by ``(phi' - phi) / 2``).
+The measured increment is composed onto the odometry pose, which starts at (0, 0, 0).
+
+Consequences: driving straight, the odometry distance is exactly ``(1 + e_lin)`` times the true one;
+turning in place, the odometry rotation is exactly ``(1 + e_ang)`` times the true one (with
+``e_ang = -1 deg/rad``, 360 deg of true rotation read 353.72 deg).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from slamtrials.sim.config import OdometryConfig
+from slamtrials.sim.robot import compose1
+
+__all__ = ["draw_bias", "measured_increment", "Odometry"]
+
+
+def draw_bias(config: OdometryConfig, rng: np.random.Generator) -> dict[str, float]:
+    """Draw the per-run bias: ``{"linear": e_lin (m/m), "angular": e_ang (rad/rad)}``.
+
+    Two uniform deviates are always drawn from ``rng`` (linear first), even when the config fixes a
+    value, so fixing the bias leaves the rest of the random stream unchanged.
+    """
+    lin = float(rng.uniform(*config.bias_linear_range))
+    ang = float(rng.uniform(*config.bias_angular_range))
+    if config.bias_linear is not None:
+        lin = float(config.bias_linear)
+    if config.bias_angular is not None:
+        ang = float(config.bias_angular)
+    return {"linear": lin, "angular": ang}
+
+
+def _sinc(x: float) -> float:
+    return 1.0 if x == 0.0 else math.sin(x) / x
+
+
+def measured_increment(delta: ArrayLike, bias_linear: float, bias_angular: float, noise_linear: float = 0.0,
+                       noise_angular: float = 0.0) -> NDArray[np.float64]:
+    """The odometry increment measured for the true step ``delta``.
+
+    Parameters
+    ----------
+    delta:
+        float64 ``[3]`` true relative pose (dx, dy, phi) of the step, in the robot frame at its start
+        (m, m, rad; ``|phi| < pi``).
+    bias_linear, bias_angular:
+        Scale errors ``e_lin`` (m/m) and ``e_ang`` (rad/rad).
+    noise_linear:
+        Additive error (m) on the measured arc length (in the direction of travel).
+    noise_angular:
+        Additive error (rad) on the measured heading change.
+
+    Returns
+    -------
+    float64 ``[3]`` measured relative pose (dx', dy', phi'), see the module docstring.
+    """
+    dx, dy, phi = (float(v) for v in np.asarray(delta, dtype=np.float64))
+    phi_m = (1.0 + bias_angular) * phi + noise_angular
+    chord = math.hypot(dx, dy)
+    if chord == 0.0:
+        return np.array([0.0, 0.0, phi_m])
+    length = chord / _sinc(0.5 * phi)  # arc length, >= 0 (the direction sits in the chord)
+    length_m = (1.0 + bias_linear) * length + noise_linear
+    scale = length_m * _sinc(0.5 * phi_m) / chord
+    turn = 0.5 * (phi_m - phi)
+    c, s = math.cos(turn), math.sin(turn)
+    return np.array([scale * (c * dx - s * dy), scale * (s * dx + c * dy), phi_m])
+
+
+class Odometry:
+    """The robot's odometry for one run.
+
+    Parameters
+    ----------
+    config:
+        Error model.
+    bias:
+        ``{"linear": e_lin, "angular": e_ang}``, usually from :func:`draw_bias`.
+    rng:
+        Random stream for the optional per-step noise; not used when the noise coefficients are 0.
+
+    Attributes
+    ----------
+    pose:
+        float64 ``[3]`` current odometry pose (odometry frame, starts at (0, 0, 0)).
+    """
+
+    def __init__(self, config: OdometryConfig, bias: dict[str, float], rng: np.random.Generator):
+        self.config = config
+        self.bias = dict(bias)
+        self.rng = rng
+        self.pose: NDArray[np.float64] = np.zeros(3)
+
+    def update(self, delta: ArrayLike) -> NDArray[np.float64]:
+        """Add the measurement of the true step ``delta`` (``[3]``, robot frame) and return the new pose.
+
+        With ``noise_linear_per_m > 0`` one normal deviate with standard deviation
+        ``noise_linear_per_m * |arc length|`` is drawn, then (with ``noise_angular_per_rad > 0``) one
+        with standard deviation ``noise_angular_per_rad * |phi|``.
+        """
+        delta = np.asarray(delta, dtype=np.float64)
+        cfg = self.config
+        n_lin = n_ang = 0.0
+        if cfg.noise_linear_per_m > 0.0:
+            length = math.hypot(delta[0], delta[1]) / _sinc(0.5 * float(delta[2]))
+            n_lin = float(self.rng.normal(0.0, cfg.noise_linear_per_m * length))
+        if cfg.noise_angular_per_rad > 0.0:
+            n_ang = float(self.rng.normal(0.0, cfg.noise_angular_per_rad * abs(float(delta[2]))))
+        inc = measured_increment(delta, self.bias["linear"], self.bias["angular"], n_lin, n_ang)
+        self.pose = compose1(self.pose, inc)
+        return self.pose

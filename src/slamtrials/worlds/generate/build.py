@@ -1,0 +1,161 @@
+"""One generation pass: plan -> labels -> doors -> walls -> furniture -> one connected free region.
+
+:func:`build_grid` runs the whole pipeline for a given gross footprint and returns the occupancy grid
+with what the caller needs for the :class:`~slamtrials.worlds.World` (start pose, doors, counts).
+All randomness comes from one ``numpy.random.Generator`` made from the seed, so a pass is a pure
+function of its arguments.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import ndimage
+
+from slamtrials.worlds.generate.corridors import furnish_circulation
+from slamtrials.worlds.generate.doors import carve_doors, door_record, plan_doors
+from slamtrials.worlds.generate.furniture import furnish_room
+from slamtrials.worlds.generate.kinds import KindSpec
+from slamtrials.worlds.generate.placement import Placer
+from slamtrials.worlds.generate.raster import CIRCULATION, Grid, draw_walls, paint_labels, wall_pixels
+from slamtrials.worlds.generate.rooms import neighbour_of, clean_labels, merge_room
+from slamtrials.worlds.generate.skeleton import build_plan, choose_shape
+
+__all__ = ["Built", "build_grid", "keep_largest_region"]
+
+#: Clearance (m) the start pose is given from walls and furniture.
+START_CLEARANCE = 0.6
+
+
+@dataclass
+class Built:
+    """The result of one pass.
+
+    Attributes
+    ----------
+    occupied:
+        bool ``[H, W]``, row 0 at the top.
+    grid:
+        The raster (resolution, margin -> world origin).
+    start:
+        float64 ``[3]`` start pose in the world frame, or None to let :class:`World` choose.
+    shape:
+        Building shape name.
+    rooms:
+        Number of rooms that ended up with a door.
+    doors:
+        ``[x, y, width, wall_axis]`` per door (see :func:`~slamtrials.worlds.generate.doors.door_record`).
+    footprint:
+        Gross area of the building (m^2): everything inside the outer walls.
+    """
+
+    occupied: NDArray[np.bool_]
+    grid: Grid
+    start: NDArray[np.float64] | None
+    shape: str
+    rooms: int
+    doors: list[list[float]] = field(default_factory=list)
+    footprint: float = 0.0
+
+    @property
+    def free_area(self) -> float:
+        """Free area (m^2)."""
+        return float(np.count_nonzero(~self.occupied)) * self.grid.resolution**2
+
+
+def keep_largest_region(occupied: NDArray[np.bool_]) -> int:
+    """Fill every 4-connected free region but the largest as occupied (in place); return how many were filled."""
+    regions, count = ndimage.label(~occupied)
+    if count <= 1:
+        return 0
+    sizes = np.bincount(regions.ravel())
+    sizes[0] = 0
+    keep = int(np.argmax(sizes))
+    occupied[(regions != keep) & (regions != 0)] = True
+    return count - 1
+
+
+def _start_pose(occupied: NDArray[np.bool_], labels: NDArray[np.int32], grid: Grid) -> NDArray[np.float64] | None:
+    """A pose in the circulation nearest the building's centre, with START_CLEARANCE, along the corridor."""
+    step = 4
+    rows, cols = np.nonzero(labels[::step, ::step] > 0)
+    centre_r, centre_c = rows.mean() * step, cols.mean() * step
+    size = 2 * grid.px(START_CLEARANCE) + 1
+    free = (~occupied).view(np.uint8)
+    roomy = ndimage.minimum_filter1d(ndimage.minimum_filter1d(free, size, axis=0), size, axis=1).view(bool)
+    cand_r, cand_c = np.nonzero(roomy & (labels == CIRCULATION))
+    if len(cand_r) == 0:
+        return None
+    best = int(np.argmin((cand_r - centre_r) ** 2 + (cand_c - centre_c) ** 2))
+    r, c = int(cand_r[best]), int(cand_c[best])
+    run = []
+    for line, i in ((occupied[r, :], c), (occupied[:, c], r)):
+        walls = np.flatnonzero(line)
+        after = walls[walls > i]
+        before = walls[walls < i]
+        run.append((after[0] if len(after) else len(line)) - (before[-1] if len(before) else -1))
+    heading = 0.0 if run[0] >= run[1] else np.pi / 2
+    x, y = grid.cell_centre(r, c)
+    return np.array([x, y, heading])
+
+
+def _plan_all_doors(labels, uses, boxes, grid, wall_k, rng):
+    """Doors for every room; rooms that cannot get one are merged into a neighbour and we try again."""
+    for _ in range(6):
+        doors, pending = plan_doors(labels, uses, grid, wall_k, rng)
+        if not pending:
+            return doors
+        for k in pending:
+            if k in boxes:
+                merge_room(labels, boxes, k, neighbour_of(labels, k, boxes[k]))
+    for k in pending:
+        uses[k - 2] = ("shaft", uses[k - 2][1])
+    return doors
+
+
+def build_grid(spec: KindSpec, shape_area: float, gross: float, seed: int, resolution: float) -> Built:
+    """Run the whole pipeline once.
+
+    Parameters
+    ----------
+    spec:
+        The building kind.
+    shape_area:
+        Gross area (m^2) the shape is chosen for (kept fixed while ``gross`` is tuned).
+    gross:
+        Gross footprint (m^2) to lay out.
+    seed:
+        Seed of the pass's random generator.
+    resolution:
+        Cell size (m).
+    """
+    rng = np.random.default_rng(seed)
+    shape = choose_shape(spec, shape_area, rng)
+    plan = build_plan(spec, shape, gross, rng)
+    grid = Grid.for_plan(plan, resolution)
+    labels, uses = paint_labels(plan, grid)
+    boxes = clean_labels(labels, uses, grid)
+    wall_k = wall_pixels(resolution)
+    doors = _plan_all_doors(labels, uses, boxes, grid, wall_k, rng)
+    occupied = draw_walls(labels, wall_k)
+    solid = np.zeros(len(uses) + 2, dtype=bool)
+    solid[2:] = [use == "shaft" for use, _ in uses]
+    occupied |= solid[labels]
+    door_mask, reserved = carve_doors(occupied, doors, grid, wall_k)
+    placer = Placer(occupied, labels, reserved, grid)
+    furnish_circulation(placer, plan, rng)
+    interiors = ndimage.find_objects(np.where(occupied | door_mask, 0, labels))
+    present = 0
+    for index, sub in enumerate(interiors):
+        label = index + 1
+        if sub is None or label < 2:
+            continue
+        present += 1
+        use, style = uses[label - 2]
+        furnish_room(placer, label, (sub[0].start, sub[0].stop, sub[1].start, sub[1].stop), use, style, rng)
+    keep_largest_region(occupied)
+    start = _start_pose(occupied, labels, grid)
+    footprint = float(np.count_nonzero(labels)) * resolution**2
+    return Built(occupied, grid, start, shape, present, [door_record(d, grid) for d in doors], footprint)

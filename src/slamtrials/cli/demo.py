@@ -22,16 +22,18 @@ def demo(
     from slamtrials.demo import run_demo
 
     console = Console()
-    table = Table(title="slamtrials demo: scripted tours (paper robot, laser and odometry)")
-    for column in ("world", "frames", "simulated", "wall", "speed-up", "distance", "odometry drift", "outcome"):
-        table.add_column(column, justify="left" if column in ("world", "outcome") else "right")
+    if not console.is_terminal:  # logs and pipes: do not squeeze the table into 80 columns
+        console = Console(width=110)
+    table = Table(title="Scripted tours, paper robot; drift = odometry end-point error")
+    for column in ("world", "frames", "sim s", "wall s", "speed", "path m", "drift m", "outcome"):
+        table.add_column(column, justify="left" if column in ("world", "outcome") else "right", no_wrap=True)
 
     def show(run) -> None:
         console.print(f"  {run.world}: {run.frames} frames -> {run.folder}")
         table.add_row(
-            run.world, str(run.frames), f"{run.simulated_s:.0f} s", f"{run.wall_s:.1f} s",
-            f"{run.simulated_s / max(run.wall_s, 1e-9):.0f}x", f"{run.distance_m:.1f} m",
-            f"{run.odometry_drift_m:.2f} m", run.outcome,
+            run.world, str(run.frames), f"{run.simulated_s:.0f}", f"{run.wall_s:.1f}",
+            f"{run.simulated_s / max(run.wall_s, 1e-9):.0f}x", f"{run.distance_m:.1f}",
+            f"{run.odometry_drift_m:.2f}", run.outcome,
         )
 
     run_demo(out, tuple(world) if world else DEMO_WORLDS, seed=seed, on_run=show)

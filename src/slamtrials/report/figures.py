@@ -37,8 +37,8 @@ def world_picture(world: World, max_pixels: int = 2000) -> tuple[NDArray[np.floa
     """RGB image ``[h, w, 3]`` of the world for display, and the block size it was reduced by.
 
     Blocks of ``f x f`` cells are shown as occupied if any cell is, so thin walls survive the
-    reduction. Occupied cells within 0.35 m of free space are walls (black); solid mass further away
-    (outside the building, solid cores) is grey.
+    reduction. Occupied cells are black (walls, furniture), except the solid mass outside the
+    building (more than 0.25 m from free space and connected to the image border), which is grey.
     """
     occ = world.occupied
     factor = max(1, math.ceil(max(occ.shape) / max_pixels))
@@ -47,17 +47,20 @@ def world_picture(world: World, max_pixels: int = 2000) -> tuple[NDArray[np.floa
         padded = np.pad(occ, ((0, (-h) % factor), (0, (-w) % factor)), constant_values=True)
         occ = padded.reshape(padded.shape[0] // factor, factor, padded.shape[1] // factor, factor).any(axis=(1, 3))
     cell = world.resolution * factor
-    depth = ndimage.distance_transform_edt(occ) * cell
+    deep = ndimage.distance_transform_edt(occ) * cell > max(0.25, 1.5 * cell)
+    parts, _count = ndimage.label(deep)
+    border = np.unique(np.concatenate([parts[0], parts[-1], parts[:, 0], parts[:, -1]]))
+    outside = np.isin(parts, border[border > 0])
     rgb = np.empty(occ.shape + (3,))
     rgb[...] = FREE_RGB
     rgb[occ] = WALL_RGB
-    rgb[occ & (depth > max(0.35, 1.5 * cell))] = SOLID_RGB
+    rgb[outside] = SOLID_RGB
     return rgb, factor
 
 
 def draw_world(ax, world: World, *, start: bool = True, scale_bar: bool = True, title: str | None = None,
                max_pixels: int = 2000) -> None:
-    """Draw a world on ``ax`` in world coordinates (metres): walls black, free white, solid mass grey,
+    """Draw a world on ``ax`` in world coordinates (metres): walls black, free white, outside grey,
     the start pose as an arrow, a scale bar in metres, and a title with the name and the free area.
 
     Parameters

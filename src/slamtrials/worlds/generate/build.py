@@ -80,16 +80,27 @@ def keep_largest_region(occupied: NDArray[np.bool_]) -> int:
 def _start_pose(occupied: NDArray[np.bool_], labels: NDArray[np.int32], grid: Grid) -> NDArray[np.float64] | None:
     """A pose in the circulation nearest the building's centre, with START_CLEARANCE, along the corridor."""
     step = 4
-    rows, cols = np.nonzero(labels[::step, ::step] > 0)
-    centre_r, centre_c = rows.mean() * step, cols.mean() * step
-    size = 2 * grid.px(START_CLEARANCE) + 1
-    free = (~occupied).view(np.uint8)
-    roomy = ndimage.minimum_filter1d(ndimage.minimum_filter1d(free, size, axis=0), size, axis=1).view(bool)
-    cand_r, cand_c = np.nonzero(roomy & (labels == CIRCULATION))
-    if len(cand_r) == 0:
+    coarse = labels[::step, ::step]
+    rows, cols = np.nonzero(coarse > 0)
+    centre_r, centre_c = rows.mean(), cols.mean()
+    rows, cols = np.nonzero(coarse == CIRCULATION)
+    if len(rows) == 0:
         return None
-    best = int(np.argmin((cand_r - centre_r) ** 2 + (cand_c - centre_c) ** 2))
-    r, c = int(cand_r[best]), int(cand_c[best])
+    nearest = np.argsort((rows - centre_r) ** 2 + (cols - centre_c) ** 2)[0]
+    centre_r, centre_c = int(rows[nearest]) * step, int(cols[nearest]) * step
+    size = 2 * grid.px(START_CLEARANCE) + 1
+    for reach in (grid.px(12.0), max(occupied.shape)):
+        r0, c0 = max(0, centre_r - reach), max(0, centre_c - reach)
+        window = (slice(r0, centre_r + reach), slice(c0, centre_c + reach))
+        free = (~occupied[window]).view(np.uint8)
+        roomy = ndimage.minimum_filter1d(ndimage.minimum_filter1d(free, size, axis=0), size, axis=1).view(bool)
+        cand_r, cand_c = np.nonzero(roomy & (labels[window] == CIRCULATION))
+        if len(cand_r):
+            break
+    else:
+        return None
+    best = int(np.argmin((cand_r + r0 - centre_r) ** 2 + (cand_c + c0 - centre_c) ** 2))
+    r, c = int(cand_r[best]) + r0, int(cand_c[best]) + c0
     run = []
     for line, i in ((occupied[r, :], c), (occupied[:, c], r)):
         walls = np.flatnonzero(line)
@@ -104,7 +115,7 @@ def _start_pose(occupied: NDArray[np.bool_], labels: NDArray[np.int32], grid: Gr
 def _plan_all_doors(labels, uses, boxes, grid, wall_k, rng):
     """Doors for every room; rooms that cannot get one are merged into a neighbour and we try again."""
     for _ in range(6):
-        doors, pending = plan_doors(labels, uses, grid, wall_k, rng)
+        doors, pending = plan_doors(labels, uses, boxes, grid, wall_k, rng)
         if not pending:
             return doors
         for k in pending:

@@ -56,6 +56,8 @@ class Door:
 def _runs(first: NDArray, second: NDArray, a: NDArray, b: NDArray) -> tuple[NDArray, ...]:
     """Group boundary cells sorted by (first, second) into runs of consecutive ``second``."""
     lo, hi = np.minimum(a, b), np.maximum(a, b)
+    if len(first) == 0:
+        return first, second, second, lo, hi
     brk = np.ones(len(first), dtype=bool)
     brk[1:] = (first[1:] != first[:-1]) | (second[1:] != second[:-1] + 1) | (lo[1:] != lo[:-1]) | (hi[1:] != hi[:-1])
     starts = np.flatnonzero(brk)
@@ -67,7 +69,9 @@ def interface_segments(labels: NDArray[np.int32]) -> Segments:
     """All straight boundary runs between two labels that are both inside the building (> 0)."""
     left, right = labels[:, :-1], labels[:, 1:]
     mask = (left != right) & (left > 0) & (right > 0)
-    cols, rows = np.nonzero(mask.T)  # sorted by column, then row
+    rows, cols = np.nonzero(mask)
+    order = np.lexsort((rows, cols))  # by column, then row
+    rows, cols = rows[order], cols[order]
     v = _runs(cols, rows, left[rows, cols], right[rows, cols])
     top, bottom = labels[:-1, :], labels[1:, :]
     mask = (top != bottom) & (top > 0) & (bottom > 0)
@@ -105,23 +109,25 @@ def _place(segs: Segments, s: int, n: int, margin: int, rng: np.random.Generator
     return None
 
 
-def plan_doors(labels: NDArray[np.int32], uses: list[tuple[str, str]], grid: Grid, wall_k: int,
-               rng: np.random.Generator) -> tuple[list[Door], list[int]]:
-    """Choose the doors of every room.
+def plan_doors(labels: NDArray[np.int32], uses: list[tuple[str, str]], boxes: dict[int, tuple[slice, slice]],
+               grid: Grid, wall_k: int, rng: np.random.Generator) -> tuple[list[Door], list[int]]:
+    """Choose the doors of every room (``boxes``: label -> bounding box of the rooms present).
 
     Returns the doors and the rooms that could not be given a way in (to be merged by the caller).
     """
     segs = interface_segments(labels)
     margin = wall_k + 1 + grid.px(0.15)
     res2 = grid.resolution**2
-    present = np.unique(labels)
-    rooms = [int(k) for k in present if k >= 2 and uses[k - 2][0] != "shaft"]
-    areas = np.bincount(labels.ravel(), minlength=int(present.max()) + 1) * res2
+    rooms = [k for k in sorted(boxes) if uses[k - 2][0] != "shaft"]
+    areas = {k: float(np.count_nonzero(labels[boxes[k]] == k)) * res2 for k in rooms}
     by_room: dict[int, list[int]] = {k: [] for k in rooms}
-    for s in range(len(segs.line)):
-        for k in (int(segs.lo[s]), int(segs.hi[s])):
-            if k in by_room:
-                by_room[k].append(s)
+    lengths_all = (segs.stop - segs.start).tolist()
+    los, his = segs.lo.tolist(), segs.hi.tolist()
+    for s, (a, b) in enumerate(zip(los, his)):
+        if a in by_room:
+            by_room[a].append(s)
+        if b in by_room:
+            by_room[b].append(s)
 
     def width_of(k: int) -> int:
         use, style = uses[k - 2]
@@ -131,7 +137,7 @@ def plan_doors(labels: NDArray[np.int32], uses: list[tuple[str, str]], grid: Gri
         return _door_cells(float(rng.uniform(lo, hi)), grid)
 
     def other(s: int, k: int) -> int:
-        return int(segs.hi[s]) if int(segs.lo[s]) == k else int(segs.lo[s])
+        return his[s] if los[s] == k else los[s]
 
     doors: list[Door] = []
     used: dict[int, list[tuple[int, int]]] = {}
@@ -142,13 +148,12 @@ def plan_doors(labels: NDArray[np.int32], uses: list[tuple[str, str]], grid: Gri
         changed = False
         for k in list(pending):
             n = width_of(k)
-            options = [s for s in by_room[k] if other(s, k) in connected
-                       and int(segs.stop[s] - segs.start[s]) >= n + 2 * margin and other(s, k) not in pending]
+            options = [s for s in by_room[k] if other(s, k) in connected and lengths_all[s] >= n + 2 * margin]
             if not options:
                 continue
             to_corridor = [s for s in options if other(s, k) == CIRCULATION]
             pool = to_corridor or options
-            lengths = np.array([segs.stop[s] - segs.start[s] for s in pool], dtype=float)
+            lengths = np.array([lengths_all[s] for s in pool], dtype=float)
             s = pool[int(rng.choice(len(pool), p=lengths / lengths.sum()))]
             door = _place(segs, s, n, margin, rng)
             if door is None:
@@ -163,8 +168,7 @@ def plan_doors(labels: NDArray[np.int32], uses: list[tuple[str, str]], grid: Gri
                 if second is not None and abs(second.start - door.start) * grid.resolution > 3.0:
                     doors.append(second)
                     used[s].append((second.start, second.start + n))
-    for s in range(len(segs.line)):
-        a, b = int(segs.lo[s]), int(segs.hi[s])
+    for s, (a, b) in enumerate(zip(los, his)):
         if a < 2 or a not in connected or b not in connected or s in used:
             continue
         style = STYLES[uses[a - 2][1]]

@@ -152,13 +152,13 @@ def _lab(p: Placer, label: int, box: Box, rng: np.random.Generator) -> None:
         _office(p, label, box, rng)
         along_walls(p, label, box, rng, 1, (1.0, 2.0), (0.6, 0.8))
         return
-    along_walls(p, label, box, rng, 3 + int(area > 40), (2.0, 5.0), (0.7, 0.8))  # wall benches
-    along_walls(p, label, box, rng, 1, (1.2, 1.8), (0.8, 0.9))  # fume hood
-    along_walls(p, label, box, rng, 2, (0.8, 1.2), (0.5, 0.6))  # cabinets
+    along_walls(p, label, box, rng, 4 + int(area // 20), (1.8, 4.5), (0.7, 0.8))  # wall benches
+    along_walls(p, label, box, rng, 1 + int(area > 35), (1.2, 1.8), (0.8, 0.9))  # fume hoods
+    along_walls(p, label, box, rng, 3, (0.6, 1.2), (0.5, 0.6))  # cabinets, fridges
     r0, r1, c0, c1 = box
     bench = (1.5, _u(rng, 2.4, 4.0))
-    island_grid(p, label, box, rng, bench if (c1 - c0) >= (r1 - r0) else bench[::-1], _u(rng, 1.1, 1.6), skip=0.15)
-    for _ in range(int(area // 15)):  # instruments, carts, small tables
+    island_grid(p, label, box, rng, bench if (c1 - c0) >= (r1 - r0) else bench[::-1], _u(rng, 1.1, 1.5), skip=0.1)
+    for _ in range(int(area // 6)):  # instruments, carts, small tables
         r, c = int(rng.integers(r0, max(r0 + 1, r1))), int(rng.integers(c0, max(c0 + 1, c1)))
         s1, s2 = p.px(_u(rng, 0.5, 1.1)), p.px(_u(rng, 0.5, 1.1))
         p.put(label, r, c, s1, s2, round_=rng.random() < 0.3)

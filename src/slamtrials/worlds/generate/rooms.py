@@ -58,17 +58,25 @@ def merge_room(labels: NDArray[np.int32], boxes: dict[int, Box], label: int, int
         boxes[into] = _union(boxes[into], box)
 
 
-def clean_labels(labels: NDArray[np.int32], uses: list[tuple[str, str]], grid: Grid, *,
-                 min_area: float = 2.5, min_width: float = 1.4) -> dict[int, Box]:
-    """Split rooms into connected pieces and merge pieces smaller than ``min_area`` m^2 or thinner than
-    ``min_width`` m into a neighbour. Modifies ``labels`` and ``uses`` in place; returns room boxes."""
-    boxes = room_boxes(labels)
+def _trim_thin(labels: NDArray[np.int32], boxes: dict[int, Box], size: int) -> None:
+    """Turn every part of a room that a ``size x size`` square cannot sweep into solid (OUTSIDE)."""
+    for label, box in boxes.items():
+        window = labels[box]
+        mask = (window == label).view(np.uint8)
+        opened = ndimage.maximum_filter(ndimage.minimum_filter(mask, size=size, mode="constant", cval=0), size=size,
+                                        mode="constant", cval=0)
+        window[(mask > opened)] = OUTSIDE
+
+
+def _split_pieces(labels: NDArray[np.int32], uses: list[tuple[str, str]], boxes: dict[int, Box]) -> None:
+    """Give every 4-connected piece of a room but the largest a label of its own."""
     four = ndimage.generate_binary_structure(2, 1)
     for label in sorted(boxes):
         box = boxes[label]
         window = labels[box]
         parts, count = ndimage.label(window == label, structure=four)
-        if count <= 1:
+        if count == 0:
+            del boxes[label]
             continue
         sizes = np.bincount(parts.ravel())[1:]
         keep = int(np.argmax(sizes)) + 1
@@ -83,19 +91,25 @@ def clean_labels(labels: NDArray[np.int32], uses: list[tuple[str, str]], grid: G
             uses.append(uses[label - 2])
             window[parts == part] = new
             boxes[new] = sub
+
+
+def clean_labels(labels: NDArray[np.int32], uses: list[tuple[str, str]], grid: Grid, *,
+                 min_area: float = 2.5, min_width: float = 1.2) -> dict[int, Box]:
+    """Make every room a clean, reachable shape.
+
+    Parts of a room narrower than ``min_width`` metres (slivers left by corridors painted over room
+    strips, thin legs) become solid, so no passage narrower than that can lead into or through a room;
+    rooms cut in pieces get one label per piece; pieces smaller than ``min_area`` m^2 join the
+    neighbour they share the longest boundary with. Modifies ``labels`` and ``uses`` in place; returns
+    the bounding box of every room label left.
+    """
+    boxes = room_boxes(labels)
+    _trim_thin(labels, boxes, 2 * (int(round(min_width / grid.resolution)) // 2) + 1)
+    _split_pieces(labels, uses, boxes)
     min_px = min_area / grid.resolution**2
-    half = 0.5 * min_width / grid.resolution
     order = sorted(boxes, key=lambda k: (int(np.count_nonzero(labels[boxes[k]] == k)), k))
     for label in order:
-        if label not in boxes:
-            continue
         box = boxes[label]
-        mask = labels[box] == label
-        area = int(np.count_nonzero(mask))
-        thin = False
-        if area >= min_px:
-            inner = ndimage.distance_transform_edt(np.pad(mask, 1))
-            thin = float(inner.max()) < half
-        if area < min_px or thin:
+        if int(np.count_nonzero(labels[box] == label)) < min_px:
             merge_room(labels, boxes, label, neighbour_of(labels, label, box))
     return boxes

@@ -56,25 +56,24 @@ def choose_shape(spec: KindSpec, gross: float, rng: np.random.Generator) -> str:
     if spec.name == "house":
         return "bar"
     style = STYLES[spec.styles[0]]
-    bar_width = 2 * sum(style.depth) / 2 + sum(style.corridor) / 2 + 3 * WALL
+    bar_width = sum(style.depth) + sum(style.corridor) / 2 + 3 * WALL
     if spec.name == "multiwing":
         if gross < 2500:
             options = ["L", "T", "Z", "U"]
         elif gross < 6000:
             options = ["U", "H", "comb", "T", "cross"]
         else:
-            options = ["H", "comb", "fishbone", "U"]
+            options = ["H", "comb", "fishbone"]
         return options[int(rng.integers(len(options)))]
     bar_length = gross / bar_width
     if bar_length <= 55.0:
         return "bar"
-    options = ["racetrack", "L", "T"]
-    if bar_length <= 85.0:
-        options.append("bar")
-    if gross >= 2500:
-        options += ["U", "H"]
-    if gross >= 5000:
-        options += ["comb", "racetrack"]
+    if gross <= 2500:
+        options = ["racetrack", "L", "T"] + (["bar"] if bar_length <= 85.0 else [])
+    elif gross <= 5500:
+        options = ["racetrack", "U", "H", "T"]
+    else:
+        options = ["H", "comb", "fishbone", "U"]
     return options[int(rng.integers(len(options)))]
 
 
@@ -113,23 +112,25 @@ def _single(spec: KindSpec, shape: str, gross: float, rng: np.random.Generator) 
     for draw, e in zip(ends, extra):
         wanted = corridors == 2 or draw < (0.9 if style.name == "house" else 0.6)
         end_depth.append(e if wanted and length > 2.5 * e + 6.0 else 0.0)
-    cross: tuple[float, ...] = ()
-    if corridors == 2:
-        cw = bands[1].depth
-        first, last = end_depth[0] + cw / 2, length - end_depth[1] - cw / 2
-        count = max(0, int((last - first) // float(rng.uniform(28.0, 42.0))))
-        cross = tuple(float(c) for c in np.linspace(first, last, count + 2))
+    cross = _cross(length, (end_depth[0], end_depth[1]), bands[1].depth, rng) if corridors == 2 else ()
     wing = Wing(0.0, 0.0, True, length, bands, (end_depth[0], end_depth[1]), cross, style, lobby=rng.random() < style.lobby_prob)
     return wing_plan(wing, rng)
 
 
-def _arm_layout(shape: str, rng: np.random.Generator) -> list[tuple[str | float, int]]:
+def _cross(wing_len: float, end_depth: tuple[float, float], cw: float, rng: np.random.Generator) -> tuple[float, ...]:
+    """Cross-corridor centres: one at each end of the corridors and one every 28-42 m between."""
+    first, last = end_depth[0] + cw / 2, wing_len - end_depth[1] - cw / 2
+    count = max(0, int((last - first) // float(rng.uniform(28.0, 42.0))))
+    return tuple(float(c) for c in np.linspace(first, last, count + 2))
+
+
+def _arm_layout(shape: str, gross: float) -> list[tuple[str | float, int]]:
     if shape in SHAPES:
         return list(SHAPES[shape])
     if shape == "comb":
-        n = int(rng.integers(3, 6))
+        n = int(np.clip(round(gross / 1800.0), 3, 6))
         return [("end0", +1)] + [(i / (n - 1), +1) for i in range(1, n - 1)] + [("end1", +1)]
-    n = int(rng.integers(2, 4))  # fishbone: arms on both sides
+    n = int(np.clip(round(gross / 3500.0), 2, 4))  # fishbone: arms on both sides
     arms: list[tuple[str | float, int]] = []
     for i in range(n):
         pos: str | float = "end0" if i == 0 else "end1" if i == n - 1 else i / (n - 1)
@@ -137,31 +138,45 @@ def _arm_layout(shape: str, rng: np.random.Generator) -> list[tuple[str | float,
     return arms
 
 
-def _arms(spec: KindSpec, shape: str, gross: float, rng: np.random.Generator) -> Plan:
-    """A spine with arms; the arms' corridors join the spine's corridors through junction lobbies."""
-    spine_style = _pick_style(spec, rng)
-    spine_corridors = 2 if gross > 6500 and rng.random() < 0.6 else 1
-    spine_bands = _bands(spine_style, rng, spine_corridors)
-    layout = _arm_layout(shape, rng)
-    arm_styles = [_pick_style(spec, rng) for _ in layout]
-    arm_bands = [_bands(s, rng, 1) for s in arm_styles]
-    alphas = np.array([float(rng.uniform(0.35, 0.75)) for _ in layout])
-    if len(layout) > 3:
-        alphas *= 0.8
+def _arm_sizes(layout, narrow, wide, spine_bands, gross, rng):
+    """Spine length, and each arm's bands and length (m)."""
+    shares = np.array([float(rng.uniform(0.75, 1.25)) for _ in layout])
     gaps = float(rng.uniform(9.0, 16.0))
     ws = _width(spine_bands)
-    wa = np.array([_width(b) for b in arm_bands])
-    spine_len = gross / (ws + float(np.sum(alphas * wa)))
+    spine_share = float(rng.uniform(0.85, 1.15)) / (1.0 + 0.8 * len(layout))
+    spine_len = spine_share * gross / ws
+    arm_gross = (gross - ws * spine_len) * shares / shares.sum()
+    bands = [n if gross < 3000 or a / _width(n) <= 0.9 * spine_len else w for n, w, a in zip(narrow, wide, arm_gross)]
+    wa = np.array([_width(b) for b in bands])
+    need = 0.0
     for side in (+1, -1):
         on_side = [i for i, (_, s) in enumerate(layout) if s == side]
         if on_side:
-            need = float(np.sum(wa[on_side])) + gaps * (len(on_side) - 1) + (0.0 if len(on_side) > 1 else 4.0)
-            spine_len = max(spine_len, need)
-    rest = gross - ws * spine_len
-    alphas = alphas * max(0.2, rest / (spine_len * float(np.sum(alphas * wa)))) if rest > 0 else alphas * 0.2
-    arm_len = np.maximum(alphas * spine_len, 0.9 * wa)
+            need = max(need, float(np.sum(wa[on_side])) + gaps * (len(on_side) - 1) + (0.0 if len(on_side) > 1 else 4.0))
+    if spine_len < need:
+        spine_len = need
+        arm_gross = max(gross - ws * spine_len, 0.15 * gross) * shares / shares.sum()
+    return float(spine_len), bands, [float(v) for v in np.maximum(arm_gross / wa, 0.9 * wa)]
+
+
+def _arms(spec: KindSpec, shape: str, gross: float, rng: np.random.Generator) -> Plan:
+    """A spine with arms; the arms' corridors join the spine's corridors, often through a junction lobby.
+
+    The spine takes about 1 / (1 + 0.8 n) of the area for n arms (more if the arms need the room
+    along it); the arms share the rest. In buildings over 3,000 m^2, an arm that would be longer than 0.9 times the spine gets
+    two corridors (twice as wide).
+    """
+    spine_style = _pick_style(spec, rng)
+    spine_bands = _bands(spine_style, rng, 2 if gross > 5000 and rng.random() < 0.7 else 1)
+    layout = _arm_layout(shape, gross)
+    arm_styles = [_pick_style(spec, rng) for _ in layout]
+    narrow = [_bands(s, rng, 1) for s in arm_styles]
+    wide = [_bands(s, rng, 2) for s in arm_styles]
+    spine_len, arm_bands, arm_len = _arm_sizes(layout, narrow, wide, spine_bands, gross, rng)
+    ws = _width(spine_bands)
     centres = []
-    for (pos, _), w in zip(layout, wa):
+    for (pos, _), bands in zip(layout, arm_bands):
+        w = _width(bands)
         if pos == "end0":
             centres.append(w / 2)
         elif pos == "end1":
@@ -179,33 +194,28 @@ def _arms(spec: KindSpec, shape: str, gross: float, rng: np.random.Generator) ->
     for k in range(2):
         if end_depth[k] == 0 and rng.random() < 0.6:
             end_depth[k] = float(rng.uniform(0.9, 1.2)) * spine_bands[0].depth
-    cross: tuple[float, ...] = ()
-    if spine_corridors == 2:
-        cw = spine_bands[1].depth
-        first, last = end_depth[0] + cw / 2, spine_len - end_depth[1] - cw / 2
-        count = max(0, int((last - first) // float(rng.uniform(28.0, 42.0))))
-        cross = tuple(float(c) for c in np.linspace(first, last, count + 2))
-    spine = Wing(0.0, 0.0, True, spine_len, spine_bands, (end_depth[0], end_depth[1]), cross, spine_style,
-                 lobby=rng.random() < spine_style.lobby_prob)
+    ends = (end_depth[0], end_depth[1])
+    cross = _cross(spine_len, ends, spine_bands[1].depth, rng) if len(spine_bands) > 3 else ()
+    spine = Wing(0.0, 0.0, True, spine_len, spine_bands, ends, cross, spine_style, lobby=rng.random() < spine_style.lobby_prob)
     plan = wing_plan(spine, rng)
     spine_corr = [spine.band_range(i) for i in spine.corridor_indices()]
-    for (pos, side), bands, style, centre, length in zip(layout, arm_bands, arm_styles, centres, arm_len):
-        width = _width(bands)
-        x0 = centre - width / 2
-        tip = float(rng.uniform(0.9, 1.3)) * bands[0].depth if rng.random() < 0.65 else 0.0
+    for (_pos, side), bands, style, centre, length in zip(layout, arm_bands, arm_styles, centres, arm_len):
+        x0 = centre - _width(bands) / 2
+        tip = float(rng.uniform(0.9, 1.3)) * bands[0].depth if len(bands) > 3 or rng.random() < 0.65 else 0.0
         y0 = ws if side > 0 else -float(length)
-        ends = (0.0, tip) if side > 0 else (tip, 0.0)
-        arm = Wing(x0, y0, False, float(length), bands, ends, (), style)
+        arm_ends = (0.0, tip) if side > 0 else (tip, 0.0)
+        arm_cross = _cross(float(length), arm_ends, bands[1].depth, rng) if len(bands) > 3 else ()
+        arm = Wing(x0, y0, False, float(length), bands, arm_ends, arm_cross, style)
         plan.extend(wing_plan(arm, rng))
-        c0, c1 = arm.band_range(arm.corridor_indices()[0])
-        cx0, cx1 = x0 + c0, x0 + c1
-        if side > 0:
-            link = Rect(cx0, spine_corr[-1][0], cx1, ws)
-        else:
-            link = Rect(cx0, 0.0, cx1, spine_corr[0][1])
-        plan.corridors.append((link, "y", style.name))
+        sy0, sy1 = spine_corr[-1] if side > 0 else spine_corr[0]
+        for index in arm.corridor_indices():
+            c0, c1 = arm.band_range(index)
+            cx0, cx1 = x0 + c0, x0 + c1
+            link = Rect(cx0, sy0, cx1, ws) if side > 0 else Rect(cx0, 0.0, cx1, sy1)
+            plan.corridors.append((link, "y", style.name))
         if rng.random() < 0.5:
-            sy0, sy1 = spine_corr[-1] if side > 0 else spine_corr[0]
+            c0, c1 = arm.band_range(arm.corridor_indices()[0])
+            cx0, cx1 = x0 + c0, x0 + c1
             grow_x, grow_y = float(rng.uniform(1.5, 3.5)), float(rng.uniform(1.5, 3.5))
             lobby = Rect(max(0.0, cx0 - grow_x), sy0 - (grow_y if side < 0 else 0.0),
                          min(spine_len, cx1 + grow_x), sy1 + (grow_y if side > 0 else 0.0))

@@ -1,0 +1,107 @@
+"""Build the bundled catalog of generated worlds (run once by ``bench/make_catalog.py``).
+
+Each entry is regenerated from its (kind, area, seed) by :func:`slamtrials.worlds.generate.generate_world`
+and written as a ROS map (``<name>.png`` + ``<name>.yaml``) into the data folder, with ``catalog.yaml``
+listing every world. The test suite regenerates every entry and checks the stored image bit for bit,
+so a change to the generator that changes a bundled world must rebuild the catalog (and bump
+``GENERATOR_VERSION``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import yaml
+
+from slamtrials.atomicfile import atomic_write_text
+from slamtrials.worlds.formats.rosmap_save import save_rosmap
+from slamtrials.worlds.generate import GENERATOR_VERSION, KINDS, generate_world
+from slamtrials.worlds.world import World
+
+__all__ = ["CatalogEntry", "CATALOG", "CATALOG_FILE", "RESOLUTION", "build_catalog", "build_entry", "describe"]
+
+#: Name of the index file in the data folder.
+CATALOG_FILE = "catalog.yaml"
+#: Resolution (m/px) of every bundled world.
+RESOLUTION = 0.05
+
+
+@dataclass(frozen=True)
+class CatalogEntry:
+    """One bundled world: its name and the arguments that generate it (area = requested free m^2)."""
+
+    name: str
+    kind: str
+    area: float
+    seed: int
+
+
+#: The bundled worlds: small ones (for demos and tests), medium and large ones.
+CATALOG: tuple[CatalogEntry, ...] = (
+    CatalogEntry("office_small_01", "office", 150, 11),
+    CatalogEntry("office_small_02", "office", 280, 3),
+    CatalogEntry("school_small_01", "school", 260, 2),
+    CatalogEntry("lab_small_01", "lab", 180, 4),
+    CatalogEntry("lab_small_02", "lab", 350, 1),
+    CatalogEntry("house_small_01", "house", 110, 1),
+    CatalogEntry("house_small_02", "house", 220, 5),
+    CatalogEntry("office_medium_01", "office", 700, 2),
+    CatalogEntry("office_medium_02", "office", 1600, 5),
+    CatalogEntry("school_medium_01", "school", 1000, 3),
+    CatalogEntry("school_medium_02", "school", 1900, 7),
+    CatalogEntry("lab_medium_01", "lab", 600, 2),
+    CatalogEntry("lab_medium_02", "lab", 1300, 6),
+    CatalogEntry("multiwing_medium_01", "multiwing", 1200, 1),
+    CatalogEntry("multiwing_medium_02", "multiwing", 2000, 4),
+    CatalogEntry("office_large_01", "office", 4000, 1),
+    CatalogEntry("school_large_01", "school", 6000, 2),
+    CatalogEntry("lab_large_01", "lab", 3000, 3),
+    CatalogEntry("multiwing_large_01", "multiwing", 10000, 1),
+    CatalogEntry("multiwing_large_02", "multiwing", 5000, 2),
+)
+
+
+def build_entry(entry: CatalogEntry) -> World:
+    """Generate the world of one catalog entry."""
+    return generate_world(entry.kind, entry.area, seed=entry.seed, resolution=RESOLUTION, name=entry.name)
+
+
+def describe(world: World) -> str:
+    """One line about a generated world: kind, shape, rooms and doors."""
+    meta = world.metadata
+    kind = meta["kind"]
+    return f"{kind} ({KINDS[kind].description}); {meta['shape']} shape, {meta['rooms']} rooms, {len(meta['doors'])} doors"
+
+
+def build_catalog(out_dir: str | Path, entries: tuple[CatalogEntry, ...] = CATALOG) -> list[dict]:
+    """Generate every entry into ``out_dir`` (``<name>.png``, ``<name>.yaml``) and write ``catalog.yaml``.
+
+    Returns the catalog records (also the content of ``catalog.yaml``'s ``worlds`` list).
+    """
+    out_dir = Path(out_dir)
+    records = []
+    for entry in entries:
+        world = build_entry(entry)
+        save_rosmap(world, out_dir / f"{entry.name}.yaml")
+        width, height = world.size_m
+        records.append({
+            "name": entry.name,
+            "kind": entry.kind,
+            "shape": world.metadata["shape"],
+            "area_m2": float(entry.area),
+            "free_area_m2": round(world.free_area, 1),
+            "seed": entry.seed,
+            "width_m": round(width, 2),
+            "height_m": round(height, 2),
+            "rooms": world.metadata["rooms"],
+            "description": describe(world),
+        })
+    doc = {
+        "generator_version": GENERATOR_VERSION,
+        "resolution": RESOLUTION,
+        "note": "area_m2 is the requested free area; regenerate with generate_world(kind, area_m2, seed=seed)",
+        "worlds": records,
+    }
+    atomic_write_text(out_dir / CATALOG_FILE, yaml.safe_dump(doc, sort_keys=False, width=120))
+    return records

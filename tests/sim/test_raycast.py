@@ -209,24 +209,28 @@ def brute_force_bounds(occ_up: np.ndarray, ox: float, oy: float, angle: float, m
     y0 = jj - 1.0
     dx, dy = math.cos(angle), math.sin(angle)
 
-    def slab(lo, origin, d):
+    def slab(lo, origin, d, closed):
         if d != 0.0:
-            t0 = (lo - origin) / d
-            t1 = (lo + 1.0 - origin) / d
+            with np.errstate(over="ignore"):
+                t0 = (lo - origin) / d
+                t1 = (lo + 1.0 - origin) / d
             return np.minimum(t0, t1), np.maximum(t0, t1)
-        inside = (lo <= origin) & (origin <= lo + 1.0)
+        # A ray parallel to the slab: inside it for all t, or never (on its edge: closed yes, open no).
+        inside = (lo <= origin) & (origin <= lo + 1.0) if closed else (lo < origin) & (origin < lo + 1.0)
         return np.where(inside, -np.inf, np.inf), np.where(inside, np.inf, -np.inf)
 
-    tx0, tx1 = slab(x0, ox, dx)
-    ty0, ty1 = slab(y0, oy, dy)
-    enter = np.maximum(tx0, ty0)
-    leave = np.minimum(tx1, ty1)
-    touch = (enter <= leave + tol) & (leave >= 0.0)
-    cross = (leave - enter > tol) & (leave > 0.0)
-    entry = np.maximum(enter, 0.0)
-    lo = min(entry[touch].min(initial=np.inf), max_t)
-    hi = min(entry[cross].min(initial=np.inf), max_t)
-    return lo, hi
+    bounds = []
+    for closed in (True, False):
+        tx0, tx1 = slab(x0, ox, dx, closed)
+        ty0, ty1 = slab(y0, oy, dy, closed)
+        enter = np.maximum(tx0, ty0)
+        leave = np.minimum(tx1, ty1)
+        if closed:
+            hit = (enter <= leave + tol) & (leave >= 0.0)
+        else:
+            hit = (leave - enter > tol) & (leave > 0.0)
+        bounds.append(min(np.maximum(enter, 0.0)[hit].min(initial=np.inf), max_t))
+    return bounds[0], bounds[1]
 
 
 world_params = st.tuples(
@@ -282,6 +286,23 @@ def test_raycaster_matches_brute_force(params, fx, fy, cell, theta, max_t):
         assert lo - tol <= r <= hi + tol, (a, r, lo, hi)
         if r >= max_t - tol:
             assert r == np.float32(max_t)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_accelerated_equals_plain_on_large_worlds(seed):
+    # Bigger worlds with large empty rooms, so that long jumps happen; many poses and dense beams.
+    world = random_world(seed, 400, 25, 0.0005)
+    dist = RaycastMap(world).dist
+    rng = np.random.default_rng(seed)
+    free = np.argwhere(dist > 0)
+    angles = np.linspace(-math.pi, math.pi, 2001)
+    for _ in range(20):
+        iy, ix = free[rng.integers(len(free))]
+        origin = (ix + rng.random(), iy + rng.random())
+        theta = rng.uniform(-math.pi, math.pi)
+        fast = cast_scan(dist, origin, theta, angles, 600.0, 0.05)
+        plain = cast_scan_dda(dist, origin, theta, angles, 600.0, 0.05)
+        np.testing.assert_array_equal(fast, plain)
 
 
 def test_exact_axis_aligned_and_diagonal_rays():

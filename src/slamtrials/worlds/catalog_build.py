@@ -46,19 +46,19 @@ CATALOG: tuple[CatalogEntry, ...] = (
     CatalogEntry("lab_small_02", "lab", 350, 1),
     CatalogEntry("house_small_01", "house", 110, 1),
     CatalogEntry("house_small_02", "house", 220, 5),
-    CatalogEntry("office_medium_01", "office", 700, 2),
-    CatalogEntry("office_medium_02", "office", 1600, 5),
-    CatalogEntry("school_medium_01", "school", 1000, 3),
-    CatalogEntry("school_medium_02", "school", 1900, 7),
+    CatalogEntry("office_medium_01", "office", 700, 1),
+    CatalogEntry("office_medium_02", "office", 1600, 11),
+    CatalogEntry("school_medium_01", "school", 1000, 0),
+    CatalogEntry("school_medium_02", "school", 1900, 12),
     CatalogEntry("lab_medium_01", "lab", 600, 2),
-    CatalogEntry("lab_medium_02", "lab", 1300, 6),
-    CatalogEntry("multiwing_medium_01", "multiwing", 1200, 1),
-    CatalogEntry("multiwing_medium_02", "multiwing", 2000, 4),
-    CatalogEntry("office_large_01", "office", 4000, 1),
-    CatalogEntry("school_large_01", "school", 6000, 2),
-    CatalogEntry("lab_large_01", "lab", 3000, 3),
-    CatalogEntry("multiwing_large_01", "multiwing", 10000, 1),
-    CatalogEntry("multiwing_large_02", "multiwing", 5000, 2),
+    CatalogEntry("lab_medium_02", "lab", 1300, 10),
+    CatalogEntry("multiwing_medium_01", "multiwing", 1200, 0),
+    CatalogEntry("multiwing_medium_02", "multiwing", 2000, 0),
+    CatalogEntry("office_large_01", "office", 4000, 4),
+    CatalogEntry("school_large_01", "school", 6000, 1),
+    CatalogEntry("lab_large_01", "lab", 3000, 14),
+    CatalogEntry("multiwing_large_01", "multiwing", 10000, 0),
+    CatalogEntry("multiwing_large_02", "multiwing", 5000, 4),
 )
 
 
@@ -84,6 +84,8 @@ def build_catalog(out_dir: str | Path, entries: tuple[CatalogEntry, ...] = CATAL
     for entry in entries:
         world = build_entry(entry)
         save_rosmap(world, out_dir / f"{entry.name}.yaml")
+        for suffix in (".yaml", ".png"):  # readable by everyone once installed
+            (out_dir / f"{entry.name}{suffix}").chmod(0o644)
         width, height = world.size_m
         records.append({
             "name": entry.name,
@@ -104,4 +106,5 @@ def build_catalog(out_dir: str | Path, entries: tuple[CatalogEntry, ...] = CATAL
         "worlds": records,
     }
     atomic_write_text(out_dir / CATALOG_FILE, yaml.safe_dump(doc, sort_keys=False, width=120))
+    (out_dir / CATALOG_FILE).chmod(0o644)
     return records

@@ -87,11 +87,12 @@ def load_world(source: str | Path, *, fmt: str | None = None, **options: Any) ->
     """
     path = Path(source)
     if fmt is None and not path.exists():
-        from slamtrials.worlds.catalog import catalog_names, load_catalog_world
+        from slamtrials.worlds.catalog import catalog_entry, load_catalog_world
 
-        if str(source) in catalog_names():
-            return load_catalog_world(str(source))
-        raise WorldError(f"{source}: no such file and no bundled world of that name (see 'slamtrials worlds list')")
+        if path.suffix or len(path.parts) > 1:
+            raise WorldError(f"{source}: no such floor-plan file")
+        catalog_entry(str(source))  # an unknown name raises, suggesting close names
+        return load_catalog_world(str(source))
     if path.is_dir():
         raise WorldError(f"{path}: is a folder; give a floor-plan file ({', '.join(sorted(SUFFIX_FORMATS))})")
     fmt = fmt or SUFFIX_FORMATS.get(path.suffix.lower())

@@ -49,6 +49,8 @@ class Built:
         ``[x, y, width, wall_axis]`` per door (see :func:`~slamtrials.worlds.generate.doors.door_record`).
     footprint:
         Gross area of the building (m^2): everything inside the outer walls.
+    corridors:
+        ``[x0, y0, x1, y1]`` (m, world frame) centre line of every corridor piece.
     """
 
     occupied: NDArray[np.bool_]
@@ -58,6 +60,7 @@ class Built:
     rooms: int
     doors: list[list[float]] = field(default_factory=list)
     footprint: float = 0.0
+    corridors: list[list[float]] = field(default_factory=list)
 
     @property
     def free_area(self) -> float:
@@ -134,7 +137,8 @@ def build_grid(spec: KindSpec, shape_area: float, gross: float, seed: int, resol
     spec:
         The building kind.
     shape_area:
-        Gross area (m^2) the shape is chosen for (kept fixed while ``gross`` is tuned).
+        Gross area (m^2) the shape and its structure are chosen for (kept fixed while ``gross`` is
+        tuned, so that tuning changes lengths only).
     gross:
         Gross footprint (m^2) to lay out.
     seed:
@@ -144,29 +148,41 @@ def build_grid(spec: KindSpec, shape_area: float, gross: float, seed: int, resol
     """
     rng = np.random.default_rng(seed)
     shape = choose_shape(spec, shape_area, rng)
-    plan = build_plan(spec, shape, gross, rng)
+    plan = build_plan(spec, shape, shape_area, gross, rng)
     grid = Grid.for_plan(plan, resolution)
     labels, uses = paint_labels(plan, grid)
     boxes = clean_labels(labels, uses, grid)
     wall_k = wall_pixels(resolution)
     doors = _plan_all_doors(labels, uses, boxes, grid, wall_k, rng)
     occupied = draw_walls(labels, wall_k)
-    solid = np.zeros(len(uses) + 2, dtype=bool)
-    solid[2:] = [use == "shaft" for use, _ in uses]
-    occupied |= solid[labels]
+    for k in sorted(boxes):
+        if uses[k - 2][0] == "shaft":
+            occupied[boxes[k]] |= labels[boxes[k]] == k
     door_mask, reserved = carve_doors(occupied, doors, grid, wall_k)
     placer = Placer(occupied, labels, reserved, grid)
     furnish_circulation(placer, plan, rng)
-    interiors = ndimage.find_objects(np.where(occupied | door_mask, 0, labels))
     present = 0
-    for index, sub in enumerate(interiors):
-        label = index + 1
-        if sub is None or label < 2:
+    for k in sorted(boxes):
+        use, style = uses[k - 2]
+        box = boxes[k]
+        inner = (labels[box] == k) & ~occupied[box] & ~door_mask[box]
+        rows, cols = np.flatnonzero(inner.any(axis=1)), np.flatnonzero(inner.any(axis=0))
+        if use == "shaft" or len(rows) == 0:
             continue
         present += 1
-        use, style = uses[label - 2]
-        furnish_room(placer, label, (sub[0].start, sub[0].stop, sub[1].start, sub[1].stop), use, style, rng)
+        r0, c0 = box[0].start, box[1].start
+        furnish_room(placer, k, (r0 + int(rows[0]), r0 + int(rows[-1]) + 1, c0 + int(cols[0]), c0 + int(cols[-1]) + 1), use, style, rng)
     keep_largest_region(occupied)
     start = _start_pose(occupied, labels, grid)
     footprint = float(np.count_nonzero(labels)) * resolution**2
-    return Built(occupied, grid, start, shape, present, [door_record(d, grid) for d in doors], footprint)
+    corridors = [_centre_line(rect, axis) for rect, axis, _style in plan.corridors]
+    return Built(occupied, grid, start, shape, present, [door_record(d, grid) for d in doors], footprint, corridors)
+
+
+def _centre_line(rect, axis: str) -> list[float]:
+    """``[x0, y0, x1, y1]`` (m): the centre line of a corridor rectangle along its axis."""
+    if axis == "x":
+        y = 0.5 * (rect.y0 + rect.y1)
+        return [round(rect.x0, 3), round(y, 3), round(rect.x1, 3), round(y, 3)]
+    x = 0.5 * (rect.x0 + rect.x1)
+    return [round(x, 3), round(rect.y0, 3), round(x, 3), round(rect.y1, 3)]

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 from slamtrials.worlds.generate.kinds import STYLES
 from slamtrials.worlds.generate.raster import CIRCULATION, Grid
 
-__all__ = ["Segments", "Door", "interface_segments", "plan_doors", "carve_doors", "MIN_DOOR"]
+__all__ = ["Segments", "Door", "interface_segments", "plan_doors", "carve_doors", "door_box", "door_record", "MIN_DOOR"]
 
 #: Narrowest door opening (m).
 MIN_DOOR = 0.9

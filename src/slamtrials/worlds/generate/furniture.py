@@ -78,8 +78,8 @@ def _office(p: Placer, label: int, box: Box, rng: np.random.Generator) -> None:
     if area > 16.0 and rng.random() < 0.3:
         _meeting(p, label, box, rng)
         return
-    along_walls(p, label, box, rng, 1 if area < 14 else 2 + (area > 24), (1.4, 1.8), (0.7, 0.8))
-    along_walls(p, label, box, rng, 1 + (area > 12), (0.8, 2.0), (0.4, 0.45))
+    along_walls(p, label, box, rng, 1 if area < 12 else 2 + (area > 22), (1.4, 1.8), (0.7, 0.8), tries=10)
+    along_walls(p, label, box, rng, 2 + (area > 16), (0.6, 2.0), (0.4, 0.5), tries=10)
     if area > 14.0 and rng.random() < 0.4:
         d = _u(rng, 0.8, 1.1)
         _centre(p, label, box, d, d, round_=True)

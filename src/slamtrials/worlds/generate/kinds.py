@@ -97,11 +97,11 @@ class KindSpec:
 
 
 KINDS: dict[str, KindSpec] = {
-    "office": KindSpec("office", "offices and meeting rooms off corridors, open-plan areas with cubicles", ("office",), (80.0, 12000.0), 0.80),
-    "school": KindSpec("school", "long wide corridors with lockers, large classrooms, gym or library halls", ("school",), (150.0, 12000.0), 0.80),
-    "lab": KindSpec("lab", "laboratories full of benches, tables and cabinets, workshop halls", ("lab",), (80.0, 12000.0), 0.70),
-    "multiwing": KindSpec("multiwing", "several wings (L, T, U, H, comb shapes) joined by corridors, mixed use", ("office", "school", "lab"), (1000.0, 15000.0), 0.77),
-    "house": KindSpec("house", "a small house or flat: hallway, bedrooms, living room, kitchen", ("house",), (50.0, 400.0), 0.75),
+    "office": KindSpec("office", "offices and meeting rooms off corridors, open-plan areas with cubicles", ("office",), (80.0, 12000.0), 0.84),
+    "school": KindSpec("school", "long wide corridors with lockers, large classrooms, gym or library halls", ("school",), (150.0, 12000.0), 0.86),
+    "lab": KindSpec("lab", "laboratories full of benches, tables and cabinets, workshop halls", ("lab",), (80.0, 12000.0), 0.79),
+    "multiwing": KindSpec("multiwing", "several wings (L, T, U, H, comb shapes) joined by corridors, mixed use", ("office", "school", "lab"), (1000.0, 15000.0), 0.85),
+    "house": KindSpec("house", "a small house or flat: hallway, bedrooms, living room, kitchen", ("house",), (50.0, 400.0), 0.79),
 }
 
 #: Names of the building kinds, in a stable order.

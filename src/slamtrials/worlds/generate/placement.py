@@ -1,16 +1,19 @@
 """Checked placement of furniture: an item goes in only if it keeps every passage open.
 
-The rules, which keep the free space of a room connected and passable for the robot:
+Every item is an axis-aligned rectangle of free cells of one room (or of the circulation), at least
+0.3 m from the door zones, and it comes with a *keep-clear zone* of width ``gap`` (1 m by default):
 
-* an item is an axis-aligned rectangle of free cells of one room (or of the circulation), away from
-  the door zones (0.3 m);
-* a *free-standing* item keeps ``gap`` metres (1 m by default) of free cells of its room all around;
-* a *wall* item touches a wall (not furniture) with its back, the whole length of that side (in a
-  corner: with two sides), and keeps ``gap`` metres free in front of it.
+* a *free-standing* item: the ring ``gap`` wide all around it;
+* a *wall* item, whose back touches a wall (not furniture) along its whole length: the band ``gap``
+  deep in front of it, widened by ``gap`` to both sides; beside it, the nearest obstacle (if closer
+  than ``gap``) must span the item's whole depth (a wall meeting its back wall, or an item as deep),
+  so that the space beside it is a niche against the wall that leads nowhere;
+* a *corner* item, touching walls with two sides: the band ``gap`` wide along both free sides.
 
-So no two items and no item and wall can be closer than the gap across a passage: whatever lies
-between them is either at least a gap wide, or a niche against a wall (beside a wall item, in a
-corner) that leads nowhere.
+An item goes in only if its zone holds no wall or other item (a wall item's widening: no obstacle
+but those allowed beside it), and its body lies in no other item's zone. So two obstacles facing
+each other across free space are always at least ``gap`` apart, and no passage narrower than that
+is made.
 """
 
 from __future__ import annotations
@@ -44,6 +47,8 @@ class Placer:
         The raster, for metre -> cell conversions.
     walls:
         bool ``[H, W]``: ``occupied`` as it was before any item (what counts as a wall).
+    clear:
+        bool ``[H, W]``: the keep-clear zones of the items placed so far.
     """
 
     occupied: NDArray[np.bool_]
@@ -52,6 +57,7 @@ class Placer:
     grid: Grid
     placed: int = 0
     walls: NDArray[np.bool_] = field(init=False, repr=False)
+    clear: NDArray[np.bool_] = field(init=False, repr=False)
 
     def px(self, metres: float) -> int:
         """Metres -> whole cells (at least 1)."""
@@ -62,20 +68,56 @@ class Placer:
 
     def __post_init__(self) -> None:
         self.walls = self.occupied.copy()
+        self.clear = np.zeros_like(self.occupied)
+
+    def _zones(self, r0: int, r1: int, c0: int, c1: int, back: str, g: int) -> tuple[tuple[int, int, int, int], tuple[int, int, int, int]]:
+        """(strict zone, widened zone) of an item, as (r0, r1, c0, c1); the strict zone must hold no wall."""
+        if not back:
+            box = (r0 - g, r1 + g, c0 - g, c1 + g)
+            return box, box
+        if len(back) == 1:
+            front = {"N": (r1, r1 + g, c0, c1), "S": (r0 - g, r0, c0, c1),
+                     "W": (r0, r1, c1, c1 + g), "E": (r0, r1, c0 - g, c0)}[back]
+            wide = {"N": (r1, r1 + g, c0 - g, c1 + g), "S": (r0 - g, r0, c0 - g, c1 + g),
+                    "W": (r0 - g, r1 + g, c1, c1 + g), "E": (r0 - g, r1 + g, c0 - g, c0)}[back]
+            return front, wide
+        box = (r0 - (g if "S" in back else 0), r1 + (g if "N" in back else 0),
+               c0 - (g if "E" in back else 0), c1 + (g if "W" in back else 0))
+        return box, box
+
+    def _sides_ok(self, r0: int, r1: int, c0: int, c1: int, back: str, g: int) -> bool:
+        """Beside a wall item (up to ``g`` cells away, from its back to ``g`` beyond its front), the nearest
+        obstacle must span the item's whole depth: a wall meeting the back wall, or an item at least as
+        deep. Then the space beside the item is a niche, or open towards its front."""
+        occ = self.occupied
+        if back in ("W", "E"):  # work with the back at the top or bottom
+            occ = occ.T
+            r0, r1, c0, c1 = c0, c1, r0, r1
+            back = "N" if back == "W" else "S"
+        rows = slice(r0, r1 + g) if back == "N" else slice(r0 - g, r1)
+        blocked = np.flatnonzero(occ[rows, c0 - g:c0].any(axis=0))
+        if len(blocked) and not occ[r0:r1, c0 - g + int(blocked[-1])].all():
+            return False
+        blocked = np.flatnonzero(occ[rows, c1:c1 + g].any(axis=0))
+        return not (len(blocked) and not occ[r0:r1, c1 + int(blocked[0])].all())
 
     def fits(self, label: int, r0: int, c0: int, h: int, w: int, back: str = "", gap: float = 1.0) -> bool:
         """Whether an ``h x w`` cell item at (r0, c0) obeys the rules; ``back`` lists the sides that touch walls."""
         g = self.px(gap)
         r1, c1 = r0 + h, c0 + w
-
-        def reach(side: str, opposite: str) -> int:
-            return g if not back or opposite in back else 0
-
-        er0, er1 = r0 - reach("N", "S"), r1 + reach("S", "N")
-        ec0, ec1 = c0 - reach("W", "E"), c1 + reach("E", "W")
-        if not self._inside(er0 - 1, er1 + 1, ec0 - 1, ec1 + 1):
+        strict, wide = self._zones(r0, r1, c0, c1, back, g)
+        lo_r, hi_r = min(strict[0], wide[0], r0), max(strict[1], wide[1], r1)
+        lo_c, hi_c = min(strict[2], wide[2], c0), max(strict[3], wide[3], c1)
+        if not self._inside(lo_r - 1, hi_r + 1, lo_c - 1, hi_c + 1):
             return False
-        if self.occupied[er0:er1, ec0:ec1].any() or (self.labels[er0:er1, ec0:ec1] != label).any():
+        occ, lab = self.occupied, self.labels
+        body = (slice(r0, r1), slice(c0, c1))
+        if occ[body].any() or (lab[body] != label).any() or self.clear[body].any():
+            return False
+        zone = (slice(strict[0], strict[1]), slice(strict[2], strict[3]))
+        if occ[zone].any() or (lab[zone] != label).any():
+            return False
+        if len(back) == 1 and not self._sides_ok(r0, r1, c0, c1, back, g):
             return False
         walls = self.walls
         behind = {"N": walls[r0 - 1, c0:c1], "S": walls[r1, c0:c1], "W": walls[r0:r1, c0 - 1], "E": walls[r0:r1, c1]}
@@ -95,6 +137,9 @@ class Placer:
             self.occupied[r0:r0 + h, c0:c0 + w] |= disk
         else:
             self.occupied[r0:r0 + h, c0:c0 + w] = True
+        _strict, wide = self._zones(r0, r0 + h, c0, c0 + w, back, self.px(gap))
+        zone = (slice(wide[0], wide[1]), slice(wide[2], wide[3]))
+        self.clear[zone] |= (self.labels[zone] == label) & ~self.occupied[zone]
         self.placed += 1
         return True
 

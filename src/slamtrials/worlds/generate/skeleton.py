@@ -59,9 +59,9 @@ def choose_shape(spec: KindSpec, gross: float, rng: np.random.Generator) -> str:
     bar_width = sum(style.depth) + sum(style.corridor) / 2 + 3 * WALL
     if spec.name == "multiwing":
         if gross < 2500:
-            options = ["L", "T", "Z", "U"]
+            options = ["L", "T", "Z"] + (["U"] if gross >= 1800 else [])
         elif gross < 6000:
-            options = ["U", "H", "comb", "T", "cross"]
+            options = ["U", "H", "T", "cross"] + (["comb"] if gross >= 4500 else [])
         else:
             options = ["H", "comb", "fishbone"]
         return options[int(rng.integers(len(options)))]
@@ -73,19 +73,22 @@ def choose_shape(spec: KindSpec, gross: float, rng: np.random.Generator) -> str:
     elif gross <= 5500:
         options = ["racetrack", "U", "H", "T"]
     else:
-        options = ["H", "comb", "fishbone", "U"]
+        options = ["H", "comb", "fishbone"]
     return options[int(rng.integers(len(options)))]
 
 
-def build_plan(spec: KindSpec, shape: str, gross: float, rng: np.random.Generator) -> Plan:
+def build_plan(spec: KindSpec, shape: str, design: float, gross: float, rng: np.random.Generator) -> Plan:
     """Lay out a building of the given shape whose gross footprint is about ``gross`` m^2.
+
+    Structural choices (single- or double-loaded corridors, number of arms, wide arms) follow the
+    ``design`` area, so that tuning ``gross`` changes lengths only.
 
     The plan is shifted so that it starts at (0, 0).
     """
     if shape in ("bar", "racetrack"):
-        plan = _single(spec, shape, gross, rng)
+        plan = _single(spec, shape, design, gross, rng)
     else:
-        plan = _arms(spec, shape, gross, rng)
+        plan = _arms(spec, shape, design, gross, rng)
     plan.shape = shape
     box = plan.bounds()
     shifted = plan.shifted(-box.x0, -box.y0)
@@ -97,11 +100,11 @@ def _pick_style(spec: KindSpec, rng: np.random.Generator) -> Style:
     return STYLES[spec.styles[int(rng.integers(len(spec.styles)))]]
 
 
-def _single(spec: KindSpec, shape: str, gross: float, rng: np.random.Generator) -> Plan:
+def _single(spec: KindSpec, shape: str, design: float, gross: float, rng: np.random.Generator) -> Plan:
     """A single wing: a bar (one corridor) or a racetrack (two corridors and a core)."""
     style = _pick_style(spec, rng)
     corridors = 2 if shape == "racetrack" else 1
-    single_loaded = corridors == 1 and gross < 2.2 * (style.depth[0] + style.corridor[0]) * style.room_width[1]
+    single_loaded = corridors == 1 and design < 2.2 * (style.depth[0] + style.corridor[0]) * style.room_width[1]
     bands = _bands(style, rng, corridors, single_loaded=single_loaded)
     width = _width(bands)
     depth = bands[0].depth
@@ -124,13 +127,14 @@ def _cross(wing_len: float, end_depth: tuple[float, float], cw: float, rng: np.r
     return tuple(float(c) for c in np.linspace(first, last, count + 2))
 
 
-def _arm_layout(shape: str, gross: float) -> list[tuple[str | float, int]]:
+def _arm_layout(shape: str, design: float, per_side_max: int) -> list[tuple[str | float, int]]:
+    """Arms of a shape; comb and fishbone get more arms for bigger designs, at most ``per_side_max``."""
     if shape in SHAPES:
         return list(SHAPES[shape])
     if shape == "comb":
-        n = int(np.clip(round(gross / 1800.0), 3, 6))
+        n = int(np.clip(min(round(design / 1800.0), per_side_max), 2, 6))
         return [("end0", +1)] + [(i / (n - 1), +1) for i in range(1, n - 1)] + [("end1", +1)]
-    n = int(np.clip(round(gross / 3500.0), 2, 4))  # fishbone: arms on both sides
+    n = int(np.clip(min(round(design / 3500.0), per_side_max), 2, 4))  # fishbone: arms on both sides
     arms: list[tuple[str | float, int]] = []
     for i in range(n):
         pos: str | float = "end0" if i == 0 else "end1" if i == n - 1 else i / (n - 1)
@@ -138,16 +142,35 @@ def _arm_layout(shape: str, gross: float) -> list[tuple[str | float, int]]:
     return arms
 
 
-def _arm_sizes(layout, narrow, wide, spine_bands, gross, rng):
-    """Spine length, and each arm's bands and length (m)."""
-    shares = np.array([float(rng.uniform(0.75, 1.25)) for _ in layout])
-    gaps = float(rng.uniform(9.0, 16.0))
+def _per_side_max(spec: KindSpec, spine_width: float, design: float, gap: float) -> int:
+    """How many arms fit along one side of a spine that takes at most half the design area."""
+    arm_width = max(sum(STYLES[s].depth) + sum(STYLES[s].corridor) / 2 + 3 * WALL for s in spec.styles)
+    budget = 0.5 * design / spine_width
+    return max(2, int((budget + gap) // (arm_width + gap)))
+
+
+def _arm_sizes(layout, narrow, wide, spine_bands, design, gross, gaps, rng):
+    """Spine length (m), each arm's bands, and each arm's length (m).
+
+    Arms are ``rho`` times as long as the spine (0.4-0.7 when arms go both ways, 0.6-1.0 when one
+    way), within 20 %. A building of 4,000 m^2 or more with at most four arms whose spine would be
+    longer than 1.6 sqrt(design) gets arms with two corridors (twice as wide, so half as long). The spine is at
+    least as long as the arms on one side need, side by side with courtyards between them.
+    """
+    both = any(side < 0 for _, side in layout)
+    rho = float(rng.uniform(0.4, 0.7)) if both else float(rng.uniform(0.6, 1.0))
+    shares = np.array([float(rng.uniform(0.8, 1.2)) for _ in layout])
     ws = _width(spine_bands)
-    spine_share = float(rng.uniform(0.85, 1.15)) / (1.0 + 0.8 * len(layout))
-    spine_len = spine_share * gross / ws
-    arm_gross = (gross - ws * spine_len) * shares / shares.sum()
-    bands = [n if gross < 3000 or a / _width(n) <= 0.9 * spine_len else w for n, w, a in zip(narrow, wide, arm_gross)]
+
+    def spine_for(area: float, widths: np.ndarray) -> float:
+        return area / (ws + rho * float(np.sum(shares * widths)))
+
+    bands = list(narrow)
+    if len(layout) <= 4 and design >= 4000 and spine_for(design, np.array([_width(b) for b in narrow])) > 1.6 * np.sqrt(design):
+        bands = list(wide)
     wa = np.array([_width(b) for b in bands])
+    spine_len = spine_for(gross, wa)
+    arm_len = rho * shares * spine_len
     need = 0.0
     for side in (+1, -1):
         on_side = [i for i, (_, s) in enumerate(layout) if s == side]
@@ -155,24 +178,24 @@ def _arm_sizes(layout, narrow, wide, spine_bands, gross, rng):
             need = max(need, float(np.sum(wa[on_side])) + gaps * (len(on_side) - 1) + (0.0 if len(on_side) > 1 else 4.0))
     if spine_len < need:
         spine_len = need
-        arm_gross = max(gross - ws * spine_len, 0.15 * gross) * shares / shares.sum()
-    return float(spine_len), bands, [float(v) for v in np.maximum(arm_gross / wa, 0.9 * wa)]
+        rest = max(gross - ws * spine_len, 0.15 * gross)
+        arm_len = rest * shares / float(np.sum(shares * wa))
+    return float(spine_len), bands, [float(v) for v in np.maximum(arm_len, 0.9 * wa)]
 
 
-def _arms(spec: KindSpec, shape: str, gross: float, rng: np.random.Generator) -> Plan:
+def _arms(spec: KindSpec, shape: str, design: float, gross: float, rng: np.random.Generator) -> Plan:
     """A spine with arms; the arms' corridors join the spine's corridors, often through a junction lobby.
 
-    The spine takes about 1 / (1 + 0.8 n) of the area for n arms (more if the arms need the room
-    along it); the arms share the rest. In buildings over 3,000 m^2, an arm that would be longer than 0.9 times the spine gets
-    two corridors (twice as wide).
+    See :func:`_arm_sizes` for the proportions.
     """
     spine_style = _pick_style(spec, rng)
-    spine_bands = _bands(spine_style, rng, 2 if gross > 5000 and rng.random() < 0.7 else 1)
-    layout = _arm_layout(shape, gross)
+    spine_bands = _bands(spine_style, rng, 2 if design > 5000 and rng.random() < 0.7 else 1)
+    gaps = float(rng.uniform(9.0, 16.0))
+    layout = _arm_layout(shape, design, _per_side_max(spec, _width(spine_bands), design, gaps))
     arm_styles = [_pick_style(spec, rng) for _ in layout]
     narrow = [_bands(s, rng, 1) for s in arm_styles]
     wide = [_bands(s, rng, 2) for s in arm_styles]
-    spine_len, arm_bands, arm_len = _arm_sizes(layout, narrow, wide, spine_bands, gross, rng)
+    spine_len, arm_bands, arm_len = _arm_sizes(layout, narrow, wide, spine_bands, design, gross, gaps, rng)
     ws = _width(spine_bands)
     centres = []
     for (pos, _), bands in zip(layout, arm_bands):

@@ -6,10 +6,12 @@ over leading dimensions and never loop in Python.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["wrap_angle", "compose", "inverse", "ominus", "transform_points", "as_poses"]
+__all__ = ["wrap_angle", "compose", "inverse", "ominus", "transform_points", "as_poses", "wrap_angle1", "compose1", "ominus1"]
 
 
 def as_poses(poses: ArrayLike) -> NDArray[np.float64]:
@@ -66,3 +68,37 @@ def transform_points(pose: ArrayLike, points: ArrayLike) -> NDArray[np.float64]:
     out[..., 0] = pose[0] + c * pts[..., 0] - s * pts[..., 1]
     out[..., 1] = pose[1] + s * pts[..., 0] + c * pts[..., 1]
     return out
+
+
+# Single-pose versions in scalar arithmetic: the simulator composes a few single poses every step, and
+# the array functions above cost tens of microseconds on one pose; these cost about one.
+
+
+def wrap_angle1(angle: float) -> float:
+    """Wrap one angle (rad) into [-pi, pi), the same formula as :func:`wrap_angle`."""
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def compose1(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
+    """:func:`compose` for two single poses ``[3]``, in scalar arithmetic.
+
+    The simulator composes a few single poses every step; ``geometry.compose`` is written for arrays of
+    poses and costs tens of microseconds on one pose, this costs about one. Same formulas and results.
+    """
+    ax, ay, at = (float(v) for v in a)  # type: ignore[union-attr]
+    bx, by, bt = (float(v) for v in b)  # type: ignore[union-attr]
+    c, s = math.cos(at), math.sin(at)
+    return np.array([ax + c * bx - s * by, ay + s * bx + c * by, wrap_angle1(at + bt)])
+
+
+def ominus1(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
+    """:func:`ominus` for two single poses ``[3]``: pose ``b`` in the frame of ``a``.
+
+    Computed directly as the rotation by ``-theta_a`` of ``b - a`` (equal to ``compose(inverse(a), b)``
+    up to rounding).
+    """
+    ax, ay, at = (float(v) for v in a)  # type: ignore[union-attr]
+    bx, by, bt = (float(v) for v in b)  # type: ignore[union-attr]
+    c, s = math.cos(at), math.sin(at)
+    dx, dy = bx - ax, by - ay
+    return np.array([c * dx + s * dy, -s * dx + c * dy, wrap_angle1(bt - at)])

@@ -11,7 +11,8 @@ from hypothesis import strategies as st
 
 from slamtrials.geometry import compose, ominus
 from slamtrials.sim import RobotConfig, SimConfig, Simulator
-from slamtrials.sim.robot import CollisionChecker, arc_increment, arc_sagitta, compose1, limit_velocity, ominus1
+from slamtrials.geometry import compose1, ominus1
+from slamtrials.sim.robot import CollisionChecker, arc_increment, arc_sagitta, limit_velocity
 from slamtrials.worlds.world import World, world_to_map
 
 finite = st.floats(-50.0, 50.0)

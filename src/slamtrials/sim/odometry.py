@@ -30,7 +30,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from slamtrials.sim.config import OdometryConfig
-from slamtrials.sim.robot import compose1
+from slamtrials.geometry import compose1
+from slamtrials.sim.robot import sinc
 
 __all__ = ["draw_bias", "measured_increment", "Odometry"]
 
@@ -48,10 +49,6 @@ def draw_bias(config: OdometryConfig, rng: np.random.Generator) -> dict[str, flo
     if config.bias_angular is not None:
         ang = float(config.bias_angular)
     return {"linear": lin, "angular": ang}
-
-
-def _sinc(x: float) -> float:
-    return 1.0 if x == 0.0 else math.sin(x) / x
 
 
 def measured_increment(delta: ArrayLike, bias_linear: float, bias_angular: float, noise_linear: float = 0.0,
@@ -79,9 +76,9 @@ def measured_increment(delta: ArrayLike, bias_linear: float, bias_angular: float
     chord = math.hypot(dx, dy)
     if chord == 0.0:
         return np.array([0.0, 0.0, phi_m])
-    length = chord / _sinc(0.5 * phi)  # arc length, >= 0 (the direction sits in the chord)
+    length = chord / sinc(0.5 * phi)  # arc length, >= 0 (the direction sits in the chord)
     length_m = (1.0 + bias_linear) * length + noise_linear
-    scale = length_m * _sinc(0.5 * phi_m) / chord
+    scale = length_m * sinc(0.5 * phi_m) / chord
     turn = 0.5 * (phi_m - phi)
     c, s = math.cos(turn), math.sin(turn)
     return np.array([scale * (c * dx - s * dy), scale * (s * dx + c * dy), phi_m])
@@ -122,7 +119,7 @@ class Odometry:
         cfg = self.config
         n_lin = n_ang = 0.0
         if cfg.noise_linear_per_m > 0.0:
-            length = math.hypot(delta[0], delta[1]) / _sinc(0.5 * float(delta[2]))
+            length = math.hypot(delta[0], delta[1]) / sinc(0.5 * float(delta[2]))
             n_lin = float(self.rng.normal(0.0, cfg.noise_linear_per_m * length))
         if cfg.noise_angular_per_rad > 0.0:
             n_ang = float(self.rng.normal(0.0, cfg.noise_angular_per_rad * abs(float(delta[2]))))

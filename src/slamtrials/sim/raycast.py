@@ -36,7 +36,7 @@ from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from slamtrials.sim.config import LaserConfig
-from slamtrials.sim.robot import compose1
+from slamtrials.geometry import compose1
 from slamtrials.worlds.world import World, world_to_map
 
 __all__ = ["RaycastMap", "LaserModel", "cast_scan", "cast_scan_dda", "SAFETY_CELLS"]
@@ -90,8 +90,13 @@ def _trace_beam(dist, ox, oy, dx, dy, max_t, accelerate):  # pragma: no cover - 
                 t = t + jump
                 if t >= max_t:
                     return max_t
-                ix = int(math.floor(ox + t * dx))
-                iy = int(math.floor(oy + t * dy))
+                # The cell of the new point. The ray is monotone in u and v, so the cell never moves
+                # back against the direction of travel; rounding of the point could say otherwise
+                # (e.g. a ray along a cell boundary), and following it would loop.
+                jx = int(math.floor(ox + t * dx))
+                jy = int(math.floor(oy + t * dy))
+                ix = max(ix, jx) if step_x >= 0 else min(ix, jx)
+                iy = max(iy, jy) if step_y >= 0 else min(iy, jy)
                 if ix < 0 or iy < 0 or ix >= width or iy >= height:  # cannot happen (safe margin)
                     return t
                 jump = dist[iy, ix] - SAFETY_CELLS
@@ -127,7 +132,7 @@ def _cast_scan(dist, ox, oy, theta, angles, max_t, resolution, max_range, accele
         if t >= max_t:
             out[b] = max_range
         else:
-            out[b] = min(t * resolution, max_range)
+            out[b] = min(t * resolution, max_range) + 0.0  # + 0.0 turns a -0.0 into 0.0
 
 
 def _run(dist: NDArray[np.float32], origin_uv: ArrayLike, theta: float, angles: NDArray[np.float64], max_range: float,
@@ -205,7 +210,7 @@ class RaycastMap:
         self.dist: NDArray[np.float32] = np.ascontiguousarray(dist[::-1])
         self.dist.setflags(write=False)
         self.resolution = float(world.resolution)
-        self.world = world
+        # No reference back to the world: the per-world cache holds the world weakly.
 
     @classmethod
     def for_world(cls, world: World) -> "RaycastMap":

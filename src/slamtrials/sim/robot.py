@@ -10,7 +10,7 @@ ends at::
 
     dx = L sin(phi) / phi,   dy = L (1 - cos(phi)) / phi = 2 L sin^2(phi / 2) / phi,   dtheta = phi
 
-(``dx = L, dy = 0`` when ``phi = 0``), computed without cancellation.
+(``dx = L, dy = 0`` when ``phi = 0``), computed without cancellation (Taylor series for tiny ``phi``).
 
 Collision rule
 --------------
@@ -37,42 +37,30 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
+from slamtrials.geometry import compose1, ominus1, wrap_angle1
 from slamtrials.sim.config import RobotConfig
 from slamtrials.worlds.world import World, world_to_map
 
-__all__ = ["arc_increment", "arc_sagitta", "limit_velocity", "CollisionChecker", "Robot", "compose1", "ominus1"]
+__all__ = ["sinc", "cosc", "arc_increment", "arc_sagitta", "limit_velocity", "CollisionChecker", "Robot"]
 
 _TWO_PI = 2.0 * math.pi
 
 
-def _wrap(angle: float) -> float:
-    """Wrap one angle (rad) into [-pi, pi), the same formula as :func:`slamtrials.geometry.wrap_angle`."""
-    return (angle + math.pi) % _TWO_PI - math.pi
+def sinc(x: float) -> float:
+    """``sin(x) / x`` (1 at 0), accurate for tiny and subnormal ``x`` (Taylor series below 1e-3)."""
+    if abs(x) < 1e-3:
+        x2 = x * x
+        return 1.0 - x2 / 6.0 + x2 * x2 / 120.0
+    return math.sin(x) / x
 
 
-def compose1(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
-    """:func:`slamtrials.geometry.compose` for two single poses ``[3]``, in scalar arithmetic.
-
-    The simulator composes a few single poses every step; ``geometry.compose`` is written for arrays of
-    poses and costs tens of microseconds on one pose, this costs about one. Same formulas and results.
-    """
-    ax, ay, at = (float(v) for v in a)  # type: ignore[union-attr]
-    bx, by, bt = (float(v) for v in b)  # type: ignore[union-attr]
-    c, s = math.cos(at), math.sin(at)
-    return np.array([ax + c * bx - s * by, ay + s * bx + c * by, _wrap(at + bt)])
-
-
-def ominus1(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
-    """:func:`slamtrials.geometry.ominus` for two single poses ``[3]``: pose ``b`` in the frame of ``a``.
-
-    Computed directly as the rotation by ``-theta_a`` of ``b - a`` (equal to ``compose(inverse(a), b)``
-    up to rounding).
-    """
-    ax, ay, at = (float(v) for v in a)  # type: ignore[union-attr]
-    bx, by, bt = (float(v) for v in b)  # type: ignore[union-attr]
-    c, s = math.cos(at), math.sin(at)
-    dx, dy = bx - ax, by - ay
-    return np.array([c * dx + s * dy, -s * dx + c * dy, _wrap(bt - at)])
+def cosc(x: float) -> float:
+    """``(1 - cos(x)) / x`` (0 at 0), without cancellation (Taylor series below 1e-3)."""
+    if abs(x) < 1e-3:
+        x2 = x * x
+        return x * (0.5 - x2 / 24.0 + x2 * x2 / 720.0)
+    half = math.sin(0.5 * x)
+    return 2.0 * half * half / x
 
 
 def arc_increment(v: float, w: float, dt: float) -> NDArray[np.float64]:
@@ -93,10 +81,7 @@ def arc_increment(v: float, w: float, dt: float) -> NDArray[np.float64]:
     """
     length = v * dt
     phi = w * dt
-    if phi == 0.0:
-        return np.array([length, 0.0, 0.0])
-    half = 0.5 * phi
-    return np.array([length * math.sin(phi) / phi, 2.0 * length * math.sin(half) ** 2 / phi, phi])
+    return np.array([length * sinc(phi), length * cosc(phi), phi])
 
 
 def arc_sagitta(length: float, phi: float) -> float:
@@ -303,7 +288,7 @@ class Robot:
         if v != 0.0 and not self.collision.path_free(self.pose[:2], moved[:2], arc_sagitta(v * self.dt, w * self.dt)):
             # Blocked: turn in place only, stop the linear motion.
             moved = self.pose.copy()
-            moved[2] = _wrap(float(self.pose[2]) + float(delta[2]))
+            moved[2] = wrap_angle1(float(self.pose[2]) + float(delta[2]))
             v = 0.0
             stalled = True
         self.pose = moved

@@ -22,7 +22,8 @@ from slamtrials.record import Frame
 from slamtrials.sim.config import SimConfig
 from slamtrials.sim.odometry import Odometry, draw_bias
 from slamtrials.sim.raycast import LaserModel
-from slamtrials.sim.robot import Robot, ominus1
+from slamtrials.geometry import ominus1
+from slamtrials.sim.robot import Robot
 from slamtrials.worlds.world import World
 
 __all__ = ["Simulator", "as_generator"]
@@ -47,8 +48,8 @@ class Simulator:
     config:
         Robot, laser, odometry and step settings; ``None`` means :meth:`SimConfig.paper`.
     rng:
-        The run's random stream (a Generator, or a seed turned into one). The odometry bias is drawn
-        from it here.
+        The run's random stream (a Generator, or a seed turned into one; required, there is no default
+        seed). The odometry bias is drawn from it here.
     start:
         Optional float64 ``[3]`` start pose (world frame) instead of ``world.start``.
 
@@ -63,8 +64,8 @@ class Simulator:
     >>> frames = [sim.observe()] + [sim.step((0.5, 0.1)) for _ in range(100)]   # doctest: +SKIP
     """
 
-    def __init__(self, world: World, config: SimConfig | None = None,
-                 rng: np.random.Generator | int | np.random.SeedSequence = 0, *, start: ArrayLike | None = None):
+    def __init__(self, world: World, config: SimConfig | None,
+                 rng: np.random.Generator | int | np.random.SeedSequence, *, start: ArrayLike | None = None):
         self.world = world
         self.config = SimConfig.paper() if config is None else config
         self.rng = as_generator(rng)

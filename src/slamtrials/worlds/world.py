@@ -20,7 +20,7 @@ from slamtrials.errors import WorldError
 
 __all__ = ["World", "world_to_map", "world_to_cell", "cell_to_world", "DEFAULT_START_CLEARANCE"]
 
-#: Clearance (m) the automatic start pose asks for: a 0.2 m robot radius plus a margin.
+#: Clearance (m) the automatic start pose asks for: the 0.15 m robot footprint radius plus a margin.
 DEFAULT_START_CLEARANCE = 0.5
 
 

@@ -43,7 +43,6 @@ from slamtrials.worlds.world import World, world_to_map
 
 __all__ = ["sinc", "cosc", "arc_increment", "arc_sagitta", "limit_velocity", "CollisionChecker", "Robot"]
 
-_TWO_PI = 2.0 * math.pi
 
 
 def sinc(x: float) -> float:

@@ -7,6 +7,7 @@ from typing import Annotated
 
 import typer
 
+from slamtrials.cli.main import make_console
 from slamtrials.demo import DEMO_WORLDS
 
 
@@ -16,14 +17,11 @@ def demo(
     seed: Annotated[int, typer.Option("--seed", "-s", help="Seed of every random draw.")] = 1,
 ) -> None:
     """Simulate a scripted tour through a few bundled worlds; write run folders and pictures."""
-    from rich.console import Console
     from rich.table import Table
 
     from slamtrials.demo import run_demo
 
-    console = Console()
-    if not console.is_terminal:  # logs and pipes: do not squeeze the table into 80 columns
-        console = Console(width=110)
+    console = make_console()
     table = Table(title="Scripted tours, paper robot; drift = odometry end-point error")
     for column in ("world", "frames", "sim s", "wall s", "speed", "path m", "drift m", "outcome"):
         table.add_column(column, justify="left" if column in ("world", "outcome") else "right", no_wrap=True)

@@ -42,6 +42,14 @@ def make_app(**kwargs) -> typer.Typer:
 app = make_app(help="Repeatable SLAM evaluation: simulate, explore, map, measure, repeat until confident.")
 
 
+def make_console():
+    """A rich Console for command output; pipes and logs get 110 columns instead of rich's default 80."""
+    from rich.console import Console
+
+    console = Console()
+    return console if console.is_terminal else Console(width=110)
+
+
 def _version(value: bool) -> None:
     if value:
         typer.echo(f"slamtrials {__version__}")

@@ -9,6 +9,7 @@ from typing import Annotated
 import numpy as np
 import typer
 
+from slamtrials.cli.main import make_console
 from slamtrials.errors import ConfigError
 
 RUN_PICTURE = "run.png"
@@ -25,8 +26,6 @@ def simulate(
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace a run already stored in --out.")] = False,
 ) -> None:
     """Simulate the robot driving through WAYPOINTS (or a --tour) and record laser, odometry and ground truth."""
-    from rich.console import Console
-
     from slamtrials.io.runfolder import RUN_FILE, write_run
     from slamtrials.io.waypoints import read_waypoints
     from slamtrials.report.runplot import save_run_figure
@@ -55,7 +54,7 @@ def simulate(
     )
     write_run(out, record)
     save_run_figure(the_world, record, out / RUN_PICTURE, title=f"{the_world.name}, seed {seed}")
-    console = Console()
+    console = make_console()
     duration = float(record.t[-1] - record.t[0])
     console.print(
         f"{out}: {len(record)} frames, {duration:.1f} s simulated in {wall:.2f} s "

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from slamtrials.cli.main import make_app
+from slamtrials.cli.main import make_app, make_console
 from slamtrials.errors import ConfigError
 
 app = make_app(help="List, show, describe and generate floor plans.")
@@ -30,7 +30,6 @@ def _load(source: str, resolution: float | None):
 @app.command("list")
 def list_worlds() -> None:
     """List the bundled worlds: name, kind, requested and free area, size in metres."""
-    from rich.console import Console
     from rich.table import Table
 
     from slamtrials.worlds.catalog import catalog_entries
@@ -43,7 +42,7 @@ def list_worlds() -> None:
     for e in catalog_entries():
         table.add_row(e["name"], e["kind"], e.get("shape", ""), f"{e['area_m2']:,.0f}", f"{e['free_area_m2']:,.0f}",
                       f"{e['width_m']:.0f} \u00d7 {e['height_m']:.0f}", str(e.get("rooms", "")))
-    Console().print(table)
+    make_console().print(table)
 
 
 @app.command("show")

@@ -60,7 +60,7 @@ def run_demo(
         started = time.perf_counter()
         record = simulate_waypoints(world, waypoints, SimConfig.paper(), seed=seed)
         wall = time.perf_counter() - started
-        record.metadata.update(world_source=name, waypoints=np.round(waypoints, 4).tolist(), wall_time_s=round(wall, 3))
+        record.metadata.update(world_source=name, wall_time_s=round(wall, 3))
         folder = write_run(out / "runs" / world.name / "000", record)
         save_run_figure(world, record, folder / "run.png", title=f"{world.name}: scripted tour, seed {seed}")
         steps = np.linalg.norm(np.diff(record.truth[:, :2], axis=0), axis=1)

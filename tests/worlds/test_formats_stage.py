@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import math
 import shutil
 from pathlib import Path
@@ -14,7 +16,8 @@ from slamtrials.errors import FormatError, WorldError
 from slamtrials.worlds import load_world, world_to_cell
 from slamtrials.worlds.formats.stage import load_stage_world, parse_worldfile, type_chain
 
-REAL = Path(__file__).resolve().parents[2].parent / "shared" / "worlds" / "real"
+# The shared data folder beside the repository, or wherever SLAMTRIALS_SHARED points.
+REAL = Path(os.environ.get("SLAMTRIALS_SHARED", Path(__file__).resolve().parents[2].parent / "shared")) / "worlds" / "real"
 
 # The bitmap: 20 x 10 px, a white margin of 2 px around a 16 x 6 px walled box (the part Stage
 # scales), an interior wall with a door, and an L-shaped notch that makes the plan asymmetric.

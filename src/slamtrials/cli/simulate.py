@@ -6,7 +6,6 @@ import time
 from pathlib import Path
 from typing import Annotated
 
-import numpy as np
 import typer
 
 from slamtrials.cli.main import make_console
@@ -47,11 +46,7 @@ def simulate(
     started = time.perf_counter()
     record = simulate_waypoints(the_world, waypoints, SimConfig(), seed=seed, max_time=max_time)
     wall = time.perf_counter() - started
-    record.metadata.update(
-        world_source=str(world),
-        waypoints=np.round(waypoints, 4).tolist(),
-        wall_time_s=round(wall, 3),
-    )
+    record.metadata.update(world_source=str(world), wall_time_s=round(wall, 3))
     write_run(out, record)
     save_run_figure(the_world, record, out / RUN_PICTURE, title=f"{the_world.name}, seed {seed}")
     console = make_console()

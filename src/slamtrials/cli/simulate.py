@@ -23,10 +23,12 @@ def simulate(
     max_time: Annotated[float, typer.Option("--max-time", help="Stop after this much simulated time (s).")] = 3600.0,
     resolution: Annotated[float | None, typer.Option("--resolution", help="Metres per pixel, for a bare PNG/PGM floor plan.")] = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace a run already stored in --out.")] = False,
+    config: Annotated[Path | None, typer.Option("--config", "-c", help="YAML with robot/laser/odometry/dt settings (SI units); default: the paper's.")] = None,
 ) -> None:
     """Simulate the robot driving through WAYPOINTS (or a --tour) and record laser, odometry and ground truth."""
     from slamtrials.io.runfolder import RUN_FILE, write_run
     from slamtrials.io.waypoints import read_waypoints
+    from slamtrials.io.yamlfile import read_yaml_mapping
     from slamtrials.report.runplot import save_run_figure
     from slamtrials.sim import SimConfig, simulate_waypoints
     from slamtrials.sim.tour import tour_waypoints
@@ -40,11 +42,17 @@ def simulate(
         raise ConfigError(f"--max-time must be positive seconds, got {max_time}")
     if (out / RUN_FILE).exists() and not overwrite:
         raise ConfigError(f"{out}: already holds a run; choose another --out or pass --overwrite")
+    sim_config = SimConfig.paper()
+    if config is not None:
+        try:
+            sim_config = SimConfig.from_dict(read_yaml_mapping(config))
+        except ConfigError as exc:
+            raise ConfigError(f"{config}: {exc}") from None
     options = {} if resolution is None else {"resolution": resolution}
     the_world = load_world(world, **options)
     waypoints = read_waypoints(path) if path is not None else tour_waypoints(the_world)
     started = time.perf_counter()
-    record = simulate_waypoints(the_world, waypoints, SimConfig(), seed=seed, max_time=max_time)
+    record = simulate_waypoints(the_world, waypoints, sim_config, seed=seed, max_time=max_time)
     wall = time.perf_counter() - started
     record.metadata.update(world_source=str(world), wall_time_s=round(wall, 3))
     write_run(out, record)

@@ -21,7 +21,7 @@ ALLOWED = {
     "slam": {"geometry", "record"},
     "explore": {"geometry", "record"},
     "trial": {"geometry", "record", "worlds", "sim", "slam", "explore"},
-    "metric": {"geometry"},
+    "metric": {"geometry", "record"},
     "io": {"geometry", "record", "worlds"},
     "campaign": {"geometry", "record", "worlds", "sim", "slam", "explore", "trial", "metric", "io"},
     "report": {"geometry", "record", "worlds", "metric", "io", "campaign"},

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Frame", "RunRecord"]
+__all__ = ["Frame", "RunRecord", "Trajectory", "Relations"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -99,3 +99,52 @@ class RunRecord:
             laser=dict(laser),
             metadata=dict(metadata or {}),
         )
+
+
+@dataclass(frozen=True, eq=False)
+class Trajectory:
+    """Timestamped 2-D poses, e.g. a SLAM estimate or a ground truth read from a file.
+
+    Attributes
+    ----------
+    t:
+        float64 ``[N]`` timestamps in seconds.
+    poses:
+        float64 ``[N, 3]`` poses (x, y, theta) in metres and radians, in the trajectory's own frame.
+    """
+
+    t: NDArray[np.float64]
+    poses: NDArray[np.float64]
+
+    def __post_init__(self) -> None:
+        if self.t.ndim != 1 or self.poses.shape != (len(self.t), 3):
+            raise ValueError(f"Trajectory needs t [N] and poses [N, 3], got {self.t.shape} and {self.poses.shape}")
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+
+@dataclass(frozen=True, eq=False)
+class Relations:
+    """Relative-pose relations of the Kuemmerle et al. metric: the true motion between two times.
+
+    Attributes
+    ----------
+    t1, t2:
+        float64 ``[K]`` timestamps (s) of the two poses of each relation.
+    delta:
+        float64 ``[K, 3]`` true relative pose (dx, dy, dtheta): the pose at ``t2`` seen from the pose at
+        ``t1`` (``ominus(x(t1), x(t2))``), in metres and radians.
+    """
+
+    t1: NDArray[np.float64]
+    t2: NDArray[np.float64]
+    delta: NDArray[np.float64]
+
+    def __post_init__(self) -> None:
+        k = len(self.t1)
+        if self.t1.ndim != 1 or self.t2.shape != (k,) or self.delta.shape != (k, 3):
+            raise ValueError(f"Relations needs t1 [K], t2 [K], delta [K, 3], got {self.t1.shape}, {self.t2.shape}, {self.delta.shape}")
+
+    def __len__(self) -> int:
+        return len(self.t1)

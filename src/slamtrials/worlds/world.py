@@ -59,12 +59,12 @@ class World:
         resolution = float(self.resolution)
         if not np.isfinite(resolution) or resolution <= 0:
             raise WorldError(f"world {self.name!r}: resolution must be a positive number of metres per pixel, got {self.resolution!r}")
-        origin = np.asarray(self.origin, dtype=np.float64).reshape(-1)
+        origin = np.array(self.origin, dtype=np.float64).reshape(-1)  # copies: the flags below must not touch the caller's arrays
         if origin.shape == (2,):
             origin = np.append(origin, 0.0)
         if origin.shape != (3,) or not np.all(np.isfinite(origin)):
             raise WorldError(f"world {self.name!r}: origin must be three finite numbers (x, y, theta), got {self.origin!r}")
-        occupied = np.ascontiguousarray(occupied, dtype=bool)
+        occupied = np.array(occupied, dtype=bool, order="C")
         occupied.setflags(write=False)
         origin.setflags(write=False)
         object.__setattr__(self, "occupied", occupied)
@@ -72,7 +72,7 @@ class World:
         object.__setattr__(self, "origin", origin)
         if occupied.all():
             raise WorldError(f"world {self.name!r}: the floor plan has no free space")
-        start = choose_start_pose(self) if self.start is None else np.asarray(self.start, dtype=np.float64).reshape(-1)
+        start = choose_start_pose(self) if self.start is None else np.array(self.start, dtype=np.float64).reshape(-1)
         if start.shape != (3,) or not np.all(np.isfinite(start)):
             raise WorldError(f"world {self.name!r}: start pose must be three finite numbers (x, y, theta), got {self.start!r}")
         row, col = world_to_cell(self, start[:2])

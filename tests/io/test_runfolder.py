@@ -98,3 +98,13 @@ def test_rewrite_leaves_no_temporary_files(tmp_path):
     write_run(tmp_path, _record(seed=2))
     assert sorted(p.name for p in tmp_path.iterdir()) == [FRAMES_FILE, RUN_FILE]
     assert read_run(tmp_path).metadata["seed"] == 2
+
+
+def test_flipped_bytes_inside_frames_are_a_format_error(tmp_path):
+    write_run(tmp_path, _record(n=200, beams=50))
+    data = bytearray((tmp_path / FRAMES_FILE).read_bytes())
+    for offset in range(200, len(data) - 200, 997):  # corrupt compressed payloads, keep the zip directory
+        data[offset] ^= 0xFF
+    (tmp_path / FRAMES_FILE).write_bytes(bytes(data))
+    with pytest.raises(FormatError, match="frames.npz"):
+        read_run(tmp_path)

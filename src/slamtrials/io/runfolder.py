@@ -15,6 +15,7 @@ import io
 import json
 import platform
 import zipfile
+import zlib
 from pathlib import Path
 from typing import Any
 
@@ -97,7 +98,7 @@ def _read_frames(path: Path) -> dict[str, np.ndarray]:
     try:
         with np.load(path, allow_pickle=False) as npz:
             arrays = {name: npz[name] for name in npz.files if name in _ARRAYS}
-    except (zipfile.BadZipFile, ValueError, OSError, EOFError, io.UnsupportedOperation) as exc:
+    except (zipfile.BadZipFile, zlib.error, ValueError, OSError, EOFError, io.UnsupportedOperation) as exc:
         raise FormatError(path, f"not a readable .npz archive ({exc})") from None
     for name, (dtype, last) in _ARRAYS.items():
         if name not in arrays:

@@ -15,6 +15,7 @@ __all__ = [
     "FormatError",
     "WorldError",
     "SimulationError",
+    "MetricError",
 ]
 
 
@@ -60,3 +61,26 @@ class WorldError(SlamtrialsError):
 
 class SimulationError(SlamtrialsError):
     """The simulator was asked for something it cannot do (e.g. a start pose inside a wall)."""
+
+
+class MetricError(SlamtrialsError):
+    """Data handed to the metric cannot be evaluated (empty or unordered trajectory, unmatched relation, ...).
+
+    The metric is pure and knows no files, so it names the item at fault by position; the caller that
+    read the data maps that position to a file and line.
+
+    Parameters
+    ----------
+    problem:
+        What is wrong and what was expected.
+    what:
+        Which input is at fault: ``"relations"``, ``"estimate"``, ``"odometry"``, ``"truth"``, ... .
+    index:
+        0-based index of the relation or pose at fault within that input.
+    """
+
+    def __init__(self, problem: str, *, what: str | None = None, index: int | None = None):
+        self.problem = problem
+        self.what = what
+        self.index = index
+        super().__init__(problem)

@@ -11,7 +11,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["wrap_angle", "compose", "inverse", "ominus", "transform_points", "as_poses", "wrap_angle1", "compose1", "ominus1"]
+__all__ = ["wrap_angle", "compose", "inverse", "ominus", "transform_points", "as_poses", "wrap_angle1", "compose1", "ominus1", "interpolate"]
 
 
 def as_poses(poses: ArrayLike) -> NDArray[np.float64]:
@@ -67,6 +67,31 @@ def transform_points(pose: ArrayLike, points: ArrayLike) -> NDArray[np.float64]:
     out = np.empty(pts.shape)
     out[..., 0] = pose[0] + c * pts[..., 0] - s * pts[..., 1]
     out[..., 1] = pose[1] + s * pts[..., 0] + c * pts[..., 1]
+    return out
+
+
+def interpolate(a: ArrayLike, b: ArrayLike, fraction: ArrayLike) -> NDArray[np.float64]:
+    """Poses a fraction of the way from ``a`` to ``b``: linear in (x, y), along the shorter arc in theta.
+
+    Parameters
+    ----------
+    a, b:
+        Poses ``[..., 3]`` (m, m, rad), broadcast against each other.
+    fraction:
+        ``[...]`` position between them: 0 gives ``a``, 1 gives ``b`` (up to angle wrapping).
+
+    Returns
+    -------
+    NDArray[np.float64]
+        ``[..., 3]`` interpolated poses, theta wrapped into [-pi, pi).
+    """
+    a = as_poses(a)
+    b = as_poses(b)
+    f = np.asarray(fraction, dtype=np.float64)
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape, f.shape + (3,)))
+    out[..., 0] = a[..., 0] + f * (b[..., 0] - a[..., 0])
+    out[..., 1] = a[..., 1] + f * (b[..., 1] - a[..., 1])
+    out[..., 2] = wrap_angle(a[..., 2] + f * wrap_angle(b[..., 2] - a[..., 2]))
     return out
 
 

@@ -1,0 +1,201 @@
+"""``slamtrials evaluate``: real datasets (estimate + relations files) and simulated run folders."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from slamtrials.cli.main import app
+from slamtrials.geometry import compose, ominus
+from slamtrials.io.relations import read_relations, write_relations
+from slamtrials.io.runfolder import write_run
+from slamtrials.io.tum import write_tum
+from slamtrials.record import Relations, RunRecord, Trajectory
+
+runner = CliRunner()
+REPO = Path(__file__).resolve().parents[2]
+DATA = Path(os.environ.get("SLAMTRIALS_SHARED", REPO.parent / "shared")) / "data" / "mit-csail"
+LASER = {"angle_min": -2.356, "angle_increment": 0.0087, "range_min": 0.0, "range_max": 30.0, "mount": [0.0, 0.0, 0.0]}
+
+
+def _summary_rows(output: str) -> tuple[list[float], list[float]]:
+    lines = output.splitlines()
+    rows = [lines[i + 1] for i, line in enumerate(lines) if line == "Mean, Std, Min, Max, NumMeasures"]
+    assert len(rows) == 2, output
+    return [float(v) for v in rows[0].split(",")], [float(v) for v in rows[1].split(",")]
+
+
+def _files(tmp_path, comment: bool = True):
+    """Truth moves 1 m per second along x; the estimate (other frame) overshoots each relation by 0.1 m."""
+    t = 1134864600.0 + np.arange(5.0)
+    truth = np.column_stack([np.arange(5.0), np.zeros(5), np.zeros(5)])
+    estimate = compose(np.array([3.0, -2.0, 1.0]), np.column_stack([np.arange(5.0) * 1.1, np.zeros(5), np.zeros(5)]))
+    est = write_tum(tmp_path / "est.tum", Trajectory(t=t, poses=estimate))
+    i, j = np.array([0, 1, 0]), np.array([1, 2, 2])
+    rel = tmp_path / "rel.txt"
+    write_relations(rel, Relations(t1=t[i], t2=t[j], delta=ominus(truth[i], truth[j])))
+    if comment:
+        rel.write_text("# t1 t2 x y z roll pitch yaw\n\n" + rel.read_text())
+    return est, rel, t
+
+
+def test_estimate_and_relations_files_known_answer(tmp_path):
+    est, rel, _ = _files(tmp_path)
+    result = runner.invoke(app, ["evaluate", "--estimate", str(est), "--relations", str(rel), "--errors", str(tmp_path / "e.npz")])
+    assert result.exit_code == 0, result.output
+    trans, rot = _summary_rows(result.output)
+    np.testing.assert_allclose(trans, [0.4 / 3, np.std([0.1, 0.1, 0.2], ddof=1), 0.1, 0.2, 3], rtol=1e-5)  # printed to 6 digits
+    np.testing.assert_allclose(rot, [0, 0, 0, 0, 3], atol=1e-9)
+    assert "Translational error (m, absolute)" in result.output and "Rotational error (rad, absolute)" in result.output
+    with np.load(tmp_path / "e.npz") as npz:
+        np.testing.assert_allclose(npz["translational"], [0.1, 0.1, 0.2], atol=1e-9)
+        assert not npz["squared"] and len(npz["unmatched"]) == 0
+    squared = runner.invoke(app, ["evaluate", "-e", str(est), "-r", str(rel), "--squared", "--errors", str(tmp_path / "e.txt")])
+    assert squared.exit_code == 0 and "(m^2, squared)" in squared.output
+    assert _summary_rows(squared.output)[0][3] == pytest.approx(0.04)
+    assert (tmp_path / "e.txt").read_text().startswith("# t1 t2 translational_error[m^2]")
+
+
+def test_unmatched_relations_are_reported_with_their_lines(tmp_path):
+    est, rel, t = _files(tmp_path)
+    with rel.open("a") as handle:
+        handle.write(f"{float(t[1]) + 0.5!r} {float(t[3])!r} 2.0 0.0 0.0 0.0 0.0 0.0\n")  # line 6: t1 between two poses
+    result = runner.invoke(app, ["evaluate", "-e", str(est), "-r", str(rel)])
+    assert result.exit_code == 0, result.output
+    assert "matched 3 of 4 relations" in result.output and "unmatched: line 6" in result.output
+
+
+def test_bad_input_names_the_file_and_line(tmp_path):
+    est, rel, t = _files(tmp_path)
+    outside = tmp_path / "outside.txt"
+    outside.write_text(rel.read_text() + f"{float(t[0])!r} {float(t[-1]) + 5.0!r} 9.0 0.0 0.0 0.0 0.0 0.0\n")  # line 6
+    result = runner.invoke(app, ["evaluate", "-e", str(est), "-r", str(outside)])
+    assert result.exit_code == 2
+    assert f"{outside}:6: relation 3: timestamp" in result.output and "outside the time span" in result.output
+    assert runner.invoke(app, ["evaluate", "-e", str(est), "-r", str(outside), "--allow-outside"]).exit_code == 0
+
+    garbage = tmp_path / "garbage.txt"
+    garbage.write_text("1.0 2.0 0.0 0.0 0.0 0.0 0.0 0.0\n1.0 2.0 zero 0.0 0.0 0.0 0.0 0.0\n")
+    result = runner.invoke(app, ["evaluate", "-e", str(est), "-r", str(garbage)])
+    assert result.exit_code == 2 and f"{garbage}:2:" in result.output
+
+    unordered = tmp_path / "unordered.tum"
+    unordered.write_text("0.0 0 0 0 0 0 0 1\n2.0 0 0 0 0 0 0 1\n1.0 0 0 0 0 0 0 1\n")
+    result = runner.invoke(app, ["evaluate", "-e", str(unordered), "-r", str(rel)])
+    assert result.exit_code == 2 and f"{unordered}:3:" in result.output
+
+    empty = tmp_path / "empty.tum"
+    empty.write_text("# nothing here\n")
+    result = runner.invoke(app, ["evaluate", "-e", str(empty), "-r", str(rel)])
+    assert result.exit_code == 2 and str(empty) in result.output
+
+    result = runner.invoke(app, ["evaluate", "-e", str(est)])
+    assert result.exit_code == 2 and "--relations" in result.output
+    result = runner.invoke(app, ["evaluate", "-e", str(est), "-r", str(tmp_path / "missing.txt")])
+    assert result.exit_code == 2 and "missing.txt" in result.output
+
+
+def _run(tmp_path, n: int = 400) -> tuple[Path, RunRecord]:
+    """A run folder: a wandering drive at 10 Hz and an odometry that drifts from it."""
+    rng = np.random.default_rng(0)
+    steps = np.column_stack([np.full(n - 1, 0.05), np.zeros(n - 1), rng.normal(0, 0.05, n - 1)])
+    truth, odometry = np.zeros((n, 3)), np.zeros((n, 3))
+    truth[0] = [2.0, 3.0, 0.5]
+    for k in range(n - 1):
+        truth[k + 1] = compose(truth[k], steps[k])
+        odometry[k + 1] = compose(odometry[k], steps[k] * [1.01, 1.0, 1.02])
+    record = RunRecord(
+        t=np.arange(n) * 0.1, scans=np.zeros((n, 3), np.float32), odometry=odometry, truth=truth,
+        stalled=np.zeros(n, bool), laser=LASER, metadata={"seed": 0},
+    )
+    return write_run(tmp_path / "run", record), record
+
+
+def test_run_folder_samples_relations_and_writes_them(tmp_path):
+    folder, record = _run(tmp_path)
+    result = runner.invoke(app, ["evaluate", str(folder), "--seed", "3", "--margin-t", "0.005", "--margin-r", "0.005"])
+    assert result.exit_code == 0, result.output
+    assert "the run's odometry" in result.output and "sampling:  pilot 500 pairs" in result.output
+    relations = read_relations(folder / "relations.txt")
+    trans, rot = _summary_rows(result.output)
+    assert trans[4] == len(relations) == rot[4] and trans[0] > 0.0 and rot[0] > 0.0
+    with np.load(folder / "errors.npz") as npz:
+        assert len(npz["translational"]) == len(relations)
+        assert npz["translational"].mean() == pytest.approx(trans[0], rel=1e-5)
+    first = (folder / "relations.txt").read_text()
+    again = runner.invoke(app, ["evaluate", str(folder), "--seed", "3", "--margin-t", "0.005", "--margin-r", "0.005"])
+    assert again.exit_code == 0 and (folder / "relations.txt").read_text() == first  # seeded
+
+
+def test_run_folder_with_an_estimate_file(tmp_path):
+    folder, record = _run(tmp_path)
+    write_tum(folder / "estimate.tum", Trajectory(t=record.t, poses=record.truth))  # a perfect estimate
+    result = runner.invoke(app, ["evaluate", str(folder), "--seed", "1"])
+    assert result.exit_code == 0, result.output
+    assert "estimate.tum (TUM" in result.output
+    trans, rot = _summary_rows(result.output)
+    assert trans[0] < 1e-9 and rot[0] < 1e-9
+
+
+def test_run_folder_with_a_sparse_estimate_uses_the_odometry_between_its_poses(tmp_path):
+    """A perfect estimate at every 3rd frame: the other ground-truth poses are reached from the nearest
+    estimated pose through the run's odometry (1-2 % off over 0.1-0.2 s), so errors stay at millimetres;
+    with the Freiburg 0.1 s tolerance the neighbouring frame's pose would be taken as is (5 cm off)."""
+    folder, record = _run(tmp_path)
+    write_tum(folder / "estimate.tum", Trajectory(t=record.t[::3], poses=record.truth[::3]))
+    result = runner.invoke(app, ["evaluate", str(folder), "--seed", "1"])
+    assert result.exit_code == 0, result.output
+    trans, rot = _summary_rows(result.output)
+    assert trans[0] < 0.005 and rot[0] < 0.005
+    assert "0 through the odometry" not in result.output
+    coarse = runner.invoke(app, ["evaluate", str(folder), "--seed", "1", "--tolerance", "0.1"])
+    assert _summary_rows(coarse.output)[0][0] > 10 * trans[0]
+    result = runner.invoke(app, ["evaluate", str(folder), "--relations", str(folder / "relations.txt")])
+    assert result.exit_code == 2 and "drop --relations" in result.output
+
+
+@pytest.mark.skipif(not (DATA / "mit-csail.clf").is_file(), reason=f"no MIT CSAIL data in {DATA}")
+def test_mit_csail_raw_odometry():
+    """Both pose triples of this log are the raw odometry (see tests/metric/test_mit_csail.py):
+    observed 1.68146 m and 0.0885188 rad mean error over all 1,172 relations."""
+    result = runner.invoke(app, ["evaluate", "-e", str(DATA / "mit-csail.clf"), "-r", str(DATA / "mit-csail.relations"), "--odometry", str(DATA / "mit-csail.clf")])
+    assert result.exit_code == 0, result.output
+    trans, rot = _summary_rows(result.output)
+    assert trans[4] == rot[4] == 1172
+    assert trans[0] > 5 * 0.049 and 0.01 < rot[0] < 1.0
+
+
+def test_run_folder_with_an_estimate_that_covers_nothing(tmp_path):
+    folder, record = _run(tmp_path)
+    write_tum(folder / "estimate.tum", Trajectory(t=record.t + 1000.0, poses=record.truth))
+    result = runner.invoke(app, ["evaluate", str(folder)])
+    assert result.exit_code == 2
+    assert f"{folder / 'estimate.tum'}: the estimate covers 0 of the 400 ground-truth poses" in result.output
+
+
+def test_pose_indices_map_to_file_lines(tmp_path):
+    """The readers refuse bad trajectories themselves; this is the backstop for errors the metric finds."""
+    from slamtrials.cli.evaluate import PoseTriple, _read_trajectory, _with_lines
+    from slamtrials.errors import FormatError, MetricError
+
+    tum = tmp_path / "est.tum"
+    tum.write_text("# header\n0.0 0 0 0 0 0 0 1\n\n1.0 0 0 0 0 0 0 1\n2.0 0 0 0 0 0 0 1\n")
+    source = _read_trajectory(tum, PoseTriple.first, "estimate")
+    mapped = _with_lines(MetricError("pose 2 is bad", what="estimate", index=2), {"estimate": source}, None)
+    assert isinstance(mapped, FormatError) and (mapped.path, mapped.line) == (tum, 5)
+    clf = tmp_path / "log.clf"
+    clf.write_text(
+        "PARAM robot_front_laser_max 30.0 0 h 0\n"
+        "FLASER 2 1.0 1.0 0 0 0 0 0 0 10.0 h 0\n"
+        "ODOM 0 0 0 0 0 0 10.05 h 0\n"
+        "FLASER 2 1.0 1.0 0 0 0 0 0 0 10.1 h 0\n"
+    )
+    source = _read_trajectory(clf, PoseTriple.second, "odometry")
+    mapped = _with_lines(MetricError("pose 1 is bad", what="odometry", index=1), {"odometry": source}, None)
+    assert (mapped.path, mapped.line) == (clf, 4)
+    unknown = MetricError("no index")
+    assert _with_lines(unknown, {}, None) is unknown

@@ -23,6 +23,8 @@ _PUBLIC = {
     "simulate_waypoints": "slamtrials.sim",
     "Frame": "slamtrials.record",
     "RunRecord": "slamtrials.record",
+    "evaluate_run": "slamtrials.evaluation",
+    "evaluate_files": "slamtrials.evaluation",
     "write_run": "slamtrials.io.runfolder",
     "read_run": "slamtrials.io.runfolder",
     "SlamtrialsError": "slamtrials.errors",

@@ -179,7 +179,7 @@ def test_run_folder_with_an_estimate_that_covers_nothing(tmp_path):
 
 def test_pose_indices_map_to_file_lines(tmp_path):
     """The readers refuse bad trajectories themselves; this is the backstop for errors the metric finds."""
-    from slamtrials.cli.evaluate import PoseTriple, _read_trajectory, _with_lines
+    from slamtrials.evaluation import PoseTriple, _read_trajectory, _with_lines
     from slamtrials.errors import FormatError, MetricError
 
     tum = tmp_path / "est.tum"

@@ -1,0 +1,363 @@
+"""Evaluating trajectories with the localization error metric: the library behind ``slamtrials evaluate``.
+
+Two forms:
+
+* :func:`evaluate_files`: a real dataset. The estimate is a CARMEN log (its laser lines' first pose
+  triple, or the second, at their ``ipc_timestamp``) or a TUM file; the relations file is
+  ``t1 t2 x y z roll pitch yaw`` per line. An odometry log (a CARMEN log, whose laser lines' second
+  triple is used, or a TUM file) carries a relation timestamp with no estimated pose within the
+  tolerance to the nearest estimated pose.
+* :func:`evaluate_run`: a simulated run folder. Relations are sampled from its ground truth by the
+  IROS 2018 rule (pilot, ``N = ceil(z^2 s^2 / d^2)``, N fresh pairs) and the run's estimate is evaluated
+  on them: ``estimate.tum`` in the folder, else a given estimate file, else the run's odometry. Writes
+  ``relations.txt`` and ``errors.npz`` into the folder.
+
+This module composes io (reading and writing files) and metric (pure computation), like the CLI does,
+and does not print. The metric names bad relations or poses by index; this module maps an index back
+to the file and line it came from (re-reading the file's data lines the way the readers count them).
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass
+from enum import Enum
+from pathlib import Path
+
+from slamtrials.errors import FormatError, MetricError
+from slamtrials.record import Relations, Trajectory
+
+__all__ = ["EvaluationResult", "PoseTriple", "Quantile", "evaluate_files", "evaluate_run", "format_report", "RELATIONS_FILE", "ERRORS_FILE", "ESTIMATE_FILE", "FILE_TOLERANCE", "RUN_TOLERANCE"]
+
+#: Default matching tolerance (s) for dataset files: the Freiburg program's.
+FILE_TOLERANCE = 0.1
+#: Default matching tolerance (s) for run folders: estimate and ground truth share the simulator's clock
+#: (frames every 0.1 s), so only the same frame's pose is taken directly and the odometry fills the rest.
+RUN_TOLERANCE = 0.001
+RELATIONS_FILE = "relations.txt"
+ERRORS_FILE = "errors.npz"
+ESTIMATE_FILE = "estimate.tum"
+
+
+class PoseTriple(str, Enum):
+    """Which pose triple of a CARMEN laser line is the estimate."""
+
+    first = "first"
+    second = "second"
+
+
+class Quantile(str, Enum):
+    """Reference distribution of the critical value."""
+
+    normal = "normal"
+    t = "t"
+
+
+# ----------------------------------------------------------------------------- reading, with line mapping
+
+
+@dataclass(frozen=True)
+class _Source:
+    """A trajectory read from a file, and how to find the file line of its i-th pose."""
+
+    trajectory: Trajectory
+    path: Path
+    kind: str  # "tum", "carmen" or "run"
+    label: str
+
+    def line_of(self, index: int) -> int | None:
+        if self.kind == "tum":
+            return _data_line(self.path, index)
+        if self.kind == "carmen":
+            from slamtrials.io.carmen_log import LASER_KINDS
+
+            return _data_line(self.path, index, lambda tokens: tokens[0] in LASER_KINDS)
+        return None
+
+
+def _data_line(path: Path, index: int, keep=lambda tokens: True) -> int | None:
+    """1-based line of the ``index``-th data line of ``path`` (as the readers count them), or None."""
+    from slamtrials.io.textfile import data_lines, read_lines
+
+    count = 0
+    for number, tokens in data_lines(read_lines(path)):
+        if keep(tokens):
+            if count == index:
+                return number
+            count += 1
+    return None
+
+
+def _is_carmen(path: Path) -> bool:
+    """A CARMEN log starts (after comments) with a message name; a TUM file with a number."""
+    from slamtrials.io.textfile import data_lines, read_lines
+
+    for _, tokens in data_lines(read_lines(path)):
+        try:
+            float(tokens[0])
+        except ValueError:
+            return True
+        return False
+    return False
+
+
+def _read_trajectory(path: Path, triple: PoseTriple, what: str) -> _Source:
+    """A CARMEN log (laser lines' first or second triple at their ipc_timestamp) or a TUM file."""
+    if _is_carmen(path):
+        from slamtrials.io.carmen import read_carmen
+
+        laser = read_carmen(path).laser
+        poses = laser.pose if triple is PoseTriple.first else laser.odometry
+        label = f"{path} (CARMEN, {len(laser)} {laser.kind} lines, {triple.value} pose triple)"
+        return _Source(Trajectory(t=laser.t, poses=poses), path, "carmen", label)
+    from slamtrials.io.tum import read_tum
+
+    trajectory = read_tum(path)
+    return _Source(trajectory, path, "tum", f"{path} (TUM, {len(trajectory)} poses)")
+
+
+def _with_lines(exc: MetricError, sources: dict[str, _Source], relations_path: Path | None) -> Exception:
+    """Turn a MetricError that names an index into a FormatError that names the file and line."""
+    if exc.what == "relations" and relations_path is not None and exc.index is not None:
+        return FormatError(relations_path, exc.problem, line=_data_line(relations_path, exc.index))
+    source = sources.get(exc.what or "")
+    if source is not None and source.kind != "run":
+        line = source.line_of(exc.index) if exc.index is not None else None
+        return FormatError(source.path, exc.problem, line=line)
+    if source is not None:
+        return FormatError(source.path, exc.problem)
+    return exc
+
+
+# ----------------------------------------------------------------------------- the typed functions
+
+
+@dataclass(frozen=True, eq=False)
+class EvaluationResult:
+    """What one evaluation produced.
+
+    Attributes
+    ----------
+    relations:
+        The relations evaluated (read or sampled).
+    errors:
+        Per-relation errors (:class:`~slamtrials.metric.relerrors.RelationErrors`).
+    translational, rotational:
+        :class:`~slamtrials.metric.summary.ErrorSummary` of each kind of error.
+    estimate_label, relations_label:
+        Where the estimate and the relations came from, for the report.
+    tolerance:
+        Matching tolerance (s).
+    sampling:
+        The :class:`~slamtrials.metric.sampling.SampledRelations` of a run folder, else None.
+    relations_path:
+        The relations file (read, or written into the run folder), for mapping relation indices to lines.
+    written:
+        Files written.
+    """
+
+    relations: Relations
+    errors: object
+    translational: object
+    rotational: object
+    estimate_label: str
+    relations_label: str
+    tolerance: float
+    sampling: object = None
+    relations_path: Path | None = None
+    written: tuple[Path, ...] = ()
+
+
+def _summaries(errors):
+    from slamtrials.metric import summarize
+
+    return summarize(errors.translational), summarize(errors.rotational)
+
+
+def evaluate_files(
+    estimate: Path,
+    relations: Path,
+    *,
+    odometry: Path | None = None,
+    estimate_pose: PoseTriple = PoseTriple.first,
+    tolerance: float = FILE_TOLERANCE,
+    interpolate: bool = False,
+    squared: bool = False,
+    allow_outside: bool = False,
+) -> EvaluationResult:
+    """Evaluate an estimated trajectory file against a relations file (a real dataset).
+
+    Parameters
+    ----------
+    estimate:
+        CARMEN log or TUM file of the estimated trajectory.
+    relations:
+        Relations file, ``t1 t2 x y z roll pitch yaw`` per line.
+    odometry:
+        Optional CARMEN log (second pose triple of its laser lines) or TUM file used to carry relation
+        timestamps without an estimated pose within ``tolerance`` to the nearest estimated pose.
+    estimate_pose:
+        Which pose triple of a CARMEN estimate to use.
+    tolerance, interpolate, squared, allow_outside:
+        See :func:`slamtrials.metric.evaluate_relations`.
+
+    Raises
+    ------
+    FormatError
+        A file that does not parse, or data the metric refuses (naming the file and line).
+    """
+    from slamtrials.io.relations import read_relations
+    from slamtrials.metric import evaluate_relations
+
+    estimate_source = _read_trajectory(Path(estimate), estimate_pose, "estimate")
+    sources = {"estimate": estimate_source}
+    if odometry is not None:
+        sources["odometry"] = _read_trajectory(Path(odometry), PoseTriple.second, "odometry")
+    rel = read_relations(relations)
+    try:
+        errors = evaluate_relations(
+            estimate_source.trajectory,
+            rel,
+            tolerance=tolerance,
+            interpolate=interpolate,
+            odometry=sources["odometry"].trajectory if odometry is not None else None,
+            squared=squared,
+            allow_outside=allow_outside,
+        )
+    except MetricError as exc:
+        raise _with_lines(exc, sources, Path(relations)) from None
+    trans, rot = _summaries(errors)
+    label = f"{relations} ({len(rel)} relations)"
+    if odometry is not None:
+        label += f", odometry {sources['odometry'].label}"
+    return EvaluationResult(rel, errors, trans, rot, estimate_source.label, label, tolerance, relations_path=Path(relations))
+
+
+def evaluate_run(
+    run: Path,
+    *,
+    estimate: Path | None = None,
+    estimate_pose: PoseTriple = PoseTriple.first,
+    seed: int = 0,
+    pilot: int = 500,
+    confidence: float = 0.99,
+    margin_t: float = 0.02,
+    margin_r: float = 0.02,
+    quantile: Quantile = Quantile.normal,
+    sides: int = 2,
+    tolerance: float = RUN_TOLERANCE,
+    interpolate: bool = False,
+    squared: bool = False,
+    write: bool = True,
+) -> EvaluationResult:
+    """Sample relations from a run folder's ground truth and evaluate the run's estimate on them.
+
+    Parameters
+    ----------
+    run:
+        A run folder (``frames.npz`` + ``run.json``).
+    estimate:
+        Estimate file (CARMEN or TUM) to evaluate instead of the folder's ``estimate.tum``; without
+        either, the run's odometry is evaluated.
+    estimate_pose:
+        Which pose triple of a CARMEN estimate to use.
+    seed:
+        Seed of the relation sampling.
+    pilot, confidence, margin_t, margin_r, quantile, sides:
+        The sampling rule (:func:`slamtrials.metric.sample_relations`).
+    tolerance, interpolate, squared:
+        Matching and error options. The run's odometry carries ground-truth timestamps without an
+        estimated pose within ``tolerance`` (default 1 ms: the same frame) to the nearest estimated pose.
+    write:
+        Write ``relations.txt`` and ``errors.npz`` into the folder.
+
+    Raises
+    ------
+    FormatError
+        An unreadable run folder or estimate file, or data the metric refuses.
+    """
+    from slamtrials.io.errorsfile import write_errors
+    from slamtrials.io.relations import write_relations
+    from slamtrials.io.runfolder import FRAMES_FILE, read_run
+    from slamtrials.metric import sample_relations
+
+    run = Path(run)
+    record = read_run(run)
+    truth = Trajectory(t=record.t, poses=record.truth)
+    odometry = Trajectory(t=record.t, poses=record.odometry)
+    sources = {"truth": _Source(truth, run / FRAMES_FILE, "run", "ground truth")}
+    if estimate is None and (run / ESTIMATE_FILE).is_file():
+        estimate = run / ESTIMATE_FILE
+    if estimate is not None:
+        source = _read_trajectory(Path(estimate), estimate_pose, "estimate")
+    elif record.estimate is not None:
+        source = _Source(Trajectory(t=record.t, poses=record.estimate), run / FRAMES_FILE, "run", f"{run} (the run's estimate)")
+    else:
+        source = _Source(odometry, run / FRAMES_FILE, "run", f"{run} (no SLAM estimate in the folder: the run's odometry)")
+    sources["estimate"] = source
+    sources["odometry"] = _Source(odometry, run / FRAMES_FILE, "run", "odometry")
+    try:
+        sampled = sample_relations(
+            truth,
+            source.trajectory,
+            rng=seed,
+            pilot=pilot,
+            confidence=confidence,
+            margin_t=margin_t,
+            margin_r=margin_r,
+            distribution=quantile.value,
+            sides=sides,
+            tolerance=tolerance,
+            interpolate=interpolate,
+            odometry=odometry,
+            squared=squared,
+        )
+    except MetricError as exc:
+        raise _with_lines(exc, sources, None) from None
+    written: tuple[Path, ...] = ()
+    relations_path = run / RELATIONS_FILE
+    if write:
+        written = (write_relations(relations_path, sampled.relations), write_errors(run / ERRORS_FILE, sampled.relations, sampled.errors))
+    trans, rot = _summaries(sampled.errors)
+    label = f"{run / RELATIONS_FILE if write else 'sampled'} ({len(sampled.relations)} relations sampled from the ground truth, seed {seed})"
+    return EvaluationResult(sampled.relations, sampled.errors, trans, rot, source.label, label, tolerance, sampled, relations_path if write else None, written)
+
+
+# ----------------------------------------------------------------------------- printing
+
+
+def _row(summary) -> str:
+    return ", ".join(f"{v:.6g}" for v in summary.as_tuple()[:4]) + f", {summary.n}"
+
+
+def format_report(result: EvaluationResult) -> str:
+    """The text the command prints: sources, matching, sampling, and the two summaries."""
+    from slamtrials.metric.summary import SUMMARY_HEADER
+
+    errors = result.errors
+    kind = "squared" if errors.squared else "absolute"
+    unit_t, unit_r = errors.units
+    out = io.StringIO()
+    out.write(f"estimate:  {result.estimate_label}\n")
+    out.write(f"relations: {result.relations_label}\n")
+    out.write(
+        f"matched {len(errors)} of {errors.n_relations} relations (nearest pose within {result.tolerance:g} s)"
+        f", {len(errors.corrected)} through the odometry, {len(errors.unmatched)} unmatched\n"
+    )
+    if len(errors.unmatched):
+        shown = errors.unmatched[:10].tolist()
+        where = [f"line {_data_line(result.relations_path, i)}" for i in shown] if result.relations_path else [f"#{i}" for i in shown]
+        more = f" and {len(errors.unmatched) - len(shown)} more" if len(errors.unmatched) > len(shown) else ""
+        out.write(f"unmatched: {', '.join(where)}{more}\n")
+    s = result.sampling
+    if s is not None:
+        out.write(
+            f"sampling:  pilot {len(s.pilot_relations)} pairs, s_t = {s.std_t:.6g} {unit_t}, s_r = {s.std_r:.6g} {unit_r}; "
+            f"z = {s.critical:.4f} ({s.confidence:g} confidence, {s.distribution}, {'two' if s.sides == 2 else 'one'}-sided); margins {s.margin_t:g} {unit_t}, {s.margin_r:g} {unit_r} "
+            f"-> N_t = {s.needed_t}, N_r = {s.needed_r}, N = {s.count}{' (capped)' if s.capped else ''}\n"
+        )
+    out.write(f"Translational error ({unit_t}, {kind}):\n{SUMMARY_HEADER}\n{_row(result.translational)}\n")
+    out.write(f"Rotational error ({unit_r}, {kind}):\n{SUMMARY_HEADER}\n{_row(result.rotational)}\n")
+    for path in result.written:
+        out.write(f"wrote {path}\n")
+    return out.getvalue()

@@ -92,12 +92,18 @@ def _start_pose(occupied: NDArray[np.bool_], labels: NDArray[np.int32], grid: Gr
     nearest = np.argsort((rows - centre_r) ** 2 + (cols - centre_c) ** 2)[0]
     centre_r, centre_c = int(rows[nearest]) * step, int(cols[nearest]) * step
     size = 2 * grid.px(START_CLEARANCE) + 1
-    for reach in (grid.px(12.0), max(occupied.shape)):
+    # Prefer the circulation near the centre; narrow hallways (houses) may have no such room, and then
+    # any free cell will do.
+    searches = [(reach, kind) for kind in (CIRCULATION, None) for reach in (grid.px(12.0), max(occupied.shape))]
+    for reach, kind in searches:
         r0, c0 = max(0, centre_r - reach), max(0, centre_c - reach)
         window = (slice(r0, centre_r + reach), slice(c0, centre_c + reach))
         free = (~occupied[window]).view(np.uint8)
-        roomy = ndimage.minimum_filter1d(ndimage.minimum_filter1d(free, size, axis=0), size, axis=1).view(bool)
-        cand_r, cand_c = np.nonzero(roomy & (labels[window] == CIRCULATION))
+        # Outside the window counts as occupied: the default 'reflect' would mirror free cells over walls.
+        strip = ndimage.minimum_filter1d(free, size, axis=0, mode="constant", cval=0)
+        roomy = ndimage.minimum_filter1d(strip, size, axis=1, mode="constant", cval=0).view(bool)
+        allowed = labels[window] == CIRCULATION if kind is not None else labels[window] > 0
+        cand_r, cand_c = np.nonzero(roomy & allowed)
         if len(cand_r):
             break
     else:

@@ -2,19 +2,14 @@
 
 from __future__ import annotations
 
-import gzip
-import shutil
-import tempfile
-import zlib
 from enum import Enum
 from pathlib import Path
 from typing import Annotated
 
-import numpy as np
 import typer
 
 from slamtrials.cli.main import make_console
-from slamtrials.errors import ConfigError, FormatError
+from slamtrials.errors import ConfigError
 
 
 class ExportFormat(str, Enum):
@@ -40,23 +35,6 @@ class Pairing(str, Enum):
     previous = "previous"
 
 
-CARMEN_SUFFIXES = (".clf", ".log", ".carmen")
-BAG_SUFFIXES = (".bag", ".mcap", ".db3")
-
-
-def _check_out(out: Path, overwrite: bool) -> None:
-    if out.exists() and not overwrite:
-        raise ConfigError(f"{out}: already exists; choose another --out or pass --overwrite")
-
-
-def _remove(out: Path) -> None:
-    """Remove an existing output that a writer cannot replace by itself (a file where a folder goes)."""
-    if out.is_dir() and not out.is_symlink():
-        shutil.rmtree(out)
-    elif out.exists():
-        out.unlink()
-
-
 def export_run(
     run: Annotated[Path, typer.Argument(metavar="RUN", help="Run folder (frames.npz + run.json).")],
     to: Annotated[ExportFormat, typer.Option("--to", "-t", help="bag: ROS 1 .bag; bag2: ROS 2 bag folder (MCAP); carmen: CARMEN log; tum: TUM trajectory.")],
@@ -69,88 +47,23 @@ def export_run(
 ) -> None:
     """Export a run's laser, odometry and ground truth as a ROS bag (Stage topics), a CARMEN log or a TUM file."""
     from slamtrials.io.runfolder import read_run
+    from slamtrials.io.transfer import export_record
 
     if what is not None and to is not ExportFormat.tum:
         raise ConfigError("--what applies to --to tum only")
     if (time_origin is not None or compress) and to not in (ExportFormat.bag, ExportFormat.bag2):
         raise ConfigError("--time-origin-ns and --compress apply to --to bag and --to bag2 only")
-    if carmen_kind not in ("ROBOTLASER1", "FLASER"):
-        raise ConfigError(f"--carmen-kind must be ROBOTLASER1 or FLASER, got {carmen_kind!r}")
-    _check_out(out, overwrite)
+    if out.exists() and not overwrite:
+        raise ConfigError(f"{out}: already exists; choose another --out or pass --overwrite")
     record = read_run(run)
-    console = make_console()
-    if to in (ExportFormat.bag, ExportFormat.bag2):
-        from slamtrials.io.rosbag import DEFAULT_TIME_ORIGIN_NS, write_bag
-
-        ros = 1 if to is ExportFormat.bag else 2
-        if out.exists() and (out.is_dir() != (ros == 2)):
-            _remove(out)
-        origin = DEFAULT_TIME_ORIGIN_NS if time_origin is None else time_origin
-        write_bag(out, record, ros=ros, time_origin_ns=origin, overwrite=overwrite, compress=compress)
-        truth = "with" if np.isfinite(record.truth).all(axis=1).any() else "without"
-        console.print(f"{out}: ROS {ros} bag, {len(record)} scans on /base_scan, /odom, /tf, {truth} /base_pose_ground_truth")
-    elif to is ExportFormat.carmen:
-        from slamtrials.io.carmen import carmen_from_run, write_carmen
-
-        if not np.isfinite(record.truth).all():
-            raise ConfigError(f"{run}: the run has no ground truth for every frame; a CARMEN laser line needs it (first pose triple)")
-        try:
-            write_carmen(out, carmen_from_run(record, kind=carmen_kind))
-        except ValueError as exc:
-            raise ConfigError(f"{run}: cannot be written as a CARMEN log: {exc}") from None
-        console.print(f"{out}: CARMEN log, {len(record)} {carmen_kind} and ODOM lines (first pose = ground truth, second = odometry)")
-    else:
-        _export_tum(run, record, out, what or TumSource.truth, console)
-
-
-def _export_tum(run: Path, record, out: Path, what: TumSource, console) -> None:
-    from slamtrials.io.tum import write_tum
-    from slamtrials.record import Trajectory
-
-    poses = record.truth if what is TumSource.truth else record.odometry
-    known = np.isfinite(poses).all(axis=1)
-    if not known.any():
-        raise ConfigError(f"{run}: the run has no {what.value} (a recording without ground truth?); try --what odometry")
-    write_tum(out, Trajectory(t=np.asarray(record.t)[known], poses=np.asarray(poses)[known]))
-    skipped = f" ({np.count_nonzero(~known)} frames without it skipped)" if not known.all() else ""
-    frame = "world frame" if what is TumSource.truth else "odometry frame"
-    console.print(f"{out}: TUM trajectory of the {what.value} ({frame}), {np.count_nonzero(known)} poses{skipped}")
-
-
-def _import_format(path: Path, fmt: ImportFormat) -> ImportFormat:
-    if fmt is not ImportFormat.auto:
-        return fmt
-    suffixes = [s.lower() for s in path.suffixes]
-    if path.is_dir() or (suffixes and suffixes[-1] in BAG_SUFFIXES):
-        return ImportFormat.bag
-    if suffixes and (suffixes[-1] in CARMEN_SUFFIXES or suffixes[-1] == ".gz"):
-        return ImportFormat.carmen
-    if not path.exists():
-        raise FormatError(path, "no such file or folder")
-    with open(path, "rb") as handle:
-        head = handle.read(16)
-    return ImportFormat.bag if head.startswith((b"#ROSBAG", b"\x89MCAP")) else ImportFormat.carmen
-
-
-def _read_carmen_file(path: Path):
-    from slamtrials.io.carmen import read_carmen, run_from_carmen
-
-    if path.suffix.lower() != ".gz":
-        return run_from_carmen(read_carmen(path))
-    with tempfile.TemporaryDirectory(prefix="slamtrials-import-") as tmp:
-        plain = Path(tmp) / path.stem
-        try:
-            with gzip.open(path, "rb") as source, open(plain, "wb") as target:
-                shutil.copyfileobj(source, target)
-        except FileNotFoundError:
-            raise FormatError(path, "no such file") from None
-        except (OSError, EOFError, zlib.error) as exc:
-            raise FormatError(path, f"not a readable gzip file ({exc})") from None
-        try:
-            record = run_from_carmen(read_carmen(plain))
-        except FormatError as exc:  # name the file the user gave, with the line in the decompressed log
-            raise FormatError(path, f"(decompressed) {exc.problem}", line=exc.line, offset=exc.offset) from None
-    return record
+    try:
+        summary = export_record(
+            record, out, to.value, tum_source=(what or TumSource.truth).value, time_origin_ns=time_origin,
+            compress=compress, carmen_kind=carmen_kind, overwrite=overwrite,
+        )
+    except ConfigError as exc:
+        raise ConfigError(f"{run}: {exc}") from None
+    make_console().print(summary)
 
 
 def import_run(
@@ -167,12 +80,13 @@ def import_run(
 ) -> None:
     """Import a ROS bag or a CARMEN log as a run folder, so recordings (also of real robots) can be evaluated."""
     from slamtrials.io.runfolder import RUN_FILE, write_run
+    from slamtrials.io.transfer import detect_recording_format, read_carmen_run
 
     if no_truth and truth_topic is not None:
         raise ConfigError("give either --truth-topic or --no-truth, not both")
     if (out / RUN_FILE).exists() and not overwrite:
         raise ConfigError(f"{out}: already holds a run; choose another --out or pass --overwrite")
-    kind = _import_format(source, fmt)
+    kind = ImportFormat(detect_recording_format(source)) if fmt is ImportFormat.auto else fmt
     if kind is ImportFormat.bag:
         from slamtrials.io.rosbag import ODOM_TOPIC, SCAN_TOPIC, TRUTH_TOPIC, run_from_bag
 
@@ -190,7 +104,7 @@ def import_run(
         given = [name for name, value in bag_options.items() if value is not None]
         if given:
             raise ConfigError(f"{', '.join(given)} appl{'ies' if len(given) == 1 else 'y'} to ROS bags, not to CARMEN logs")
-        record = _read_carmen_file(source)
+        record = read_carmen_run(source)
     record.metadata.setdefault("imported_from", str(source))
     write_run(out, record)
     duration = float(record.t[-1] - record.t[0]) if len(record) else 0.0

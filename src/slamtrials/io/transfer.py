@@ -1,0 +1,145 @@
+"""Moving a run between the run folder and other formats: the library behind ``export`` and ``import``.
+
+Export writes a :class:`~slamtrials.record.RunRecord` as a ROS 1 bag, a ROS 2 bag (MCAP), a CARMEN log
+(first pose triple = ground truth, second = odometry) or a TUM trajectory. Import reads a ROS bag or a
+CARMEN log (plain or gzipped) back into a record. Functions return a one-line description of what they
+did for the caller to show; they never print.
+"""
+
+from __future__ import annotations
+
+import gzip
+import shutil
+import tempfile
+import zlib
+from pathlib import Path
+
+import numpy as np
+
+from slamtrials.errors import ConfigError, FormatError
+from slamtrials.record import RunRecord, Trajectory
+
+__all__ = ["EXPORT_FORMATS", "export_record", "detect_recording_format", "read_carmen_run", "CARMEN_SUFFIXES", "BAG_SUFFIXES"]
+
+EXPORT_FORMATS = ("bag", "bag2", "carmen", "tum")
+CARMEN_SUFFIXES = (".clf", ".log", ".carmen")
+BAG_SUFFIXES = (".bag", ".mcap", ".db3")
+
+
+def _remove(out: Path) -> None:
+    """Remove an existing output that a writer cannot replace by itself (a file where a folder goes)."""
+    if out.is_dir() and not out.is_symlink():
+        shutil.rmtree(out)
+    elif out.exists():
+        out.unlink()
+
+
+def export_record(
+    record: RunRecord,
+    out: str | Path,
+    to: str,
+    *,
+    tum_source: str = "truth",
+    time_origin_ns: int | None = None,
+    compress: bool = False,
+    carmen_kind: str = "ROBOTLASER1",
+    overwrite: bool = False,
+) -> str:
+    """Write ``record`` to ``out`` in format ``to`` (one of :data:`EXPORT_FORMATS`); return a description.
+
+    Parameters
+    ----------
+    tum_source:
+        For ``tum``: ``"truth"`` (world frame) or ``"odometry"`` (odometry frame). Frames without that
+        pose (NaN, e.g. an imported recording without ground truth) are skipped.
+    time_origin_ns, compress:
+        For bags: the ROS stamp of t = 0 (default 1 s) and LZ4 (ROS 1) or zstd (ROS 2) chunks.
+    carmen_kind:
+        For ``carmen``: ``"ROBOTLASER1"`` or ``"FLASER"``.
+
+    Raises
+    ------
+    ConfigError
+        An unknown format or option, an existing ``out`` without ``overwrite``, or a record the format
+        cannot hold (no ground truth for a CARMEN log).
+    """
+    out = Path(out)
+    if to not in EXPORT_FORMATS:
+        raise ConfigError(f"unknown export format {to!r}; expected one of {', '.join(EXPORT_FORMATS)}")
+    if out.exists() and not overwrite:
+        raise ConfigError(f"{out}: already exists; choose another --out or pass --overwrite")
+    if to in ("bag", "bag2"):
+        from slamtrials.io.rosbag import DEFAULT_TIME_ORIGIN_NS, write_bag
+
+        ros = 1 if to == "bag" else 2
+        if out.exists() and (out.is_dir() != (ros == 2)):
+            _remove(out)
+        origin = DEFAULT_TIME_ORIGIN_NS if time_origin_ns is None else time_origin_ns
+        write_bag(out, record, ros=ros, time_origin_ns=origin, overwrite=overwrite, compress=compress)
+        truth = "with" if np.isfinite(record.truth).all(axis=1).any() else "without"
+        return f"{out}: ROS {ros} bag, {len(record)} scans on /base_scan, /odom, /tf, {truth} /base_pose_ground_truth"
+    if to == "carmen":
+        from slamtrials.io.carmen import carmen_from_run, write_carmen
+
+        if carmen_kind not in ("ROBOTLASER1", "FLASER"):
+            raise ConfigError(f"CARMEN line kind must be ROBOTLASER1 or FLASER, got {carmen_kind!r}")
+        if not np.isfinite(record.truth).all():
+            raise ConfigError("the run has no ground truth for every frame; a CARMEN laser line needs it (first pose triple)")
+        try:
+            write_carmen(out, carmen_from_run(record, kind=carmen_kind))
+        except ValueError as exc:
+            raise ConfigError(f"the run cannot be written as a CARMEN log: {exc}") from None
+        return f"{out}: CARMEN log, {len(record)} {carmen_kind} and ODOM lines (first pose = ground truth, second = odometry)"
+    return _export_tum(record, out, tum_source)
+
+
+def _export_tum(record: RunRecord, out: Path, source: str) -> str:
+    from slamtrials.io.tum import write_tum
+
+    if source not in ("truth", "odometry"):
+        raise ConfigError(f"TUM export takes the truth or the odometry, got {source!r}")
+    poses = record.truth if source == "truth" else record.odometry
+    known = np.isfinite(poses).all(axis=1)
+    if not known.any():
+        raise ConfigError(f"the run has no {source} (a recording without ground truth?); export the odometry instead (--what odometry)")
+    write_tum(out, Trajectory(t=np.asarray(record.t)[known], poses=np.asarray(poses)[known]))
+    skipped = f" ({np.count_nonzero(~known)} frames without it skipped)" if not known.all() else ""
+    frame = "world frame" if source == "truth" else "odometry frame"
+    return f"{out}: TUM trajectory of the {source} ({frame}), {np.count_nonzero(known)} poses{skipped}"
+
+
+def detect_recording_format(path: str | Path) -> str:
+    """``"bag"`` or ``"carmen"``, from the name (suffix, folder) and, failing that, the first bytes."""
+    path = Path(path)
+    suffixes = [s.lower() for s in path.suffixes]
+    if path.is_dir() or (suffixes and suffixes[-1] in BAG_SUFFIXES):
+        return "bag"
+    if suffixes and (suffixes[-1] in CARMEN_SUFFIXES or suffixes[-1] == ".gz"):
+        return "carmen"
+    if not path.exists():
+        raise FormatError(path, "no such file or folder")
+    with open(path, "rb") as handle:
+        head = handle.read(16)
+    return "bag" if head.startswith((b"#ROSBAG", b"\x89MCAP")) else "carmen"
+
+
+def read_carmen_run(path: str | Path) -> RunRecord:
+    """A CARMEN log (plain, or gzipped with a ``.gz`` suffix) as a run record (truth = first pose triple)."""
+    from slamtrials.io.carmen import read_carmen, run_from_carmen
+
+    path = Path(path)
+    if path.suffix.lower() != ".gz":
+        return run_from_carmen(read_carmen(path))
+    with tempfile.TemporaryDirectory(prefix="slamtrials-import-") as tmp:
+        plain = Path(tmp) / path.stem
+        try:
+            with gzip.open(path, "rb") as source, open(plain, "wb") as target:
+                shutil.copyfileobj(source, target)
+        except FileNotFoundError:
+            raise FormatError(path, "no such file") from None
+        except (OSError, EOFError, zlib.error) as exc:
+            raise FormatError(path, f"not a readable gzip file ({exc})") from None
+        try:
+            return run_from_carmen(read_carmen(plain))
+        except FormatError as exc:  # name the file the user gave, with the line in the decompressed log
+            raise FormatError(path, f"(decompressed) {exc.problem}", line=exc.line, offset=exc.offset) from None

@@ -25,7 +25,7 @@ import numpy as np
 
 from slamtrials.atomicfile import atomic_write_text
 from slamtrials.errors import FormatError
-from slamtrials.io.textfile import data_lines, first_bad_row, last_line, parse_floats, read_lines
+from slamtrials.io.textfile import read_number_table
 from slamtrials.record import Relations
 
 __all__ = ["read_relations", "write_relations", "RELATION_FIELDS"]
@@ -54,21 +54,7 @@ def read_relations(path: str | Path) -> Relations:
         of +-pi/2 (no heading), or no relations at all.
     """
     path = Path(path)
-    lines = read_lines(path)
-    rows: list[list[float]] = []
-    numbers: list[int] = []
-    for number, tokens in data_lines(lines):
-        if len(tokens) != 8:
-            raise FormatError(path, f"expected 8 fields 't1 t2 x y z roll pitch yaw', got {len(tokens)}", line=number)
-        rows.append(parse_floats(path, number, tokens, 1, RELATION_FIELDS))
-        numbers.append(number)
-    if not rows:
-        raise FormatError(path, "no relations: expected lines 't1 t2 x y z roll pitch yaw'", line=last_line(lines))
-    values = np.array(rows, dtype=np.float64)
-    bad = first_bad_row(~np.isfinite(values))
-    if bad is not None:
-        row, col = bad
-        raise FormatError(path, f"field {col + 1} ({RELATION_FIELDS[col]}) is not finite: {values[row, col]}", line=numbers[row])
+    values, numbers = read_number_table(path, RELATION_FIELDS, "relations")
     roll, pitch, yaw = values[:, 5], values[:, 6], values[:, 7]
     cos_pitch = np.cos(pitch)
     vertical = np.flatnonzero(np.abs(cos_pitch) < 1e-9)

@@ -40,13 +40,13 @@ from __future__ import annotations
 import json
 import math
 from functools import cache
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from slamtrials.geometry import ominus
+from slamtrials.io.runfolder import json_default
 
 __all__ = [
     "SCAN_TOPIC",
@@ -181,16 +181,6 @@ def scan_period(record: Any) -> float:
     return 0.0
 
 
-def _json_default(value: Any) -> Any:
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, Path):
-        return str(value)
-    raise TypeError(f"cannot store {type(value).__name__} in the bag's run description")
-
-
 def run_info_json(record: Any, time_origin_ns: int) -> str:
     """The JSON document of ``/slamtrials/run``: format, time origin (ns), frames, laser dict, metadata."""
     doc = {
@@ -200,4 +190,4 @@ def run_info_json(record: Any, time_origin_ns: int) -> str:
         "laser": record.laser,
         "metadata": record.metadata,
     }
-    return json.dumps(doc, default=_json_default)
+    return json.dumps(doc, default=json_default)

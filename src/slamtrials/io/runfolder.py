@@ -42,14 +42,15 @@ _ARRAYS: dict[str, tuple[type, int | None]] = {  # name -> (dtype, size of the l
 _LASER_KEYS = ("angle_min", "angle_increment", "range_min", "range_max")
 
 
-def _json_default(value: Any) -> Any:
+def json_default(value: Any) -> Any:
+    """``json.dumps(default=...)`` hook: numpy arrays and scalars, and paths, as plain JSON values."""
     if isinstance(value, np.ndarray):
         return value.tolist()
     if isinstance(value, np.generic):
         return value.item()
     if isinstance(value, Path):
         return str(value)
-    raise TypeError(f"cannot store {type(value).__name__} in run.json")
+    raise TypeError(f"cannot store {type(value).__name__} as JSON")
 
 
 def write_run(folder: str | Path, record: RunRecord) -> Path:
@@ -71,7 +72,7 @@ def write_run(folder: str | Path, record: RunRecord) -> Path:
         "laser": record.laser,
         **record.metadata,
     }
-    atomic_write_text(folder / RUN_FILE, json.dumps(doc, indent=2, default=_json_default) + "\n")
+    atomic_write_text(folder / RUN_FILE, json.dumps(doc, indent=2, default=json_default) + "\n")
     return folder
 
 

@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 
 from slamtrials.errors import FormatError
 
-__all__ = ["read_lines", "data_lines", "parse_floats", "parse_int", "last_line", "first_bad_row", "float_text"]
+__all__ = ["read_lines", "data_lines", "parse_floats", "parse_int", "last_line", "first_bad_row", "float_text", "read_number_table"]
 
 
 def read_lines(path: Path) -> list[str]:
@@ -107,3 +107,47 @@ def first_bad_row(bad: NDArray[np.bool_]) -> tuple[int, int] | None:
 def float_text(value: float) -> str:
     """The shortest text that reads back as exactly ``value`` (Python's ``repr`` of a float)."""
     return repr(float(value))
+
+
+def read_number_table(path: Path, fields: Sequence[str], nothing: str) -> tuple[NDArray[np.float64], list[int]]:
+    """Read a text file of rows of ``len(fields)`` finite numbers (comments and blank lines skipped).
+
+    Parameters
+    ----------
+    path:
+        The file.
+    fields:
+        Names of the columns, for messages (e.g. ``("t", "x", ...)``).
+    nothing:
+        What the file holds, for the message when it has no rows (e.g. ``"poses"``).
+
+    Returns
+    -------
+    values:
+        float64 ``[N, len(fields)]``.
+    line_numbers:
+        1-based line of each row, for messages about rows found bad later.
+
+    Raises
+    ------
+    FormatError
+        Naming the file and line: a row with another number of fields, a field that is not a finite
+        number, or no rows at all.
+    """
+    layout = " ".join(fields)
+    lines = read_lines(path)
+    rows: list[list[float]] = []
+    numbers: list[int] = []
+    for number, tokens in data_lines(lines):
+        if len(tokens) != len(fields):
+            raise FormatError(path, f"expected {len(fields)} fields '{layout}', got {len(tokens)}", line=number)
+        rows.append(parse_floats(path, number, tokens, 1, fields))
+        numbers.append(number)
+    if not rows:
+        raise FormatError(path, f"no {nothing}: expected lines '{layout}'", line=last_line(lines))
+    values = np.array(rows, dtype=np.float64)
+    bad = first_bad_row(~np.isfinite(values))
+    if bad is not None:
+        row, col = bad
+        raise FormatError(path, f"field {col + 1} ({fields[col]}) is not finite: {values[row, col]}", line=numbers[row])
+    return values, numbers

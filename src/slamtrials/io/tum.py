@@ -26,7 +26,7 @@ import numpy as np
 
 from slamtrials.atomicfile import atomic_write_text
 from slamtrials.errors import FormatError
-from slamtrials.io.textfile import data_lines, first_bad_row, last_line, parse_floats, read_lines
+from slamtrials.io.textfile import read_number_table
 from slamtrials.record import Trajectory
 
 __all__ = ["read_tum", "write_tum", "TUM_FIELDS"]
@@ -55,21 +55,7 @@ def read_tum(path: str | Path) -> Trajectory:
         quaternion or one with no heading, timestamps not strictly increasing, or no poses at all.
     """
     path = Path(path)
-    lines = read_lines(path)
-    rows: list[list[float]] = []
-    numbers: list[int] = []
-    for number, tokens in data_lines(lines):
-        if len(tokens) != 8:
-            raise FormatError(path, f"expected 8 fields 't x y z qx qy qz qw', got {len(tokens)}", line=number)
-        rows.append(parse_floats(path, number, tokens, 1, TUM_FIELDS))
-        numbers.append(number)
-    if not rows:
-        raise FormatError(path, "no poses: expected lines 't x y z qx qy qz qw'", line=last_line(lines))
-    values = np.array(rows, dtype=np.float64)
-    bad = first_bad_row(~np.isfinite(values))
-    if bad is not None:
-        row, col = bad
-        raise FormatError(path, f"field {col + 1} ({TUM_FIELDS[col]}) is not finite: {values[row, col]}", line=numbers[row])
+    values, numbers = read_number_table(path, TUM_FIELDS, "poses")
     t = values[:, 0]
     step = np.flatnonzero(np.diff(t) <= 0)
     if step.size:

@@ -37,7 +37,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
-from slamtrials.geometry import compose1, ominus1, wrap_angle1
+from slamtrials.geometry import compose1, wrap_angle1
 from slamtrials.sim.config import RobotConfig
 from slamtrials.worlds.world import World, world_to_map
 

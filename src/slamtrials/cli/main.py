@@ -72,12 +72,14 @@ def _register_commands() -> None:
     from slamtrials.cli import demo, simulate, worlds
     from slamtrials.cli import transfer
     from slamtrials.cli import evaluate
+    from slamtrials.cli import slam
 
     app.add_typer(worlds.app, name="worlds", help="List, show, load and generate floor plans.")
     simulate.register(app)
     demo.register(app)
     transfer.register(app)
     evaluate.register(app)
+    slam.register(app)
 
 
 _register_commands()

@@ -1,0 +1,253 @@
+"""The SLAM plug-in interface: the :class:`SlamAlgorithm` protocol, the map type and the registry.
+
+A SLAM algorithm is a class with
+
+* ``name``: the registry name (``slamtrials slam --algorithm NAME``);
+* ``Config``: a pydantic model of its parameters (SI units), every field with a default;
+* ``PRESETS``: named parameter sets, ``{preset name: {parameter: value}}`` (may be empty);
+* a constructor ``Algorithm(config, laser)`` taking a validated ``Config`` and the laser geometry dict
+  of :class:`~slamtrials.record.RunRecord` (``angle_min``, ``angle_increment``, ``range_min``,
+  ``range_max``, ``mount``);
+* ``reset(rng)``, ``process(frame) -> pose``, ``occupancy()``, ``trajectory()`` and an ``updates``
+  counter (see :class:`SlamAlgorithm`).
+
+Built-in algorithms are listed in :data:`ALGORITHMS`; :func:`register_algorithm` adds one at run time,
+and third-party packages publish theirs under the entry-point group ``slamtrials.slam``
+(``[project.entry-points."slamtrials.slam"] myslam = "mypkg.module:MySlam"``).
+:func:`make_algorithm` validates a configuration (preset, then overrides) and builds an instance.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from importlib.metadata import entry_points
+from typing import Any, ClassVar, Protocol, runtime_checkable
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import BaseModel, ValidationError
+
+from slamtrials.errors import ConfigError
+from slamtrials.record import Frame, Trajectory
+
+__all__ = [
+    "OccupancyGrid",
+    "SlamAlgorithm",
+    "ALGORITHMS",
+    "ENTRY_POINT_GROUP",
+    "register_algorithm",
+    "get_algorithm",
+    "known_algorithms",
+    "resolve_config",
+    "make_algorithm",
+    "OCCUPIED",
+    "FREE",
+    "UNKNOWN",
+]
+
+#: Entry-point group under which other packages publish SLAM algorithm classes.
+ENTRY_POINT_GROUP = "slamtrials.slam"
+#: Cell values of :attr:`OccupancyGrid.grid` (those of a ``nav_msgs/OccupancyGrid``).
+OCCUPIED, FREE, UNKNOWN = 100, 0, -1
+
+
+@dataclass(frozen=True, eq=False)
+class OccupancyGrid:
+    """A SLAM algorithm's map, as ROS publishes it.
+
+    Attributes
+    ----------
+    grid:
+        int8 ``[H, W]``: 100 occupied, 0 free, -1 unknown; row 0 is the TOP row (largest y), column 0
+        the left one (smallest x).
+    resolution:
+        Cell size (m).
+    origin:
+        float64 ``[3]``: map-frame pose (x, y, theta) of the lower-left corner of the lower-left cell
+        (row ``H - 1``, column 0), as in ROS.
+    """
+
+    grid: NDArray[np.int8]
+    resolution: float
+    origin: NDArray[np.float64]
+
+    def __post_init__(self) -> None:
+        if self.grid.ndim != 2 or self.grid.dtype != np.int8:
+            raise ValueError(f"OccupancyGrid.grid must be int8 [H, W], got {self.grid.dtype} {self.grid.shape}")
+        if not (math.isfinite(self.resolution) and self.resolution > 0):
+            raise ValueError(f"OccupancyGrid.resolution must be positive metres, got {self.resolution!r}")
+        if np.shape(self.origin) != (3,):
+            raise ValueError(f"OccupancyGrid.origin must be (x, y, theta), got {self.origin!r}")
+
+
+@runtime_checkable
+class SlamAlgorithm(Protocol):
+    """What every SLAM algorithm offers (structural: no base class needed).
+
+    Attributes
+    ----------
+    name:
+        Registry name (class attribute).
+    Config:
+        pydantic model of the parameters (class attribute); every field has a default.
+    PRESETS:
+        ``{preset name: {parameter: value}}`` (class attribute, may be empty).
+    updates:
+        Number of map (or filter) updates done since the last :meth:`reset`.
+
+    An instance is built as ``Algorithm(config, laser)`` with a validated ``Config`` and the laser
+    geometry dict of :class:`~slamtrials.record.RunRecord`.
+    """
+
+    name: ClassVar[str]
+    Config: ClassVar[type[BaseModel]]
+    PRESETS: ClassVar[dict[str, dict[str, Any]]]
+    updates: int
+
+    def reset(self, rng: np.random.Generator) -> None:
+        """Forget every processed frame; later random draws come from ``rng``."""
+        ...
+
+    def process(self, frame: Frame) -> NDArray[np.float64]:
+        """Take one frame; return the current pose estimate of the robot base, float64 ``[3]``, map frame."""
+        ...
+
+    def occupancy(self) -> OccupancyGrid:
+        """The current map."""
+        ...
+
+    def trajectory(self) -> Trajectory:
+        """Timestamps (s) and pose estimates (map frame) of every frame processed since :meth:`reset`."""
+        ...
+
+
+#: Built-in (and run-time registered) algorithms: name -> class.
+ALGORITHMS: dict[str, type] = {}
+
+_CONTRACT = ("name", "Config", "PRESETS", "reset", "process", "occupancy", "trajectory")
+
+
+def register_algorithm(cls: type) -> type:
+    """Add ``cls`` to :data:`ALGORITHMS` under ``cls.name`` and return it (usable as a decorator).
+
+    Raises
+    ------
+    ConfigError
+        ``cls`` lacks part of the :class:`SlamAlgorithm` contract, its ``Config`` is not a pydantic model,
+        or its ``PRESETS`` is not a dict of dicts.
+    """
+    missing = [member for member in _CONTRACT if member not in dir(cls)]
+    if missing:
+        raise ConfigError(f"SLAM algorithm class {cls.__qualname__} lacks {', '.join(missing)} (see slamtrials.slam.SlamAlgorithm)")
+    if not isinstance(cls.name, str) or not cls.name:
+        raise ConfigError(f"SLAM algorithm class {cls.__qualname__}: name must be a non-empty string, got {cls.name!r}")
+    if not (isinstance(cls.Config, type) and issubclass(cls.Config, BaseModel)):
+        raise ConfigError(f"SLAM algorithm {cls.name!r}: Config must be a pydantic BaseModel subclass")
+    if not isinstance(cls.PRESETS, dict) or not all(isinstance(v, dict) for v in cls.PRESETS.values()):
+        raise ConfigError(f"SLAM algorithm {cls.name!r}: PRESETS must map preset names to parameter dicts")
+    ALGORITHMS[cls.name] = cls
+    return cls
+
+
+def _entry_points() -> dict[str, Any]:
+    return {ep.name: ep for ep in entry_points(group=ENTRY_POINT_GROUP)}
+
+
+def known_algorithms() -> list[str]:
+    """Sorted names of the registered and entry-point algorithms."""
+    return sorted(set(ALGORITHMS) | set(_entry_points()))
+
+
+def get_algorithm(name: str) -> type:
+    """The algorithm class called ``name``: registered, or published under :data:`ENTRY_POINT_GROUP`.
+
+    An entry-point class is checked and registered on first use.
+
+    Raises
+    ------
+    ConfigError
+        No algorithm has that name (the message lists the known ones), or its entry point fails to load.
+    """
+    if name in ALGORITHMS:
+        return ALGORITHMS[name]
+    found = _entry_points().get(name)
+    if found is None:
+        raise ConfigError(f"unknown SLAM algorithm {name!r}; known: {', '.join(known_algorithms()) or 'none'}")
+    try:
+        cls = found.load()
+    except Exception as exc:  # a third-party import error must not become a traceback
+        raise ConfigError(f"SLAM algorithm {name!r} (entry point {found.value}) failed to load: {exc}") from None
+    if not isinstance(cls, type) or cls.__dict__.get("name", name) != name:
+        raise ConfigError(f"entry point {name!r} = {found.value} is not a SLAM algorithm class named {name!r}")
+    return register_algorithm(cls)
+
+
+def _allowed(model: type[BaseModel], parameter: str) -> str:
+    """Human-readable bounds of one field (from its Gt/Ge/Lt/Le constraints), or ''."""
+    field = model.model_fields.get(parameter)
+    if field is None:
+        return ""
+    words = []
+    for item in field.metadata:
+        for attr, symbol in (("gt", ">"), ("ge", ">="), ("lt", "<"), ("le", "<=")):
+            value = getattr(item, attr, None)
+            if value is not None and type(item).__name__.lower() in (attr, "interval"):
+                words.append(f"{symbol} {value:g}" if isinstance(value, (int, float)) else f"{symbol} {value}")
+    return f"; allowed: {' and '.join(words)}" if words else ""
+
+
+def resolve_config(cls: type, *, preset: str | None = None, overrides: dict[str, Any] | None = None) -> BaseModel:
+    """Validate ``cls.Config`` from the defaults, then preset ``preset``, then ``overrides``.
+
+    Raises
+    ------
+    ConfigError
+        An unknown preset (listing the presets), an unknown parameter (listing the parameters), or a
+        value the model rejects (naming the parameter, the value and the allowed range).
+    """
+    values: dict[str, Any] = {}
+    if preset is not None:
+        if preset not in cls.PRESETS:
+            known = ", ".join(sorted(cls.PRESETS)) or "none"
+            raise ConfigError(f"SLAM algorithm {cls.name!r} has no preset {preset!r}; presets: {known}")
+        values.update(cls.PRESETS[preset])
+    values.update(overrides or {})
+    fields = cls.Config.model_fields
+    unknown = sorted(set(values) - set(fields))
+    if unknown:
+        raise ConfigError(f"SLAM algorithm {cls.name!r} has no parameter {', '.join(unknown)}; parameters: {', '.join(fields)}")
+    try:
+        return cls.Config.model_validate(values)
+    except ValidationError as exc:
+        problems = []
+        for err in exc.errors():
+            parameter = ".".join(str(p) for p in err["loc"]) or "<config>"
+            top = str(err["loc"][0]) if err["loc"] else ""
+            shown = f" = {err['input']!r}" if top in values else ""
+            problems.append(f"{parameter}{shown}: {err['msg']}{_allowed(cls.Config, top)}")
+        raise ConfigError(f"SLAM algorithm {cls.name!r}: " + "; ".join(problems)) from None
+
+
+def make_algorithm(name: str, laser: dict[str, Any], *, preset: str | None = None,
+                   overrides: dict[str, Any] | None = None) -> SlamAlgorithm:
+    """Build algorithm ``name`` for a laser of geometry ``laser`` with a validated configuration.
+
+    Parameters
+    ----------
+    name:
+        Registry or entry-point name.
+    laser:
+        Laser geometry dict of :class:`~slamtrials.record.RunRecord`.
+    preset:
+        Name of one of the class's :data:`PRESETS`, applied over the defaults.
+    overrides:
+        ``{parameter: value}`` applied last.
+
+    Raises
+    ------
+    ConfigError
+        See :func:`get_algorithm` and :func:`resolve_config`.
+    """
+    cls = get_algorithm(name)
+    return cls(resolve_config(cls, preset=preset, overrides=overrides), dict(laser))

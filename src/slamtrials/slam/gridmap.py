@@ -1,0 +1,231 @@
+"""Counting occupancy-grid maps with free-space ray tracing, as GMapping publishes its map.
+
+Each cell counts ``visits`` (beams that passed through it or ended in it) and ``hits`` (beams that
+ended in it). The published map (:meth:`GridMap.occupancy`) says occupied where
+``hits / visits > occ_thresh``, free where visited otherwise, unknown where never visited
+(spec/gmapping.md, section 5).
+
+How a beam of range ``r`` (m) is treated, with the laser's ``range_min``, ``range_max`` and the usable
+range ``max_urange`` (<= ``range_max``):
+
+* ``r`` NaN, ``-inf`` or ``r <= range_min`` (including 0): no information, the beam marks nothing;
+* ``range_min < r < range_max`` and ``r <= max_urange``: a return. Every cell the segment from the
+  laser to the endpoint crosses, before the endpoint's cell, gets a visit; the endpoint's cell gets a
+  visit and a hit;
+* ``r > max_urange`` (a return too far to trust): cut at ``max_urange``; the cells before the cut
+  point's cell get a visit, nothing is marked occupied;
+* ``r >= range_max`` or ``+inf`` (no return, REP 117): free space up to ``min(range_max, max_urange)``,
+  marked like a cut beam. This is what GMapping does when its ``maxRange`` exceeds the laser's range (as
+  in the seed paper's set-up: maxUrange 30 m, maxRange 60 m); a max-range reading never marks a cell
+  occupied.
+
+Cells are traversed exactly (Amanatides and Woo): every cell the segment passes through, in order.
+
+Coordinates. Cells are anchored at the map frame's origin: global cell ``(i, j)`` covers
+``[i res, (i + 1) res) x [j res, (j + 1) res)``. The map holds a window of global cells that grows in
+chunks of :attr:`GridMap.chunk` cells when a scan reaches outside, so a world point keeps its cell for
+the whole run. Internally arrays are ``[row from the bottom, column]``; :meth:`GridMap.occupancy` flips
+them into the ROS/PNG orientation (row 0 at the top). These conversions are the slam layer's own (it may
+not import ``worlds``).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numba import njit
+from numpy.typing import ArrayLike, NDArray
+
+from slamtrials.geometry import compose1
+from slamtrials.slam.base import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+
+__all__ = ["GridMap", "beam_endpoints", "beam_angles", "classify", "DEFAULT_CHUNK"]
+
+#: Cells added on a side when a map grows (plus what the scan needs).
+DEFAULT_CHUNK = 64
+
+
+@njit(cache=True, nogil=True)
+def _integrate_scan(hits, visits, ou, ov, eu, ev, hit):  # pragma: no cover - compiled
+    """Add one scan's visits and hits.
+
+    ``(ou, ov)`` is the laser in continuous window coordinates (cells: u right, v up, from the window's
+    lower-left corner); ``eu, ev`` float64 ``[B]`` the beam endpoints (already cut); ``hit`` bool ``[B]``
+    whether the endpoint's cell is an obstacle. Cells outside the window are skipped.
+    """
+    height, width = visits.shape
+    x0 = int(math.floor(ou))
+    y0 = int(math.floor(ov))
+    for b in range(eu.shape[0]):
+        dx = eu[b] - ou
+        dy = ev[b] - ov
+        jx = int(math.floor(eu[b]))
+        jy = int(math.floor(ev[b]))
+        ix = x0
+        iy = y0
+        step_x = 1 if dx > 0.0 else -1
+        step_y = 1 if dy > 0.0 else -1
+        if dx != 0.0:
+            delta_x = abs(1.0 / dx)
+            t_x = ((ix + 1.0 - ou) if dx > 0.0 else (ou - ix)) * delta_x
+        else:
+            delta_x = math.inf
+            t_x = math.inf
+        if dy != 0.0:
+            delta_y = abs(1.0 / dy)
+            t_y = ((iy + 1.0 - ov) if dy > 0.0 else (ov - iy)) * delta_y
+        else:
+            delta_y = math.inf
+            t_y = math.inf
+        steps = abs(jx - ix) + abs(jy - iy)
+        for _ in range(steps):
+            if 0 <= iy < height and 0 <= ix < width:
+                visits[iy, ix] += 1
+            if ix == jx or (iy != jy and t_y <= t_x):
+                iy += step_y
+                t_y += delta_y
+            else:
+                ix += step_x
+                t_x += delta_x
+        if hit[b] and 0 <= jy < height and 0 <= jx < width:
+            visits[jy, jx] += 1
+            hits[jy, jx] += 1
+
+
+def beam_angles(laser: dict[str, Any], beams: int) -> NDArray[np.float64]:
+    """Beam angles (rad) in the laser frame: ``angle_min + k angle_increment``, ``k = 0..beams-1``."""
+    return float(laser["angle_min"]) + float(laser["angle_increment"]) * np.arange(beams, dtype=np.float64)
+
+
+def beam_endpoints(laser_pose: ArrayLike, ranges: ArrayLike, angles: ArrayLike, *, range_min: float,
+                   range_max: float, max_urange: float) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """Where each beam's traced segment ends, and whether that end is an obstacle (module docstring).
+
+    Parameters
+    ----------
+    laser_pose:
+        ``[3]`` pose of the laser in the map frame (m, rad).
+    ranges:
+        ``[B]`` ranges (m).
+    angles:
+        ``[B]`` beam angles in the laser frame (rad).
+    range_min, range_max, max_urange:
+        The laser's limits and the usable range (m).
+
+    Returns
+    -------
+    endpoints:
+        float64 ``[K, 2]`` map-frame end points (m) of the ``K`` beams that carry information.
+    hit:
+        bool ``[K]``: the end point is a return (marks a hit), not a cut.
+    """
+    r = np.asarray(ranges, dtype=np.float64)
+    a = np.asarray(angles, dtype=np.float64)
+    no_return = (r >= range_max) | np.isposinf(r)
+    usable = (~np.isnan(r) & (r > range_min)) | no_return
+    length = np.minimum(np.where(no_return, range_max, r), max_urange)[usable]
+    hit = (~no_return & (r <= max_urange))[usable]
+    x, y, theta = (float(v) for v in laser_pose)  # type: ignore[union-attr]
+    heading = theta + a[usable]
+    endpoints = np.column_stack([x + length * np.cos(heading), y + length * np.sin(heading)])
+    return endpoints, hit
+
+
+def classify(hits: NDArray[np.int32], visits: NDArray[np.int32], occ_thresh: float) -> NDArray[np.int8]:
+    """Trinary cells from counts: 100 where ``hits / visits > occ_thresh``, 0 where visited, else -1."""
+    grid = np.full(visits.shape, UNKNOWN, dtype=np.int8)
+    visited = visits > 0
+    grid[visited] = FREE
+    grid[visited & (hits > occ_thresh * visits)] = OCCUPIED
+    return grid
+
+
+class GridMap:
+    """A growable hit/visit counting grid in the map frame.
+
+    Parameters
+    ----------
+    resolution:
+        Cell size (m).
+    chunk:
+        Cells added beyond what a scan needs whenever the window grows.
+
+    Attributes
+    ----------
+    hits, visits:
+        int32 ``[H, W]`` counts, row 0 at the BOTTOM (global cell row :attr:`row0`).
+    col0, row0:
+        Global cell index of window column 0 and row 0.
+    """
+
+    def __init__(self, resolution: float, *, chunk: int = DEFAULT_CHUNK):
+        if not (math.isfinite(resolution) and resolution > 0):
+            raise ValueError(f"resolution must be positive metres, got {resolution!r}")
+        self.resolution = float(resolution)
+        self.chunk = int(chunk)
+        self.col0 = 0
+        self.row0 = 0
+        self.hits = np.zeros((0, 0), dtype=np.int32)
+        self.visits = np.zeros((0, 0), dtype=np.int32)
+
+    @property
+    def origin(self) -> NDArray[np.float64]:
+        """Map-frame pose of the window's lower-left corner (m, m, 0)."""
+        return np.array([self.col0 * self.resolution, self.row0 * self.resolution, 0.0])
+
+    def cell_of(self, xy: ArrayLike) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+        """Global cell indices (column, row from the bottom) of map-frame points ``[..., 2]`` (m)."""
+        p = np.floor(np.asarray(xy, dtype=np.float64) / self.resolution).astype(np.intp)
+        return p[..., 0], p[..., 1]
+
+    def ensure(self, xy: ArrayLike) -> None:
+        """Grow the window (keeping every cell's world position) so it holds every point ``[N, 2]`` (m)."""
+        cols, rows = self.cell_of(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
+        if cols.size == 0:
+            return
+        height, width = self.visits.shape
+        lo_c, hi_c, lo_r, hi_r = int(cols.min()), int(cols.max()), int(rows.min()), int(rows.max())
+        if height and width and lo_c >= self.col0 and hi_c < self.col0 + width and lo_r >= self.row0 and hi_r < self.row0 + height:
+            return
+        if height and width:
+            lo_c, hi_c = min(lo_c, self.col0), max(hi_c, self.col0 + width - 1)
+            lo_r, hi_r = min(lo_r, self.row0), max(hi_r, self.row0 + height - 1)
+        new_c0, new_r0 = lo_c - self.chunk, lo_r - self.chunk
+        shape = (hi_r + self.chunk + 1 - new_r0, hi_c + self.chunk + 1 - new_c0)
+        hits, visits = np.zeros(shape, np.int32), np.zeros(shape, np.int32)
+        r, c = self.row0 - new_r0, self.col0 - new_c0
+        hits[r:r + height, c:c + width] = self.hits
+        visits[r:r + height, c:c + width] = self.visits
+        self.hits, self.visits, self.col0, self.row0 = hits, visits, new_c0, new_r0
+
+    def integrate(self, laser_pose: ArrayLike, ranges: ArrayLike, angles: ArrayLike, *, range_min: float,
+                  range_max: float, max_urange: float) -> None:
+        """Trace one scan from ``laser_pose`` (map frame, ``[3]``) into the counts (see the module)."""
+        endpoints, hit = beam_endpoints(laser_pose, ranges, angles, range_min=range_min, range_max=range_max,
+                                        max_urange=max_urange)
+        origin = np.asarray(laser_pose, dtype=np.float64)[:2]
+        self.ensure(np.vstack([origin[None, :], endpoints]))
+        scale = 1.0 / self.resolution
+        ou, ov = origin[0] * scale - self.col0, origin[1] * scale - self.row0
+        eu = np.ascontiguousarray(endpoints[:, 0] * scale - self.col0)
+        ev = np.ascontiguousarray(endpoints[:, 1] * scale - self.row0)
+        _integrate_scan(self.hits, self.visits, float(ou), float(ov), eu, ev, np.ascontiguousarray(hit))
+
+    def integrate_frame(self, base_pose: ArrayLike, ranges: ArrayLike, laser: dict[str, Any], *,
+                        max_urange: float | None = None) -> None:
+        """Trace a scan taken with the robot base at ``base_pose`` (map frame) by a laser of geometry ``laser``.
+
+        ``max_urange`` defaults to the laser's ``range_max``.
+        """
+        r = np.asarray(ranges)
+        laser_pose = compose1(np.asarray(base_pose, dtype=np.float64), np.asarray(laser.get("mount", (0.0, 0.0, 0.0)), dtype=np.float64))
+        range_max = float(laser["range_max"])
+        self.integrate(laser_pose, r, beam_angles(laser, r.shape[0]), range_min=float(laser.get("range_min", 0.0)),
+                       range_max=range_max, max_urange=range_max if max_urange is None else min(float(max_urange), range_max))
+
+    def occupancy(self, occ_thresh: float = 0.25) -> OccupancyGrid:
+        """The trinary map (:func:`classify`), flipped to row 0 at the top, with the window's origin."""
+        grid = classify(self.hits, self.visits, occ_thresh)[::-1]
+        return OccupancyGrid(grid=np.ascontiguousarray(grid), resolution=self.resolution, origin=self.origin)

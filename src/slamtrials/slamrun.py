@@ -1,0 +1,213 @@
+"""Running a SLAM algorithm over a recorded run: the library behind ``slamtrials slam``.
+
+:func:`load_recording` reads a run folder, a CARMEN log or a ROS bag as a
+:class:`~slamtrials.record.RunRecord`; :func:`run_slam` feeds its frames to an algorithm of the
+registry (:mod:`slamtrials.slam`) and times every call; :func:`write_slam_outputs` writes the results:
+
+``trajectory.tum``
+    the estimate, one pose per frame (TUM: ``t x y z qx qy qz qw``, map frame).
+``trajectory.clf``
+    a CARMEN log of the run whose FIRST pose triple is the SLAM estimate and SECOND the recorded
+    odometry (ROBOTLASER1 lines), as SLAM programs of the Freiburg benchmark write their corrected logs;
+    ``slamtrials evaluate --estimate trajectory.clf --relations ...`` evaluates it.
+``map.yaml``, ``map.pgm``, ``map.png``
+    the final map in ROS map_server form and as a picture.
+``timing.csv``
+    ``frame,t,seconds``: wall-clock seconds of each ``process`` call.
+``slam.json``
+    algorithm, preset, resolved config, seed, input, totals; written last, so it marks complete outputs.
+
+This module composes io and slam, like the CLI does; it does not print.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from slamtrials.atomicfile import atomic_write_text
+from slamtrials.errors import ConfigError, FormatError
+from slamtrials.record import Frame, RunRecord, Trajectory
+from slamtrials.slam import OccupancyGrid, get_algorithm, resolve_config
+
+__all__ = ["SlamResult", "run_slam", "write_slam_outputs", "load_recording", "OUTPUT_FILES", "SLAM_FILE"]
+
+SLAM_FILE = "slam.json"
+#: Files :func:`write_slam_outputs` writes, in order (``slam.json`` last).
+OUTPUT_FILES = ("trajectory.tum", "trajectory.clf", "map.yaml", "map.pgm", "map.png", "timing.csv", SLAM_FILE)
+
+
+@dataclass(frozen=True, eq=False)
+class SlamResult:
+    """What one SLAM run over a recording produced.
+
+    Attributes
+    ----------
+    algorithm:
+        Registry name.
+    preset:
+        Preset applied, or None.
+    config:
+        The resolved configuration (``model_dump`` of the algorithm's Config).
+    seed:
+        Seed of the algorithm's random stream.
+    trajectory:
+        The algorithm's :meth:`trajectory` after the last frame (map frame).
+    occupancy:
+        The final map.
+    timing:
+        float64 ``[T]`` wall-clock seconds of each ``process`` call.
+    updates:
+        The algorithm's update count after the last frame.
+    record:
+        The recording that was processed.
+    source:
+        Where the recording came from (for ``slam.json``).
+    """
+
+    algorithm: str
+    preset: str | None
+    config: dict[str, Any]
+    seed: int
+    trajectory: Trajectory
+    occupancy: OccupancyGrid
+    timing: NDArray[np.float64]
+    updates: int
+    record: RunRecord
+    source: str = ""
+
+
+def run_slam(record: RunRecord, algorithm_name: str, *, preset: str | None = None, overrides: dict[str, Any] | None = None,
+             seed: int = 0, on_frame: Callable[[int, int], None] | None = None, source: str = "") -> SlamResult:
+    """Process every frame of ``record`` with algorithm ``algorithm_name``.
+
+    Parameters
+    ----------
+    record:
+        The recording.
+    algorithm_name:
+        Registry or entry-point name.
+    preset, overrides:
+        Configuration (see :func:`slamtrials.slam.resolve_config`).
+    seed:
+        Seed of the ``numpy.random.Generator`` handed to ``reset``.
+    on_frame:
+        Called as ``on_frame(index, total)`` after each frame (for progress bars).
+    source:
+        Where the record came from, kept for ``slam.json``.
+
+    Raises
+    ------
+    ConfigError
+        Unknown algorithm, preset or parameter, a bad value, a negative seed or an empty record.
+    """
+    if seed < 0:
+        raise ConfigError(f"seed must be a non-negative integer, got {seed}")
+    if len(record) == 0:
+        raise ConfigError("the recording has no frames")
+    cls = get_algorithm(algorithm_name)
+    config = resolve_config(cls, preset=preset, overrides=overrides)
+    algorithm = cls(config, dict(record.laser))
+    algorithm.reset(np.random.default_rng(seed))
+    total = len(record)
+    timing = np.empty(total, dtype=np.float64)
+    for k in range(total):
+        frame = Frame(t=float(record.t[k]), ranges=record.scans[k], odometry=record.odometry[k], truth=record.truth[k],
+                      stalled=bool(record.stalled[k]))
+        started = time.perf_counter()
+        algorithm.process(frame)
+        timing[k] = time.perf_counter() - started
+        if on_frame is not None:
+            on_frame(k, total)
+    return SlamResult(algorithm=algorithm_name, preset=preset, config=config.model_dump(mode="json"), seed=seed,
+                      trajectory=algorithm.trajectory(), occupancy=algorithm.occupancy(), timing=timing,
+                      updates=int(algorithm.updates), record=record, source=source)
+
+
+def _estimate_per_frame(result: SlamResult) -> NDArray[np.float64]:
+    """The estimate at each frame of the record (the trajectory must hold one pose per frame)."""
+    trajectory, record = result.trajectory, result.record
+    if len(trajectory) != len(record) or not np.array_equal(trajectory.t, record.t):
+        raise ConfigError(f"SLAM algorithm {result.algorithm!r} returned {len(trajectory)} poses for {len(record)} frames; "
+                          "trajectory() must hold one pose per processed frame")
+    return trajectory.poses
+
+
+def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bool = False) -> list[Path]:
+    """Write :data:`OUTPUT_FILES` into ``out_dir`` (created if needed); return the paths written.
+
+    Raises
+    ------
+    ConfigError
+        ``out_dir`` already holds SLAM outputs (``slam.json``) and ``overwrite`` is False.
+    """
+    from slamtrials.io.carmen import carmen_from_run, write_carmen
+    from slamtrials.io.mapfile import write_map, write_map_png
+    from slamtrials.io.tum import write_tum
+
+    out = Path(out_dir)
+    if (out / SLAM_FILE).exists() and not overwrite:
+        raise ConfigError(f"{out}: already holds SLAM outputs; choose another --out or pass --overwrite")
+    out.mkdir(parents=True, exist_ok=True)
+    estimate = _estimate_per_frame(result)
+    written = [write_tum(out / "trajectory.tum", result.trajectory)]
+    as_run = replace(result.record, truth=estimate, estimate=estimate)  # first CARMEN triple = the estimate
+    written.append(write_carmen(out / "trajectory.clf", carmen_from_run(as_run)))
+    grid = result.occupancy
+    written.append(write_map(out / "map.yaml", grid.grid, grid.resolution, grid.origin))
+    written.append(out / "map.pgm")
+    written.append(write_map_png(out / "map.png", grid.grid))
+    rows = "".join(f"{k},{t!r},{s!r}\n" for k, (t, s) in enumerate(zip(result.record.t.tolist(), result.timing.tolist())))
+    written.append(atomic_write_text(out / "timing.csv", "frame,t,seconds\n" + rows))
+    total = float(result.timing.sum())
+    summary = {
+        "algorithm": result.algorithm,
+        "preset": result.preset,
+        "config": result.config,
+        "seed": result.seed,
+        "input": result.source,
+        "frames": len(result.record),
+        "updates": result.updates,
+        "seconds_total": total,
+        "ms_per_frame_mean": 1000.0 * total / max(len(result.record), 1),
+        "ms_per_frame_max": 1000.0 * float(result.timing.max()) if len(result.timing) else math.nan,
+        "map": {"shape": list(grid.grid.shape), "resolution": grid.resolution, "origin": [float(v) for v in grid.origin]},
+        "trajectory_clf": "first pose triple = SLAM estimate, second = recorded odometry",
+    }
+    atomic_write_text(out / SLAM_FILE, json.dumps(summary, indent=2) + "\n")
+    written.append(out / SLAM_FILE)
+    return [Path(p) for p in written]
+
+
+def load_recording(path: str | Path) -> RunRecord:
+    """Read a run folder, a CARMEN log (``.clf``, ``.log``, ``.carmen``, optionally ``.gz``) or a ROS bag.
+
+    A bag without the ground-truth topic is read without ground truth (NaN), which SLAM does not need.
+
+    Raises
+    ------
+    FormatError
+        The path does not exist or the file does not parse.
+    """
+    from slamtrials.io.runfolder import RUN_FILE, read_run
+    from slamtrials.io.transfer import detect_recording_format, read_carmen_run
+
+    path = Path(path)
+    if not path.exists():
+        raise FormatError(path, "no such file or folder")
+    if path.is_dir() and (path / RUN_FILE).exists():
+        return read_run(path)
+    if detect_recording_format(path) == "carmen":
+        return read_carmen_run(path)
+    from slamtrials.io.rosbag import TRUTH_TOPIC, bag_topics, run_from_bag
+
+    truth = TRUTH_TOPIC if TRUTH_TOPIC in bag_topics(path) else None
+    return run_from_bag(path, truth_topic=truth)

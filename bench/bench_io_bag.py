@@ -25,6 +25,8 @@ import numpy as np
 from slamtrials.io.rosbag import run_from_bag, write_rosbag1, write_rosbag2
 from slamtrials.record import RunRecord
 
+from benchutil import cpu_model
+
 FRAMES = 18_000  # 30 minutes at 10 Hz
 BEAMS = 541  # 270 deg at 0.5 deg, the paper's laser
 REPEATS = 2
@@ -62,17 +64,6 @@ def best_of(repeats: int, action) -> tuple[float, object]:
         result = action()
         best = min(best, time.perf_counter() - started)
     return best, result
-
-
-def cpu_model() -> str:
-    try:
-        with open("/proc/cpuinfo") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
 
 
 def main() -> None:

@@ -23,7 +23,6 @@ import os
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 import math  # noqa: E402
-import platform  # noqa: E402
 import time  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -32,6 +31,8 @@ from slamtrials.sim import SimConfig, Simulator  # noqa: E402
 from slamtrials.sim.raycast import LaserModel, cast_scan, cast_scan_dda  # noqa: E402
 from slamtrials.sim.waypoints import waypoint_command  # noqa: E402
 from slamtrials.worlds.world import World, cell_to_world, world_to_map  # noqa: E402
+
+from benchutil import cpu_model
 
 RES = 0.05
 SIZE = 2000  # cells: 100 m
@@ -140,17 +141,6 @@ def time_steps(world: World, n_steps: int, seed: int = 0) -> tuple[float, int]:
                 goal_idx += 1  # give up on that goal
         best = min(best, time.perf_counter() - start)
     return n_steps / best, stalls
-
-
-def cpu_model() -> str:
-    try:
-        with open("/proc/cpuinfo") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
 
 
 def main() -> None:

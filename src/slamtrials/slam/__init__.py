@@ -1,4 +1,5 @@
-"""SLAM algorithms behind one protocol: the registry, the occupancy-grid builder and the odometry baseline.
+"""SLAM algorithms behind one protocol: the registry, the occupancy-grid builder, the odometry
+baseline and ``gmapping``.
 
 ``make_algorithm("odometry", record.laser)`` builds an algorithm; feed it frames with ``process`` and read
 ``trajectory()`` and ``occupancy()``. Third-party algorithms register with :func:`register_algorithm` or
@@ -22,6 +23,7 @@ from slamtrials.slam.base import (
     resolve_config,
 )
 from slamtrials.slam.gridmap import GridMap
+from slamtrials.slam.gmapping import GMapping, GMappingConfig
 from slamtrials.slam.odometry import OdometryConfig, OdometrySlam
 
 __all__ = [
@@ -38,6 +40,8 @@ __all__ = [
     "register_algorithm",
     "resolve_config",
     "GridMap",
+    "GMapping",
+    "GMappingConfig",
     "OdometryConfig",
     "OdometrySlam",
 ]

@@ -9,7 +9,9 @@ A SLAM algorithm is a class with
   of :class:`~slamtrials.record.RunRecord` (``angle_min``, ``angle_increment``, ``range_min``,
   ``range_max``, ``mount``);
 * ``reset(rng)``, ``process(frame) -> pose``, ``occupancy()``, ``trajectory()`` and an ``updates``
-  counter (see :class:`SlamAlgorithm`).
+  counter (see :class:`SlamAlgorithm`);
+* optionally ``finish()``, called once after the last frame of a recording or trial: an algorithm that
+  publishes its map at intervals (like GMapping) brings ``occupancy()`` up to date there.
 
 Built-in algorithms are listed in :data:`ALGORITHMS`; :func:`register_algorithm` adds one at run time,
 and third-party packages publish theirs under the entry-point group ``slamtrials.slam``

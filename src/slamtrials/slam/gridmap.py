@@ -48,8 +48,8 @@ DEFAULT_CHUNK = 64
 
 
 @njit(cache=True, nogil=True)
-def _integrate_scan(hits, visits, ou, ov, eu, ev, hit):  # pragma: no cover - compiled
-    """Add one scan's visits and hits.
+def _integrate_scan(hits, visits, ou, ov, eu, ev, hit, weight):  # pragma: no cover - compiled
+    """Add one scan's visits and hits, each counted ``weight`` times (-1 takes a scan back out).
 
     ``(ou, ov)`` is the laser in continuous window coordinates (cells: u right, v up, from the window's
     lower-left corner); ``eu, ev`` float64 ``[B]`` the beam endpoints (already cut); ``hit`` bool ``[B]``
@@ -82,7 +82,7 @@ def _integrate_scan(hits, visits, ou, ov, eu, ev, hit):  # pragma: no cover - co
         steps = abs(jx - ix) + abs(jy - iy)
         for _ in range(steps):
             if 0 <= iy < height and 0 <= ix < width:
-                visits[iy, ix] += 1
+                visits[iy, ix] += weight
             if ix == jx or (iy != jy and t_y <= t_x):
                 iy += step_y
                 t_y += delta_y
@@ -90,8 +90,8 @@ def _integrate_scan(hits, visits, ou, ov, eu, ev, hit):  # pragma: no cover - co
                 ix += step_x
                 t_x += delta_x
         if hit[b] and 0 <= jy < height and 0 <= jx < width:
-            visits[jy, jx] += 1
-            hits[jy, jx] += 1
+            visits[jy, jx] += weight
+            hits[jy, jx] += weight
 
 
 def beam_angles(laser: dict[str, Any], beams: int) -> NDArray[np.float64]:
@@ -201,8 +201,11 @@ class GridMap:
         self.hits, self.visits, self.col0, self.row0 = hits, visits, new_c0, new_r0
 
     def integrate(self, laser_pose: ArrayLike, ranges: ArrayLike, angles: ArrayLike, *, range_min: float,
-                  range_max: float, max_urange: float) -> None:
-        """Trace one scan from ``laser_pose`` (map frame, ``[3]``) into the counts (see the module)."""
+                  range_max: float, max_urange: float, weight: int = 1) -> None:
+        """Trace one scan from ``laser_pose`` (map frame, ``[3]``) into the counts (see the module).
+
+        ``weight`` -1 removes a scan integrated before from the same pose (counts are exact integers).
+        """
         endpoints, hit = beam_endpoints(laser_pose, ranges, angles, range_min=range_min, range_max=range_max,
                                         max_urange=max_urange)
         origin = np.asarray(laser_pose, dtype=np.float64)[:2]
@@ -211,7 +214,7 @@ class GridMap:
         ou, ov = origin[0] * scale - self.col0, origin[1] * scale - self.row0
         eu = np.ascontiguousarray(endpoints[:, 0] * scale - self.col0)
         ev = np.ascontiguousarray(endpoints[:, 1] * scale - self.row0)
-        _integrate_scan(self.hits, self.visits, float(ou), float(ov), eu, ev, np.ascontiguousarray(hit))
+        _integrate_scan(self.hits, self.visits, float(ou), float(ov), eu, ev, np.ascontiguousarray(hit), int(weight))
 
     def integrate_frame(self, base_pose: ArrayLike, ranges: ArrayLike, laser: dict[str, Any], *,
                         max_urange: float | None = None) -> None:

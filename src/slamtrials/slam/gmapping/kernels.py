@@ -1,0 +1,315 @@
+"""Numba kernels of the particle maps: cell lookup, scan-matcher score and likelihood, hill climbing,
+endpoint registration with copy-on-write tiles.
+
+Map layout (see :mod:`slamtrials.slam.gmapping.tilemap`): a pool of tiles of ``TILE x TILE`` cells;
+``count[k, i, j]`` endpoints in cell (row ``i`` from the bottom, column ``j``) of tile ``k``, and
+``mean[k, i, j]`` their mean's offset (m, float32 x and y) from the cell's lower-left corner, so the
+mean is ``(column * res + mean[..., 0], row * res + mean[..., 1])`` in the map frame; a cell without
+endpoints holds :data:`EMPTY` as its offset, so the window search needs no branch per cell. A particle's
+``directory[tile row, tile column]`` holds its tile ids (-1: no tile); directory cell (0, 0) is global
+tile (``tile_row0``, ``tile_col0``). Global cell ``(c, r)`` covers ``[c res, (c + 1) res) x
+[r res, (r + 1) res)``.
+
+The score and likelihood follow spec/gmapping.md, section 3.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+__all__ = ["TILE_SHIFT", "TILE", "score_pose", "match_particles", "register_endpoints"]
+
+TILE_SHIFT = 4
+#: Cells per tile side.
+TILE = 1 << TILE_SHIFT
+_MASK = TILE - 1
+#: Mean offset stored in cells that hold no endpoint: far enough that no distance to it can win.
+EMPTY = np.float32(1.0e18)
+_EMPTY_D2 = 1.0e36
+_FOUND_D2 = 1.0e30
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _directory_tile(directory, rows, cols, drow, dcol):  # pragma: no cover - compiled
+    """Tile id at directory-relative cell (dcol, drow), or -1 outside the directory or without a tile."""
+    if drow < 0 or dcol < 0:
+        return -1
+    tr = drow >> TILE_SHIFT
+    tc = dcol >> TILE_SHIFT
+    if tr >= rows or tc >= cols:
+        return -1
+    return directory[np.uint64(tr), np.uint64(tc)]
+
+
+@njit(cache=True, nogil=True)
+def score_pose(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, lfx, lfy, kernel, sigma, lsigma,
+               free_test, with_likelihood):  # pragma: no cover - compiled
+    """Score (and log-likelihood) of a scan from laser pose (x, y, theta) in one particle's map.
+
+    Parameters
+    ----------
+    directory:
+        int32 ``[TR, TC]`` the particle's tile directory.
+    mean:
+        float32 ``[K * TILE * TILE * 2]``: the pool's mean offsets, flattened (module docstring).
+    lx, ly:
+        float64 ``[K]``: the used beams' endpoints in the laser frame (m).
+    lfx, lfy:
+        The free points one diagonal cell back along each beam (read only with ``free_test``).
+
+    Returns ``(score, log_likelihood)``; the likelihood is 0 unless ``with_likelihood``. Indexes are
+    unsigned so that numba does no negative-index wrap-around per access (this loop is the hot spot).
+    """
+    inv_res = 1.0 / res
+    c = math.cos(theta)
+    s = math.sin(theta)
+    score = 0.0
+    likelihood = 0.0
+    no_hit = -0.5 / lsigma
+    rows, cols = directory.shape
+    base_c = tile_col0 << TILE_SHIFT
+    base_r = tile_row0 << TILE_SHIFT
+    row_stride = 2 * TILE
+    tile_stride = 2 * TILE * TILE
+    for b in range(lx.shape[0]):
+        ex = x + c * lx[b] - s * ly[b]
+        ey = y + s * lx[b] + c * ly[b]
+        gc = int(math.floor(ex * inv_res))
+        gr = int(math.floor(ey * inv_res))
+        ox = ex - gc * res
+        oy = ey - gr * res
+        dcol = gc - base_c
+        drow = gr - base_r
+        lc = dcol & _MASK
+        lr = drow & _MASK
+        best = _EMPTY_D2
+        if not free_test and kernel <= lc < TILE - kernel and kernel <= lr < TILE - kernel:
+            # the whole window lies in one tile: one directory lookup, no branch per cell
+            tile = _directory_tile(directory, rows, cols, drow, dcol)
+            if tile >= 0 and kernel == 1:
+                # the default window, with constant bounds so that the compiler unrolls it (2x faster)
+                first = tile * tile_stride + (lr - 1) * row_stride + (lc - 1) * 2
+                for dr in range(3):
+                    uy0 = oy - (dr - 1) * res
+                    k = np.uint64(first + dr * row_stride)
+                    for dc in range(3):
+                        ux = ox - (dc - 1) * res - mean[k + np.uint64(2 * dc)]
+                        uy = uy0 - mean[k + np.uint64(2 * dc + 1)]
+                        best = min(best, ux * ux + uy * uy)
+            elif tile >= 0:
+                first = tile * tile_stride + (lr - kernel) * row_stride + (lc - kernel) * 2
+                for dr in range(-kernel, kernel + 1):
+                    uy0 = oy - dr * res
+                    k = np.uint64(first + (dr + kernel) * row_stride)
+                    for dc in range(-kernel, kernel + 1):
+                        ux = ox - dc * res - mean[k]
+                        uy = uy0 - mean[k + np.uint64(1)]
+                        best = min(best, ux * ux + uy * uy)
+                        k += np.uint64(2)
+        else:
+            fdcol = 0
+            fdrow = 0
+            if free_test:
+                fdcol = int(math.floor((x + c * lfx[b] - s * lfy[b]) * inv_res)) - base_c
+                fdrow = int(math.floor((y + s * lfx[b] + c * lfy[b]) * inv_res)) - base_r
+            for dr in range(-kernel, kernel + 1):
+                uy0 = oy - dr * res
+                for dc in range(-kernel, kernel + 1):
+                    tile = _directory_tile(directory, rows, cols, drow + dr, dcol + dc)
+                    if tile < 0:
+                        continue
+                    k = np.uint64(tile * tile_stride + ((drow + dr) & _MASK) * row_stride + ((dcol + dc) & _MASK) * 2)
+                    mx = mean[k]
+                    if mx >= EMPTY:
+                        continue
+                    if free_test:
+                        free_tile = _directory_tile(directory, rows, cols, fdrow + dr, fdcol + dc)
+                        if free_tile >= 0:
+                            f = np.uint64(free_tile * tile_stride + ((fdrow + dr) & _MASK) * row_stride
+                                          + ((fdcol + dc) & _MASK) * 2)
+                            if mean[f] < EMPTY:
+                                continue
+                    ux = ox - dc * res - mx
+                    uy = uy0 - mean[k + np.uint64(1)]
+                    best = min(best, ux * ux + uy * uy)
+        if best < _FOUND_D2:
+            score += math.exp(-best / sigma)
+            if with_likelihood:
+                likelihood -= best / lsigma
+        elif with_likelihood:
+            likelihood += no_hit
+    return score, likelihood
+
+
+_OPPOSITE = (1, 0, 3, 2, 5, 4)
+
+
+@njit(cache=True, nogil=True)
+def _hill_climb(directory, mean, tile_col0, tile_row0, res, pose, lx, ly, lfx, lfy, kernel, sigma, lsigma, free_test,
+                lstep, astep, iterations):  # pragma: no cover - compiled
+    """GMapping's hill climbing from ``pose`` (spec/gmapping.md, section 3); returns (x, y, theta, score).
+
+    One saving over the original: right after a move, the move straight back (same step) is not tried;
+    it returns to the pose just left, whose score is lower than the current one, so it could not win.
+    """
+    cx, cy, ct = pose[0], pose[1], pose[2]
+    current, _ = score_pose(directory, mean, tile_col0, tile_row0, res, cx, cy, ct, lx, ly, lfx, lfy, kernel, sigma,
+                            lsigma, free_test, False)
+    ld = lstep
+    ad = astep
+    refinement = 0
+    best = -1.0
+    came_by = -1  # the move that led to the current pose at the current step size, or -1
+    for _ in range(100_000):  # a safety bound; the loop ends long before
+        if best >= current:
+            refinement += 1
+            ld *= 0.5
+            ad *= 0.5
+            came_by = -1
+        best = current
+        bx, by, bt = cx, cy, ct
+        accepted = -1
+        for move in range(6):
+            if came_by >= 0 and move == _OPPOSITE[came_by]:
+                continue
+            px, py, pt = cx, cy, ct
+            if move == 0:
+                px += ld
+            elif move == 1:
+                px -= ld
+            elif move == 2:
+                py -= ld
+            elif move == 3:
+                py += ld
+            elif move == 4:
+                pt += ad
+            else:
+                pt -= ad
+            local, _ = score_pose(directory, mean, tile_col0, tile_row0, res, px, py, pt, lx, ly, lfx, lfy, kernel,
+                                  sigma, lsigma, free_test, False)
+            if local > current:
+                current = local
+                bx, by, bt = px, py, pt
+                accepted = move
+        cx, cy, ct = bx, by, bt
+        came_by = accepted
+        if not (current > best or refinement < iterations):
+            break
+    return cx, cy, ct, best
+
+
+@njit(cache=True, nogil=True)
+def match_particles(directories, mean, tile_col0, tile_row0, res, poses, lx, ly, lfx, lfy, kernel, sigma, lsigma,
+                    free_test, lstep, astep, iterations, minimum_score):  # pragma: no cover - compiled
+    """Scan-match every particle and weigh it (spec/gmapping.md, section 3).
+
+    Parameters
+    ----------
+    directories:
+        int32 ``[N, TR, TC]`` tile directories.
+    mean:
+        float32 ``[K * TILE * TILE * 2]`` the pool's mean offsets, flattened.
+    poses:
+        float64 ``[N, 3]`` laser poses after the motion model (map frame).
+
+    Returns
+    -------
+    matched:
+        float64 ``[N, 3]``: the matched pose where the score exceeds ``minimum_score``, else the input.
+    scores:
+        float64 ``[N]`` best match scores.
+    likelihoods:
+        float64 ``[N]`` log-likelihoods of the scan at the returned poses.
+    """
+    n = poses.shape[0]
+    matched = poses.copy()
+    scores = np.zeros(n)
+    likelihoods = np.zeros(n)
+    for p in range(n):
+        directory = directories[p]
+        x, y, t, best = _hill_climb(directory, mean, tile_col0, tile_row0, res, poses[p], lx, ly, lfx, lfy, kernel,
+                                    sigma, lsigma, free_test, lstep, astep, iterations)
+        scores[p] = best
+        if best > minimum_score:
+            matched[p, 0] = x
+            matched[p, 1] = y
+            matched[p, 2] = math.atan2(math.sin(t), math.cos(t))
+        _, likelihoods[p] = score_pose(directory, mean, tile_col0, tile_row0, res, matched[p, 0], matched[p, 1],
+                                       matched[p, 2], lx, ly, lfx, lfy, kernel, sigma, lsigma, free_test, True)
+    return matched, scores, likelihoods
+
+
+@njit(cache=True, nogil=True)
+def register_endpoints(directories, count, mean, refs, free_stack, state, tile_col0, tile_row0, res, ex, ey,
+                       start):  # pragma: no cover - compiled
+    """Add each particle's scan endpoints to its map, copying shared tiles before writing (copy-on-write).
+
+    Parameters
+    ----------
+    directories:
+        int32 ``[N, TR, TC]``; must already cover every endpoint.
+    count, mean:
+        The pool (module docstring); updated.
+    refs:
+        int32 ``[K]`` number of directory entries pointing at each tile.
+    free_stack, state:
+        int32 ``[K]`` ids of released tiles and int64 ``[2]`` = (number of them on the stack, tiles ever
+        allocated); both updated.
+    ex, ey:
+        float64 ``[N, B]`` endpoints (map frame, m) of particle ``p`` in row ``p``.
+    start:
+        First particle to do.
+
+    Returns
+    -------
+    The index of the first particle NOT done: ``N`` when all are done, less when the pool ran short of
+    tiles (grow it and call again from there).
+    """
+    n, beams = ex.shape
+    capacity = count.shape[0]
+    inv_res = 1.0 / res
+    for p in range(start, n):
+        if state[0] + (capacity - state[1]) < beams:
+            return p
+        directory = directories[p]
+        for b in range(beams):
+            gc = int(math.floor(ex[p, b] * inv_res))
+            gr = int(math.floor(ey[p, b] * inv_res))
+            lc = gc - (tile_col0 << TILE_SHIFT)
+            lr = gr - (tile_row0 << TILE_SHIFT)
+            tr = lr >> TILE_SHIFT
+            tc = lc >> TILE_SHIFT
+            tile = directory[tr, tc]
+            if tile < 0 or refs[tile] > 1:
+                if state[0] > 0:
+                    state[0] -= 1
+                    fresh = free_stack[state[0]]
+                else:
+                    fresh = state[1]
+                    state[1] += 1
+                if tile < 0:
+                    count[fresh] = 0
+                    mean[fresh] = EMPTY
+                else:
+                    count[fresh] = count[tile]
+                    mean[fresh] = mean[tile]
+                    refs[tile] -= 1
+                refs[fresh] = 1
+                directory[tr, tc] = fresh
+                tile = fresh
+            i = gr & _MASK
+            j = gc & _MASK
+            k = count[tile, i, j] + 1
+            count[tile, i, j] = k
+            ox = ex[p, b] - gc * res
+            oy = ey[p, b] - gr * res
+            if k == 1:
+                mean[tile, i, j, 0] = ox
+                mean[tile, i, j, 1] = oy
+            else:  # running mean
+                mean[tile, i, j, 0] += (ox - mean[tile, i, j, 0]) / k
+                mean[tile, i, j, 1] += (oy - mean[tile, i, j, 1]) / k
+    return n

@@ -1,0 +1,79 @@
+"""The published map: the best particle's path and stored scans traced into a counting grid.
+
+GMapping rebuilds this map from scratch every ``map_update_interval``. Here the grid keeps the scans
+of the path it was last built from; a new path usually shares a long head with the old one (the
+particles' common ancestry), so only the scans after the first differing pose are taken out (counted
+with weight -1, which is exact on integer counts) and put back at their new poses. The result is the
+same grid a rebuild from scratch would give.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from slamtrials.slam.base import OccupancyGrid
+from slamtrials.slam.gridmap import GridMap, beam_angles
+
+__all__ = ["PublishedMap"]
+
+
+class PublishedMap:
+    """An incrementally rebuilt :class:`~slamtrials.slam.gridmap.GridMap` of one path of laser poses.
+
+    Parameters
+    ----------
+    resolution:
+        Cell size (m).
+    laser:
+        Laser geometry dict (``angle_min``, ``angle_increment``, ``range_min``, ``range_max``).
+    max_urange:
+        Beams longer than this are cut there and mark only free cells (m).
+    occ_thresh:
+        Occupied where hits / visits exceeds this.
+    """
+
+    def __init__(self, resolution: float, laser: dict[str, Any], *, max_urange: float, occ_thresh: float):
+        self.grid = GridMap(resolution)
+        self.laser = laser
+        self.max_urange = float(max_urange)
+        self.occ_thresh = float(occ_thresh)
+        self._path = np.zeros((0, 3))
+        self._scans: list[NDArray[np.float32]] = []
+        self._occupancy: OccupancyGrid | None = None
+
+    def _trace(self, pose: NDArray[np.float64], ranges: NDArray[np.float32], weight: int) -> None:
+        self.grid.integrate(pose, ranges, beam_angles(self.laser, ranges.shape[0]),
+                            range_min=float(self.laser.get("range_min", 0.0)), range_max=float(self.laser["range_max"]),
+                            max_urange=self.max_urange, weight=weight)
+
+    def rebuild(self, path: NDArray[np.float64], scans: list[NDArray[np.float32]]) -> int:
+        """Make the grid that of laser poses ``path`` ``[U, 3]`` with ``scans[u]`` taken at ``path[u]``.
+
+        ``scans`` must extend the list given last time (scans are stored once and never change).
+        Returns the number of scans traced or taken out.
+        """
+        old = self._path
+        common = min(len(old), len(path))
+        differs = np.flatnonzero(np.any(old[:common] != path[:common], axis=1))
+        keep = int(differs[0]) if differs.size else common
+        work = 0
+        for u in range(len(old) - 1, keep - 1, -1):
+            self._trace(old[u], self._scans[u], -1)
+            work += 1
+        for u in range(keep, len(path)):
+            self._trace(path[u], scans[u], 1)
+            work += 1
+        self._path = np.array(path, dtype=np.float64)
+        self._scans = scans
+        self._occupancy = self.grid.occupancy(self.occ_thresh)
+        return work
+
+    def occupancy(self) -> OccupancyGrid:
+        """The grid as of the last :meth:`rebuild` (an empty 0 x 0 grid before the first)."""
+        if self._occupancy is None:
+            return OccupancyGrid(grid=np.zeros((0, 0), dtype=np.int8), resolution=self.grid.resolution,
+                                 origin=np.zeros(3))
+        return self._occupancy

@@ -7,13 +7,14 @@ radians; ground truth is in the world frame, odometry in the odometry frame (whi
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Frame", "RunRecord", "Trajectory", "Relations"]
+__all__ = ["Frame", "RunRecord", "Trajectory", "Relations", "OccupancyGrid", "OCCUPIED", "FREE", "UNKNOWN"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -99,6 +100,39 @@ class RunRecord:
             laser=dict(laser),
             metadata=dict(metadata or {}),
         )
+
+
+#: Cell values of :attr:`OccupancyGrid.grid` (those of a ``nav_msgs/OccupancyGrid``).
+OCCUPIED, FREE, UNKNOWN = 100, 0, -1
+
+
+@dataclass(frozen=True, eq=False)
+class OccupancyGrid:
+    """An occupancy-grid map (a SLAM algorithm's), as ROS publishes it.
+
+    Attributes
+    ----------
+    grid:
+        int8 ``[H, W]``: 100 occupied, 0 free, -1 unknown; row 0 is the TOP row (largest y), column 0
+        the left one (smallest x).
+    resolution:
+        Cell size (m).
+    origin:
+        float64 ``[3]``: map-frame pose (x, y, theta) of the lower-left corner of the lower-left cell
+        (row ``H - 1``, column 0), as in ROS.
+    """
+
+    grid: NDArray[np.int8]
+    resolution: float
+    origin: NDArray[np.float64]
+
+    def __post_init__(self) -> None:
+        if self.grid.ndim != 2 or self.grid.dtype != np.int8:
+            raise ValueError(f"OccupancyGrid.grid must be int8 [H, W], got {self.grid.dtype} {self.grid.shape}")
+        if not (math.isfinite(self.resolution) and self.resolution > 0):
+            raise ValueError(f"OccupancyGrid.resolution must be positive metres, got {self.resolution!r}")
+        if np.shape(self.origin) != (3,):
+            raise ValueError(f"OccupancyGrid.origin must be (x, y, theta), got {self.origin!r}")
 
 
 @dataclass(frozen=True, eq=False)

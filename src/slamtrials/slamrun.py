@@ -127,9 +127,6 @@ def run_slam(record: RunRecord, algorithm_name: str, *, preset: str | None = Non
         timing[k] = time.perf_counter() - started
         if on_frame is not None:
             on_frame(k, total)
-    finish = getattr(algorithm, "finish", None)
-    if callable(finish):
-        finish()
     return SlamResult(algorithm=algorithm_name, preset=preset, config=config.model_dump(mode="json"), seed=seed,
                       trajectory=algorithm.trajectory(), occupancy=algorithm.occupancy(), timing=timing,
                       updates=int(algorithm.updates), record=record, source=source)

@@ -9,9 +9,7 @@ A SLAM algorithm is a class with
   of :class:`~slamtrials.record.RunRecord` (``angle_min``, ``angle_increment``, ``range_min``,
   ``range_max``, ``mount``);
 * ``reset(rng)``, ``process(frame) -> pose``, ``occupancy()``, ``trajectory()`` and an ``updates``
-  counter (see :class:`SlamAlgorithm`);
-* optionally ``finish()``, called once after the last frame of a recording or trial: an algorithm that
-  publishes its map at intervals (like GMapping) brings ``occupancy()`` up to date there.
+  counter (see :class:`SlamAlgorithm`).
 
 Built-in algorithms are listed in :data:`ALGORITHMS`; :func:`register_algorithm` adds one at run time,
 and third-party packages publish theirs under the entry-point group ``slamtrials.slam``
@@ -21,8 +19,6 @@ and third-party packages publish theirs under the entry-point group ``slamtrials
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
 from importlib.metadata import entry_points
 from typing import Any, ClassVar, Protocol, runtime_checkable
 
@@ -31,7 +27,7 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ValidationError
 
 from slamtrials.errors import ConfigError
-from slamtrials.record import Frame, Trajectory
+from slamtrials.record import FREE, OCCUPIED, UNKNOWN, Frame, OccupancyGrid, Trajectory
 
 __all__ = [
     "OccupancyGrid",
@@ -50,39 +46,6 @@ __all__ = [
 
 #: Entry-point group under which other packages publish SLAM algorithm classes.
 ENTRY_POINT_GROUP = "slamtrials.slam"
-#: Cell values of :attr:`OccupancyGrid.grid` (those of a ``nav_msgs/OccupancyGrid``).
-OCCUPIED, FREE, UNKNOWN = 100, 0, -1
-
-
-@dataclass(frozen=True, eq=False)
-class OccupancyGrid:
-    """A SLAM algorithm's map, as ROS publishes it.
-
-    Attributes
-    ----------
-    grid:
-        int8 ``[H, W]``: 100 occupied, 0 free, -1 unknown; row 0 is the TOP row (largest y), column 0
-        the left one (smallest x).
-    resolution:
-        Cell size (m).
-    origin:
-        float64 ``[3]``: map-frame pose (x, y, theta) of the lower-left corner of the lower-left cell
-        (row ``H - 1``, column 0), as in ROS.
-    """
-
-    grid: NDArray[np.int8]
-    resolution: float
-    origin: NDArray[np.float64]
-
-    def __post_init__(self) -> None:
-        if self.grid.ndim != 2 or self.grid.dtype != np.int8:
-            raise ValueError(f"OccupancyGrid.grid must be int8 [H, W], got {self.grid.dtype} {self.grid.shape}")
-        if not (math.isfinite(self.resolution) and self.resolution > 0):
-            raise ValueError(f"OccupancyGrid.resolution must be positive metres, got {self.resolution!r}")
-        if np.shape(self.origin) != (3,):
-            raise ValueError(f"OccupancyGrid.origin must be (x, y, theta), got {self.origin!r}")
-
-
 @runtime_checkable
 class SlamAlgorithm(Protocol):
     """What every SLAM algorithm offers (structural: no base class needed).

@@ -47,7 +47,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from slamtrials.geometry import compose, compose1, inverse, ominus, ominus1, wrap_angle1
+from slamtrials.geometry import compose, compose1, inverse, ominus, wrap_angle1
 from slamtrials.record import Frame, Trajectory
 from slamtrials.slam.base import OccupancyGrid, register_algorithm
 from slamtrials.slam.gmapping.config import PRESETS, GMappingConfig
@@ -228,13 +228,9 @@ class GMapping:
     # ------------------------------------------------------------------ results
 
     def occupancy(self) -> OccupancyGrid:
-        """The published map (rebuilt every ``map_update_interval`` seconds of processed readings)."""
+        """The published map: rebuilt on a processed reading more than ``map_update_interval`` seconds
+        after the last rebuild, as slam_gmapping publishes it (so up to that long out of date)."""
         return self.published.occupancy()
-
-    def finish(self) -> None:
-        """Rebuild the published map from the current best particle's path (the final map)."""
-        if len(self.lineage):
-            self.published.rebuild(self.lineage.path(self.best_particle), self._scans)
 
     def trajectory(self) -> Trajectory:
         """The final best particle's path, every reading placed by odometry from the processed one before it."""

@@ -1,0 +1,150 @@
+"""Settings of the frontier explorer and of the paper's termination rule (pydantic models, SI units).
+
+Lengths are metres, angles radians, times seconds (of simulated time). Both models are frozen and
+reject unknown keys; :meth:`ExploreConfig.from_dict` and :meth:`TerminationConfig.from_dict` validate a
+plain dict (e.g. loaded from YAML) and turn a ``pydantic.ValidationError`` into a one-line
+:class:`~slamtrials.errors.ConfigError` that names the field, the value and the problem.
+
+The defaults follow the paper's set-up (spec/simulation.md): a 0.15 m disc robot, 0.7 m/s and
+70 deg/s at most, a 0.1 s control period, goals blacklisted after 30 s without progress, snapshots of
+the map every 120 s (small buildings) or 600 s (large ones), compared by mean square error below 10.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, TypeVar
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from slamtrials.errors import ConfigError
+
+__all__ = ["ExploreConfig", "TerminationConfig"]
+
+_MODEL_CONFIG = ConfigDict(extra="forbid", frozen=True)
+_Model = TypeVar("_Model", bound=BaseModel)
+
+
+def _validate(cls: type[_Model], data: dict[str, Any], what: str) -> _Model:
+    try:
+        return cls.model_validate(data)
+    except ValidationError as exc:
+        problems = []
+        for err in exc.errors():
+            field = ".".join(str(p) for p in err["loc"]) or "<root>"
+            problems.append(f"{field}: {err['msg']} (got {err.get('input')!r})")
+        raise ConfigError(f"{what} config: " + "; ".join(problems)) from None
+
+
+class ExploreConfig(BaseModel):
+    """Frontier exploration: costmap, frontiers, planner, path follower, goal bookkeeping, recovery.
+
+    Costmap (:mod:`slamtrials.explore.costmap`). ``d`` is the distance (m) from a cell's centre to the
+    nearest occupied cell's edge. Cells with ``d < robot_radius + inflation_margin`` are lethal; the
+    others cost ``1 + wall_cost * exp(-(d - robot_radius - inflation_margin) / cost_decay_distance)``
+    per metre travelled, so paths keep to the middle of corridors and doors.
+
+    Unknown cells are not traversable by default (``unknown_traversable=False``): frontier goals are
+    known-free cells, so every goal can be reached through known space, and a frontier that can only
+    be reached through unknown space (a room seen through a gap narrower than the robot, a laser ray
+    leaking out of the building) counts as unreachable at once instead of costing a 30 s timeout.
+
+    Recovery: the robot is stuck when, over ``stuck_time``, it moved less than ``stuck_ratio`` of what
+    it was commanded to move (the simulator stops the robot on a collision), or when the laser kept it
+    from moving forward for ``blocked_time``. It then backs off ``backoff_distance`` and turns
+    ``recovery_turn`` towards the more open side, and replans.
+    """
+
+    model_config = _MODEL_CONFIG
+
+    # --- robot and costmap ---------------------------------------------------------------------------
+    robot_radius: float = Field(0.15, gt=0.0, le=5.0, description="footprint disc radius (m)")
+    inflation_margin: float = Field(0.05, ge=0.0, le=5.0, description="lethal margin added to the radius (m)")
+    wall_cost: float = Field(10.0, ge=0.0, le=100.0, description="extra cost factor at the edge of the lethal zone")
+    cost_decay_distance: float = Field(0.25, gt=0.0, le=10.0, description="decay length of the wall cost (m)")
+    unknown_traversable: bool = Field(False, description="let paths cross unknown cells (at unknown_cost)")
+    unknown_cost: float = Field(5.0, ge=1.0, le=20.0, description="cost factor of an unknown cell when traversable")
+    escape_radius: float = Field(0.6, ge=0.0, le=10.0, description="lethal/unknown cells within this distance of the robot may be crossed to get out (m)")
+    escape_cost: float = Field(50.0, ge=1.0, le=100.0, description="cost factor of crossing a lethal cell while escaping")
+    # --- frontiers -----------------------------------------------------------------------------------
+    min_frontier_length: float = Field(0.3, ge=0.0, le=100.0, description="smallest frontier kept: cells x resolution (m)")
+    min_unknown_area: float = Field(0.2, ge=0.0, le=1000.0, description="enclosed unknown pockets smaller than this make no frontier (m^2)")
+    # --- motion limits and follower ------------------------------------------------------------------
+    max_linear_speed: float = Field(0.7, gt=0.0, le=10.0, description="largest forward speed (m/s)")
+    max_angular_speed: float = Field(math.radians(70.0), gt=0.0, le=4.0 * math.pi, description="largest turn rate (rad/s)")
+    max_linear_accel: float = Field(0.5, gt=0.0, le=100.0, description="largest linear acceleration (m/s^2)")
+    max_angular_accel: float = Field(math.radians(100.0), gt=0.0, le=100.0, description="largest angular acceleration (rad/s^2)")
+    control_period: float = Field(0.1, gt=0.0, le=1.0, description="time between commands (s)")
+    lookahead_distance: float = Field(0.6, gt=0.0, le=10.0, description="pure-pursuit look-ahead (m)")
+    rotate_in_place_angle: float = Field(math.radians(50.0), gt=0.0, le=math.pi, description="heading error above which the robot turns in place (rad)")
+    obstacle_margin: float = Field(0.03, ge=0.0, le=1.0, description="clearance added to the radius when checking the scan ahead (m)")
+    stop_distance: float = Field(0.05, ge=0.0, le=2.0, description="distance kept from obstacles seen in the scan (m)")
+    # --- goals ---------------------------------------------------------------------------------------
+    replan_period: float = Field(3.0, gt=0.0, le=600.0, description="replan at least this often (s)")
+    min_replan_interval: float = Field(1.0, ge=0.0, le=600.0, description="smallest time between event-driven replans (s)")
+    goal_tolerance: float = Field(0.3, gt=0.0, le=10.0, description="a goal is reached within this distance (m)")
+    goal_timeout: float = Field(30.0, gt=0.0, le=3600.0, description="blacklist a goal after this long without progress (s)")
+    progress_distance: float = Field(0.25, gt=0.0, le=10.0, description="getting this much closer to the goal is progress (m)")
+    blacklist_radius: float = Field(0.5, ge=0.0, le=20.0, description="frontier cells this close to a failed or reached goal are skipped (m)")
+    goal_hysteresis: float = Field(0.75, gt=0.0, le=1.0, description="switch goal only if the new one costs less than this fraction of the current one")
+    blacklist_resets: int = Field(1, ge=0, le=100, description="times the failed-goal blacklist is cleared when nothing else is left")
+    initial_spin: bool = Field(True, description="turn a full circle at the start, to see behind the laser's blind sector")
+    # --- stuck detection and recovery ----------------------------------------------------------------
+    stuck_time: float = Field(3.0, gt=0.0, le=600.0, description="window of the stuck test (s)")
+    stuck_ratio: float = Field(0.3, gt=0.0, lt=1.0, description="stuck when moving less than this fraction of the commanded distance")
+    stuck_min_command: float = Field(0.3, gt=0.0, le=100.0, description="commanded distance over the window needed before the stuck test applies (m)")
+    blocked_time: float = Field(2.0, gt=0.0, le=600.0, description="recover after being held still by the scan this long (s)")
+    backoff_distance: float = Field(0.25, ge=0.0, le=5.0, description="distance backed off in a recovery (m)")
+    backoff_speed: float = Field(0.15, gt=0.0, le=10.0, description="backing speed (m/s)")
+    recovery_turn: float = Field(math.radians(90.0), ge=0.0, le=2.0 * math.pi, description="turn in place after backing off (rad)")
+    max_recoveries_per_goal: int = Field(2, ge=1, le=100, description="blacklist a goal after this many recoveries on the way")
+
+    @model_validator(mode="after")
+    def _consistent(self) -> "ExploreConfig":
+        if self.min_replan_interval > self.replan_period:
+            raise ValueError(f"min_replan_interval ({self.min_replan_interval:g} s) must not exceed replan_period ({self.replan_period:g} s)")
+        return self
+
+    @property
+    def lethal_distance(self) -> float:
+        """Distance (m) from an occupied cell's edge below which a cell is lethal."""
+        return self.robot_radius + self.inflation_margin
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> "ExploreConfig":
+        """Validate a plain dict; raise :class:`ConfigError` with a one-line message."""
+        return _validate(cls, data, "explore")
+
+
+class TerminationConfig(BaseModel):
+    """The paper's termination rule (:class:`~slamtrials.explore.termination.SnapshotTermination`).
+
+    Every ``small_period`` (``large_period`` for large environments) seconds of simulated time, take a
+    snapshot of the map as a grey image (occupied 0, free 255, unknown ``unknown_grey``), align the
+    previous snapshot inside it by the map origins, downscale both by ``downscale`` (block mean), and
+    stop when their mean square error, summed over ``channels`` identical colour channels, is below
+    ``mse_threshold``. Also stop after ``max_snapshots`` snapshots, or at ``max_time``.
+
+    Small or large: the environment is large when its free area is at least ``size_threshold`` m^2.
+    The default, 1,000 m^2, is the paper's border between its small published buildings (100 to
+    1,000 m^2) and its large campus buildings (1,000 to 30,000 m^2). Unless the caller gives the
+    area, the known free area of the map at the time of each snapshot is used, so the period grows to
+    ``large_period`` once the mapped part of a building passes the threshold.
+    """
+
+    model_config = _MODEL_CONFIG
+
+    small_period: float = Field(120.0, gt=0.0, le=1e5, description="snapshot period of small environments (s)")
+    large_period: float = Field(600.0, gt=0.0, le=1e5, description="snapshot period of large environments (s)")
+    size_threshold: float = Field(1000.0, gt=0.0, le=1e7, description="free area from which an environment is large (m^2)")
+    mse_threshold: float = Field(10.0, ge=0.0, le=1e6, description="stop when the snapshot MSE is below this (grey^2, summed over channels)")
+    channels: int = Field(3, ge=1, le=4, description="colour channels the MSE is summed over (grey images: identical channels)")
+    downscale: int = Field(4, ge=1, le=64, description="block size of the downscaling (cells)")
+    max_snapshots: int = Field(19, ge=2, le=100000, description="stop after this many snapshots")
+    max_time: float = Field(10800.0, gt=0.0, le=1e7, description="hard cap on simulated time (s)")
+    unknown_grey: int = Field(205, ge=0, le=255, description="grey level of unknown cells (ROS map_server's 205)")
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> "TerminationConfig":
+        """Validate a plain dict; raise :class:`ConfigError` with a one-line message."""
+        return _validate(cls, data, "termination")

@@ -1,0 +1,280 @@
+"""Local control: follow a planned path with pure pursuit, within speed and acceleration limits,
+slowing down and stopping for obstacles seen in the current laser scan.
+
+Per call, with the robot at ``pose`` (map frame) and the path as map-frame points:
+
+1. progress: the path point nearest the robot, searched forward from the last one;
+2. target: the first path point at least ``lookahead_distance`` from the robot (else the last point);
+3. heading error ``e`` to the target (robot frame). If ``|e| > rotate_in_place_angle`` the robot turns
+   in place: ``w = sign(e) min(w_max, k |e|, sqrt(2 alpha |e|))`` with ``k = 2.5 /s`` (it can stop
+   turning in time), ``v = 0``;
+4. otherwise pure pursuit: curvature ``kappa = 2 sin(e) / l`` (``l`` the distance to the target),
+   ``v = min(v_max, sqrt(2 a s_end), sqrt(2 a (s_free - stop_distance)), w_max / |kappa|)`` with
+   ``s_end`` the remaining path length and ``s_free`` how far the robot can go along the arc of
+   curvature ``kappa`` before its disc (radius + ``obstacle_margin``) touches a scan point
+   (:func:`free_travel`), and ``w = kappa v``;
+5. acceleration: ``v`` may rise by at most ``max_linear_accel * dt`` per call (braking is left to the
+   robot's own limits, which the speed caps above respect), ``w`` changes by at most
+   ``max_angular_accel * dt``.
+
+If the scan blocks the arc, steps 2 to 4 are tried again with a short look-ahead (0.25 m), which
+tracks the path more tightly in narrow places. If that is blocked too, the robot *creeps*: it turns in
+place to face the path point 0.15 m ahead, then inches straight towards it at 0.15 m/s at most,
+keeping only 1 cm from the scan's points (the path itself keeps off walls by the costmap's lethal
+distance). If even that is impossible it reports itself *blocked* (the explorer starts a recovery if
+this lasts).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from slamtrials.explore.config import ExploreConfig
+
+__all__ = ["PathFollower", "FollowCommand", "scan_points", "free_travel", "turn_rate"]
+
+_K_TURN = 2.5
+_SEARCH_AHEAD = 60  # path points searched for progress per call
+_BLOCKED_SPEED = 0.03  # m/s: a speed cap below this from the scan means blocked
+_SHORT_LOOKAHEAD = 0.25  # m: look-ahead tried when the normal one leads into an obstacle
+_CREEP_LOOKAHEAD = 0.15  # m: target of the creeping mode
+_CREEP_ALIGN = math.radians(8.0)  # heading error (rad) up to which the robot creeps straight
+_CREEP_SPEED = 0.15  # m/s
+_CREEP_MARGIN = 0.01  # m: clearance kept while creeping
+
+
+def turn_rate(error: float, max_rate: float, max_accel: float) -> float:
+    """Turn rate (rad/s) towards a heading error (rad) that can still stop in time: see the module docstring."""
+    magnitude = min(max_rate, _K_TURN * abs(error), math.sqrt(2.0 * max_accel * abs(error)))
+    return math.copysign(magnitude, error)
+
+
+_ANGLE_CACHE: dict[tuple[int, float, float, float], tuple[NDArray[np.float64], NDArray[np.float64]]] = {}
+
+
+def _beam_directions(beams: int, laser: dict[str, Any]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """(cos, sin) of every beam's direction in the base frame, cached per laser geometry."""
+    mth = float(laser.get("mount", (0.0, 0.0, 0.0))[2])
+    key = (beams, float(laser["angle_min"]), float(laser["angle_increment"]), mth)
+    found = _ANGLE_CACHE.get(key)
+    if found is None:
+        angles = key[1] + key[2] * np.arange(beams) + mth
+        found = (np.cos(angles), np.sin(angles))
+        if len(_ANGLE_CACHE) > 64:
+            _ANGLE_CACHE.clear()
+        _ANGLE_CACHE[key] = found
+    return found
+
+
+def scan_points(ranges: ArrayLike, laser: dict[str, Any]) -> NDArray[np.float64]:
+    """float64 ``[K, 2]`` scan returns in the robot base frame (m).
+
+    Beams with NaN, ``r <= range_min`` or ``r >= range_max`` (no return) are left out. ``laser`` is the
+    geometry dict (``angle_min``, ``angle_increment``, ``range_min``, ``range_max``, optional ``mount``).
+    """
+    r = np.asarray(ranges, dtype=np.float64)
+    cos, sin = _beam_directions(r.shape[0], laser)
+    mount = laser.get("mount", (0.0, 0.0, 0.0))
+    mx, my = float(mount[0]), float(mount[1])
+    ok = (r > float(laser.get("range_min", 0.0))) & (r < float(laser["range_max"]))
+    r = r[ok]
+    return np.column_stack([mx + r * cos[ok], my + r * sin[ok]])
+
+
+def free_travel(points: NDArray[np.float64], curvature: float, half_width: float, horizon: float = 5.0) -> float:
+    """How far (m) the robot centre can move forward along an arc before touching a point.
+
+    Parameters
+    ----------
+    points:
+        float64 ``[K, 2]`` obstacle points in the robot base frame (m), x forward, y left.
+    curvature:
+        Curvature of the arc (1/m), positive turning left; 0 is straight ahead.
+    half_width:
+        Radius (m) of the disc swept along the arc.
+    horizon:
+        Largest distance reported (m).
+
+    Returns
+    -------
+    float
+        Arc length (m), in ``[0, horizon]``; 0 when a point is already inside the disc ahead of the centre.
+    """
+    if points.shape[0] == 0:
+        return horizon
+    x, y = points[:, 0], points[:, 1]
+    if abs(curvature) < 0.05:
+        near = (x > 0.0) & (np.abs(y) < half_width)
+        if not near.any():
+            return horizon
+        travel = x[near] - np.sqrt(half_width**2 - y[near] ** 2)
+    else:
+        radius = 1.0 / abs(curvature)
+        ys = y if curvature > 0 else -y  # mirror right turns into left ones
+        rho = np.hypot(x, ys - radius)
+        near = np.abs(rho - radius) < half_width
+        if not near.any():
+            return horizon
+        beta = np.arctan2(ys[near] - radius, x[near])  # angle around the turning centre
+        swept = np.mod(beta + 0.5 * math.pi, 2.0 * math.pi)  # from the robot's position, counter-clockwise
+        ahead = swept < math.pi
+        if not ahead.any():
+            return horizon
+        travel = radius * swept[ahead] - np.sqrt(half_width**2 - (rho[near][ahead] - radius) ** 2)
+    return float(min(max(travel.min(), 0.0), horizon))
+
+
+@dataclass(frozen=True)
+class FollowCommand:
+    """One command of the follower.
+
+    Attributes
+    ----------
+    v, w:
+        Linear (m/s) and angular (rad/s) velocity.
+    blocked:
+        The scan keeps the robot from driving on.
+    finished:
+        The robot is within ``goal_tolerance`` of the path's last point.
+    """
+
+    v: float
+    w: float
+    blocked: bool = False
+    finished: bool = False
+
+
+class PathFollower:
+    """Pure-pursuit path follower (see the module docstring).
+
+    Parameters
+    ----------
+    config:
+        Speed and acceleration limits, look-ahead, clearances.
+    """
+
+    def __init__(self, config: ExploreConfig):
+        self.config = config
+        self._path = np.zeros((0, 2))
+        self._remaining = np.zeros(0)
+        self._index = 0
+        self._v = 0.0
+        self._w = 0.0
+
+    @property
+    def path(self) -> NDArray[np.float64]:
+        """float64 ``[N, 2]`` the path being followed (map frame, m)."""
+        return self._path
+
+    @property
+    def has_path(self) -> bool:
+        """Whether a path is set."""
+        return self._path.shape[0] > 0
+
+    def set_path(self, path: ArrayLike) -> None:
+        """Follow ``path``, float ``[N, 2]`` map-frame points (m), from its start."""
+        points = np.asarray(path, dtype=np.float64).reshape(-1, 2)
+        self._path = points
+        seg = np.hypot(*np.diff(points, axis=0).T) if len(points) > 1 else np.zeros(0)
+        self._remaining = np.concatenate([np.cumsum(seg[::-1])[::-1], [0.0]]) if len(points) else np.zeros(0)
+        self._index = 0
+
+    def clear(self) -> None:
+        """Forget the path."""
+        self.set_path(np.zeros((0, 2)))
+
+    def reset(self) -> None:
+        """Forget the path and the remembered velocity."""
+        self.clear()
+        self._v = 0.0
+        self._w = 0.0
+
+    def remaining(self, pose: ArrayLike) -> float:
+        """Path length (m) still ahead: from ``pose`` to the nearest path point (searched forward from the
+        current one), then along the path; ``inf`` without a path."""
+        if not self.has_path:
+            return math.inf
+        x, y = float(pose[0]), float(pose[1])  # type: ignore[index]
+        stop = min(self._index + _SEARCH_AHEAD, len(self._path))
+        d = np.hypot(self._path[self._index:stop, 0] - x, self._path[self._index:stop, 1] - y)
+        k = int(np.argmin(d))
+        return float(d[k] + self._remaining[self._index + k])
+
+    def remember(self, v: float, w: float) -> None:
+        """Record a command given by someone else (e.g. a recovery), for the acceleration limits."""
+        self._v, self._w = float(v), float(w)
+
+    def command(self, pose: ArrayLike, ranges: ArrayLike, laser: dict[str, Any]) -> FollowCommand:
+        """Velocity command towards the path from ``pose`` (float64 ``[3]``, map frame) given the current scan."""
+        cfg = self.config
+        x, y, theta = (float(v) for v in np.asarray(pose, dtype=np.float64)[:3])
+        if not self.has_path:
+            return self._limited(0.0, 0.0, finished=True)
+        path = self._path
+        stop = min(self._index + _SEARCH_AHEAD, len(path))
+        d = np.hypot(path[self._index:stop, 0] - x, path[self._index:stop, 1] - y)
+        self._index += int(np.argmin(d))
+        to_end = float(self._remaining[self._index]) + float(d.min())
+        end_dist = math.hypot(path[-1, 0] - x, path[-1, 1] - y)
+        if end_dist < cfg.goal_tolerance:
+            return self._limited(0.0, 0.0, finished=True)
+        points = scan_points(ranges, laser)
+        blocked = False
+        for lookahead in (cfg.lookahead_distance, _SHORT_LOOKAHEAD):
+            tx, ty = self._target(x, y, lookahead)
+            error = math.remainder(math.atan2(ty - y, tx - x) - theta, 2.0 * math.pi)
+            if abs(error) > cfg.rotate_in_place_angle:
+                return self._limited(0.0, turn_rate(error, cfg.max_angular_speed, cfg.max_angular_accel))
+            dist = max(math.hypot(tx - x, ty - y), 1e-6)
+            curvature = 2.0 * math.sin(error) / dist
+            free = free_travel(points, curvature, cfg.robot_radius + cfg.obstacle_margin)
+            v_scan = math.sqrt(2.0 * cfg.max_linear_accel * max(free - cfg.stop_distance, 0.0))
+            blocked = v_scan < _BLOCKED_SPEED
+            if not blocked:
+                break
+        if blocked:
+            return self._creep(x, y, theta, points, to_end)
+        v = min(cfg.max_linear_speed, math.sqrt(2.0 * cfg.max_linear_accel * to_end), v_scan)
+        if abs(curvature) > 1e-9:
+            v = min(v, cfg.max_angular_speed / abs(curvature))
+        return self._limited(v, curvature * v, pure_pursuit=True, curvature=curvature)
+
+    def _creep(self, x: float, y: float, theta: float, points: NDArray[np.float64], to_end: float) -> FollowCommand:
+        """Tight manoeuvring: face the path a few centimetres ahead, then inch straight along it."""
+        cfg = self.config
+        tx, ty = self._target(x, y, _CREEP_LOOKAHEAD)
+        error = math.remainder(math.atan2(ty - y, tx - x) - theta, 2.0 * math.pi)
+        if abs(error) > _CREEP_ALIGN:
+            return self._limited(0.0, turn_rate(error, cfg.max_angular_speed, cfg.max_angular_accel))
+        free = free_travel(points, 0.0, cfg.robot_radius + _CREEP_MARGIN)
+        v = min(_CREEP_SPEED, math.sqrt(2.0 * cfg.max_linear_accel * max(free - _CREEP_MARGIN, 0.0)),
+                math.sqrt(2.0 * cfg.max_linear_accel * to_end))
+        if v < _BLOCKED_SPEED:
+            return self._limited(0.0, 0.0, blocked=True)
+        return self._limited(v, 0.0)
+
+    def _target(self, x: float, y: float, lookahead: float) -> tuple[float, float]:
+        """The first path point from the current one at least ``lookahead`` from (x, y), else the last."""
+        path = self._path
+        ahead = np.hypot(path[self._index:, 0] - x, path[self._index:, 1] - y)
+        beyond = np.flatnonzero(ahead >= lookahead)
+        tx, ty = path[self._index + int(beyond[0])] if beyond.size else path[-1]
+        return float(tx), float(ty)
+
+    def _limited(self, v: float, w: float, *, blocked: bool = False, finished: bool = False,
+                 pure_pursuit: bool = False, curvature: float = 0.0) -> FollowCommand:
+        cfg = self.config
+        dt = cfg.control_period
+        if v > 0.0:
+            v = min(v, max(self._v, 0.0) + cfg.max_linear_accel * dt)
+            if pure_pursuit:
+                w = curvature * v  # stay on the arc while speeding up
+        dw = cfg.max_angular_accel * dt
+        w = min(max(w, self._w - dw), self._w + dw)
+        self._v, self._w = v, w
+        return FollowCommand(v, w, blocked, finished)

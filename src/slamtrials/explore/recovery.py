@@ -1,0 +1,140 @@
+"""Getting unstuck: notice that the robot does not move as commanded, then back off and turn.
+
+:class:`StuckMonitor` keeps the last ``stuck_time`` seconds of commanded forward speed and estimated
+position. The robot is stuck when it was commanded to move at least ``stuck_min_command`` metres over
+that window but moved (net) less than ``stuck_ratio`` of it: the simulator stops a robot that bumps
+into a wall, and a robot wedged against an obstacle that the map does not show (or shows elsewhere,
+after a SLAM error) does not move either.
+
+:class:`Recovery` is a fixed manoeuvre, timed in simulated seconds: back off ``backoff_distance`` at
+``backoff_speed`` (the laser sees nothing behind, so this is blind, but it retraces where the robot
+came from; it is skipped when the map shows an obstacle there, see :func:`segment_clear`), then turn
+in place by ``recovery_turn`` towards the side where the scan sees more room.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from slamtrials.explore.config import ExploreConfig
+from slamtrials.explore.gridframe import FREE_BELOW, GridFrame, map_arrays
+
+__all__ = ["StuckMonitor", "Recovery", "open_side", "segment_clear"]
+
+
+class StuckMonitor:
+    """Detects a robot that does not move as commanded (see the module docstring)."""
+
+    def __init__(self, config: ExploreConfig):
+        self.config = config
+        self._samples: deque[tuple[float, float, float, float]] = deque()  # (t, x, y, commanded distance)
+        self._commanded = 0.0
+
+    def reset(self) -> None:
+        """Forget the history."""
+        self._samples.clear()
+        self._commanded = 0.0
+
+    def update(self, t: float, pose: ArrayLike, v_command: float, dt: float) -> bool:
+        """Record that at time ``t`` (s) the robot was at ``pose`` and was then commanded ``v_command``
+        (m/s) for ``dt`` s; return whether it is stuck."""
+        x, y = float(pose[0]), float(pose[1])  # type: ignore[index]
+        moved = max(float(v_command), 0.0) * dt
+        self._samples.append((t, x, y, moved))
+        self._commanded += moved
+        window = self.config.stuck_time
+        while self._samples and self._samples[0][0] < t - window - 1e-9:
+            self._commanded -= self._samples.popleft()[3]
+        if len(self._samples) < 2 or t - self._samples[0][0] < window - 1e-9:
+            return False
+        # the displacement since the oldest sample comes from the commands given before the newest one
+        commanded = self._commanded - moved
+        if commanded < self.config.stuck_min_command:
+            return False
+        t0, x0, y0, _ = self._samples[0]
+        return math.hypot(x - x0, y - y0) < self.config.stuck_ratio * commanded
+
+
+def open_side(ranges: ArrayLike, laser: dict[str, Any]) -> float:
+    """+1.0 if the scan sees more room to the left (beam angle > 0) than to the right, else -1.0."""
+    r = np.asarray(ranges, dtype=np.float64)
+    angles = float(laser["angle_min"]) + float(laser["angle_increment"]) * np.arange(r.shape[0])
+    r = np.where(np.isfinite(r), np.minimum(r, float(laser["range_max"])), 0.0)
+    r = np.minimum(r, 5.0)  # what matters is the room nearby
+    left = float(r[angles > 0.0].sum())
+    right = float(r[angles < 0.0].sum())
+    return 1.0 if left >= right else -1.0
+
+
+def segment_clear(occupancy: Any, a: ArrayLike, b: ArrayLike, radius: float) -> bool:
+    """Whether a disc of ``radius`` (m) moved from map-frame point ``a`` to ``b`` stays off the map's
+    occupied cells (each taken as a disc of half a cell around its centre). Unknown cells count as free."""
+    grid, resolution, _ = map_arrays(occupancy)
+    frame = GridFrame.of(occupancy)
+    pa = np.asarray(a, dtype=np.float64)[:2]
+    pb = np.asarray(b, dtype=np.float64)[:2]
+    reach = radius + resolution
+    corners = np.array([[min(pa[0], pb[0]) - reach, max(pa[1], pb[1]) + reach],
+                        [max(pa[0], pb[0]) + reach, min(pa[1], pb[1]) - reach]])
+    rows, cols = frame.to_cell(corners)
+    r0, r1 = int(max(rows.min(), 0)), int(min(rows.max() + 1, grid.shape[0]))
+    c0, c1 = int(max(cols.min(), 0)), int(min(cols.max() + 1, grid.shape[1]))
+    if r0 >= r1 or c0 >= c1:
+        return True
+    rr, cc = np.nonzero(grid[r0:r1, c0:c1] >= FREE_BELOW)
+    if rr.size == 0:
+        return True
+    centres = frame.to_xy(rr + r0, cc + c0)
+    seg = pb - pa
+    length2 = float(seg @ seg)
+    s = np.zeros(len(centres)) if length2 == 0.0 else np.clip((centres - pa) @ seg / length2, 0.0, 1.0)
+    gap = np.hypot(*(centres - (pa + s[:, None] * seg)).T)
+    return bool(gap.min() >= radius + 0.5 * resolution)
+
+
+class Recovery:
+    """The back-off-and-turn manoeuvre (see the module docstring)."""
+
+    def __init__(self, config: ExploreConfig):
+        self.config = config
+        self._phases: list[tuple[float, float, float]] = []  # (end time, v, w)
+
+    @property
+    def active(self) -> bool:
+        """Whether a manoeuvre is under way."""
+        return bool(self._phases)
+
+    def reset(self) -> None:
+        """Abort any manoeuvre."""
+        self._phases = []
+
+    def start(self, t: float, ranges: ArrayLike, laser: dict[str, Any], *, back_off: bool = True) -> None:
+        """Begin a manoeuvre at time ``t`` (s), turning towards the more open side of the scan.
+
+        ``back_off=False`` skips backing off (the caller saw an obstacle behind the robot).
+        """
+        cfg = self.config
+        phases = []
+        end = t
+        if back_off and cfg.backoff_distance > 0.0:
+            end += cfg.backoff_distance / cfg.backoff_speed + cfg.backoff_speed / cfg.max_linear_accel
+            phases.append((end, -cfg.backoff_speed, 0.0))
+        if cfg.recovery_turn > 0.0:
+            rate = 0.8 * cfg.max_angular_speed
+            end += cfg.recovery_turn / rate + rate / cfg.max_angular_accel
+            phases.append((end, 0.0, open_side(ranges, laser) * rate))
+        self._phases = phases
+
+    def command(self, t: float) -> tuple[float, float] | None:
+        """The manoeuvre's command at time ``t``, or ``None`` once it is over."""
+        while self._phases and t >= self._phases[0][0] - 1e-9:
+            self._phases.pop(0)
+        if not self._phases:
+            return None
+        _, v, w = self._phases[0]
+        return v, w

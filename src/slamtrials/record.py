@@ -65,7 +65,9 @@ class RunRecord:
     metadata:
         Free-form JSON-serialisable facts about the run (world name, seed, drawn odometry bias, ...).
     estimate:
-        Optional float64 ``[T, 3]`` SLAM pose estimates, filled in by later stages.
+        Optional float64 ``[T, 3]`` SLAM pose estimates (map frame), filled in by later stages.
+    map:
+        Optional final SLAM map (:class:`OccupancyGrid`, map frame), filled in by a trial.
     """
 
     t: NDArray[np.float64]
@@ -76,6 +78,7 @@ class RunRecord:
     laser: dict[str, Any]
     metadata: dict[str, Any] = field(default_factory=dict)
     estimate: NDArray[np.float64] | None = None
+    map: OccupancyGrid | None = None
 
     def __post_init__(self) -> None:
         n = len(self.t)

@@ -73,6 +73,7 @@ def _register_commands() -> None:
     from slamtrials.cli import transfer
     from slamtrials.cli import evaluate
     from slamtrials.cli import slam
+    from slamtrials.cli import trial
 
     app.add_typer(worlds.app, name="worlds", help="List, show, load and generate floor plans.")
     simulate.register(app)
@@ -80,6 +81,7 @@ def _register_commands() -> None:
     transfer.register(app)
     evaluate.register(app)
     slam.register(app)
+    trial.register(app)
 
 
 _register_commands()

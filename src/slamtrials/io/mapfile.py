@@ -20,7 +20,6 @@ unknown as occupied).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -30,39 +29,19 @@ from numpy.typing import ArrayLike, NDArray
 
 from slamtrials.atomicfile import atomic_write, atomic_write_bytes, atomic_write_text
 from slamtrials.errors import FormatError
+from slamtrials.record import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from slamtrials.io.yamlfile import read_yaml_mapping
 from slamtrials.worlds.formats.image import read_pixels
 from slamtrials.worlds.formats.rosmap import MAP_MODES, classify_rosmap
 
-__all__ = ["OccupancyMap", "write_map", "write_map_png", "read_map", "trinary", "FREE", "OCCUPIED", "UNKNOWN",
+__all__ = ["OccupancyGrid", "write_map", "write_map_png", "read_map", "trinary", "FREE", "OCCUPIED", "UNKNOWN",
            "FREE_GREY", "OCCUPIED_GREY", "UNKNOWN_GREY"]
 
-#: Values of the trinary grid :func:`read_map` returns (those of a ``nav_msgs/OccupancyGrid``).
-FREE, OCCUPIED, UNKNOWN = 0, 100, -1
 #: Grey levels map_saver writes.
 FREE_GREY, OCCUPIED_GREY, UNKNOWN_GREY = 254, 0, 205
 #: map_saver's defaults: at most 25 % is free, at least 65 % occupied.
 FREE_MAX_PERCENT, OCCUPIED_MIN_PERCENT = 25.0, 65.0
 _YAML_THRESHOLDS = {"occupied_thresh": 0.65, "free_thresh": 0.196}
-
-
-@dataclass(frozen=True, eq=False)
-class OccupancyMap:
-    """A trinary occupancy map read from a map_server YAML.
-
-    Attributes
-    ----------
-    grid:
-        int8 ``[H, W]``: 0 free, 100 occupied, -1 unknown; row 0 is the top row of the image.
-    resolution:
-        Metres per cell.
-    origin:
-        float64 ``[3]`` world pose (x, y, yaw) of the lower-left corner of the grid.
-    """
-
-    grid: NDArray[np.int8]
-    resolution: float
-    origin: NDArray[np.float64]
 
 
 def trinary(grid: ArrayLike) -> NDArray[np.int8]:
@@ -174,8 +153,8 @@ def _number(path: Path, doc: dict[str, Any], key: str) -> float:
     return float(value)
 
 
-def read_map(yaml_path: str | Path) -> OccupancyMap:
-    """Read a map_server map (YAML + image) as a trinary :class:`OccupancyMap`.
+def read_map(yaml_path: str | Path) -> OccupancyGrid:
+    """Read a map_server map (YAML + image) as a trinary :class:`OccupancyGrid`.
 
     Pixels are classified as map_server does (:func:`slamtrials.worlds.formats.rosmap.classify_rosmap`,
     honouring ``negate``, the thresholds and ``mode``), so maps of other tools read as ROS would read
@@ -222,4 +201,4 @@ def read_map(yaml_path: str | Path) -> OccupancyMap:
     grid[free] = FREE
     grid[occupied] = OCCUPIED
     values = [float(v) for v in origin] + [0.0] * (3 - len(origin))
-    return OccupancyMap(grid=grid, resolution=resolution, origin=np.array(values))
+    return OccupancyGrid(grid=grid, resolution=resolution, origin=np.array(values))

@@ -1,9 +1,11 @@
 """The run folder of DESIGN.md: ``frames.npz`` (the recorded data) and ``run.json`` (what produced it).
 
 ``frames.npz`` holds ``t`` float64 [T] (s), ``scans`` float32 [T, B] (m), ``odometry`` float64 [T, 3]
-(odometry frame), ``truth`` float64 [T, 3] (world frame) and ``stalled`` bool [T].
+(odometry frame), ``truth`` float64 [T, 3] (world frame) and ``stalled`` bool [T], and, for a run with a
+SLAM estimate, ``estimate`` float64 [T, 3] (map frame), also written as ``estimate.tum``.
 ``run.json`` holds the laser geometry, the run's metadata (world, seed, drawn odometry bias, outcome,
 timings, resolved config) and the versions that produced it.
+A run with a final SLAM map also has ``map.yaml`` + ``map.pgm`` (ROS map_server) and ``map.png``.
 
 Every file is written atomically and ``run.json`` is written last, so a folder with a ``run.json`` is a
 complete run; a crash mid-write leaves a folder that :func:`read_run` rejects rather than misreads.
@@ -24,12 +26,17 @@ import numpy as np
 from slamtrials.__about__ import __version__
 from slamtrials.atomicfile import atomic_write, atomic_write_text
 from slamtrials.errors import FormatError
-from slamtrials.record import RunRecord
+from slamtrials.io.mapfile import read_map, write_map, write_map_png
+from slamtrials.io.tum import write_tum
+from slamtrials.record import RunRecord, Trajectory
 
-__all__ = ["write_run", "read_run", "FRAMES_FILE", "RUN_FILE", "RUN_FORMAT"]
+__all__ = ["write_run", "read_run", "FRAMES_FILE", "RUN_FILE", "RUN_FORMAT", "ESTIMATE_FILE", "MAP_FILE", "MAP_PICTURE"]
 
 FRAMES_FILE = "frames.npz"
 RUN_FILE = "run.json"
+ESTIMATE_FILE = "estimate.tum"
+MAP_FILE = "map.yaml"
+MAP_PICTURE = "map.png"
 RUN_FORMAT = "slamtrials-run/1"
 
 _ARRAYS: dict[str, tuple[type, int | None]] = {  # name -> (dtype, size of the last axis or None)
@@ -63,6 +70,17 @@ def write_run(folder: str | Path, record: RunRecord) -> Path:
     folder.mkdir(parents=True, exist_ok=True)
     (folder / RUN_FILE).unlink(missing_ok=True)  # the folder is incomplete until run.json is back
     arrays = {name: np.asarray(getattr(record, name), dtype=dtype) for name, (dtype, _) in _ARRAYS.items()}
+    if record.estimate is not None:
+        arrays["estimate"] = np.asarray(record.estimate, dtype=np.float64).reshape(len(record), 3)
+        write_tum(folder / ESTIMATE_FILE, Trajectory(t=arrays["t"], poses=arrays["estimate"]))
+    else:
+        (folder / ESTIMATE_FILE).unlink(missing_ok=True)
+    if record.map is not None:
+        write_map(folder / MAP_FILE, record.map.grid, record.map.resolution, record.map.origin)
+        write_map_png(folder / MAP_PICTURE, record.map.grid)
+    else:
+        for stale in (MAP_FILE, "map.pgm", MAP_PICTURE):
+            (folder / stale).unlink(missing_ok=True)
     atomic_write(folder / FRAMES_FILE, lambda handle: np.savez_compressed(handle, **arrays))
     doc = {
         "format": RUN_FORMAT,
@@ -98,7 +116,7 @@ def _read_frames(path: Path) -> dict[str, np.ndarray]:
         raise FormatError(path, "missing: every run folder has frames.npz")
     try:
         with np.load(path, allow_pickle=False) as npz:
-            arrays = {name: npz[name] for name in npz.files if name in _ARRAYS}
+            arrays = {name: npz[name] for name in npz.files if name in _ARRAYS or name == "estimate"}
     except (zipfile.BadZipFile, zlib.error, ValueError, OSError, EOFError, io.UnsupportedOperation) as exc:
         raise FormatError(path, f"not a readable .npz archive ({exc})") from None
     for name, (dtype, last) in _ARRAYS.items():
@@ -109,6 +127,8 @@ def _read_frames(path: Path) -> dict[str, np.ndarray]:
         if last is not None and (arrays[name].ndim != 2 or arrays[name].shape[1] != last):
             raise FormatError(path, f"array '{name}' has shape {arrays[name].shape}, expected [T, {last}]")
     n = len(arrays["t"])
+    if "estimate" in arrays and (arrays["estimate"].dtype != np.float64 or arrays["estimate"].shape != (n, 3)):
+        raise FormatError(path, f"array 'estimate' has {arrays['estimate'].dtype} {arrays['estimate'].shape}, expected float64 [{n}, 3]")
     if arrays["scans"].ndim != 2 or any(len(a) != n for a in arrays.values()):
         raise FormatError(path, f"arrays disagree on the number of frames: { {k: v.shape for k, v in arrays.items()} }")
     if n > 1 and not np.all(np.diff(arrays["t"]) > 0):
@@ -133,4 +153,5 @@ def read_run(folder: str | Path) -> RunRecord:
         raise FormatError(folder / RUN_FILE, f"says {doc['beams']} beams but frames.npz has {arrays['scans'].shape[1]}")
     laser = doc.pop("laser")
     metadata = {k: v for k, v in doc.items() if k not in ("format", "frames", "beams")}
-    return RunRecord(**arrays, laser=laser, metadata=metadata)
+    slam_map = read_map(folder / MAP_FILE) if (folder / MAP_FILE).is_file() else None
+    return RunRecord(**arrays, laser=laser, metadata=metadata, map=slam_map)

@@ -1,4 +1,4 @@
-"""Pictures of one run: the world, the true path, and the odometry path it would be believed to be."""
+"""Pictures of one run: the world, the true path, the odometry path, and the SLAM estimate if any."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from slamtrials.geometry import compose
+from slamtrials.geometry import compose, inverse
 from slamtrials.record import RunRecord
 from slamtrials.worlds.world import World
 
@@ -14,10 +14,11 @@ __all__ = ["draw_run", "save_run_figure"]
 
 
 def draw_run(ax, world: World, record: RunRecord) -> None:
-    """Draw ``world`` with the run's true path (world frame) and its odometry path on a matplotlib Axes.
+    """Draw ``world`` with the run's true path (world frame), its odometry path and, when the record
+    has one, its SLAM estimate, on a matplotlib Axes.
 
-    The odometry path is anchored at the first true pose, so its drift from the true path is what the
-    odometry error did over the run.
+    The odometry path and the estimate are anchored at the first true pose, so their drift from the true
+    path is what the odometry error, and what is left of it after SLAM, did over the run.
     """
     from slamtrials.report.figures import draw_world
 
@@ -25,6 +26,10 @@ def draw_run(ax, world: World, record: RunRecord) -> None:
     odometry_in_world = compose(record.truth[0], record.odometry)
     ax.plot(record.truth[:, 0], record.truth[:, 1], color="tab:blue", lw=1.2, label="ground truth")
     ax.plot(odometry_in_world[:, 0], odometry_in_world[:, 1], color="tab:red", lw=0.9, ls="--", label="odometry")
+    if record.estimate is not None and len(record.estimate):
+        world_from_map = compose(record.truth[0], inverse(record.estimate[0]))
+        estimate_in_world = compose(world_from_map, record.estimate)
+        ax.plot(estimate_in_world[:, 0], estimate_in_world[:, 1], color="tab:green", lw=0.9, label="SLAM estimate")
     stalls = record.stalled
     if np.any(stalls):
         ax.plot(record.truth[stalls, 0], record.truth[stalls, 1], "x", color="tab:orange", ms=5, label="stalled")

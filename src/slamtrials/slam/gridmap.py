@@ -48,12 +48,15 @@ DEFAULT_CHUNK = 64
 
 
 @njit(cache=True, nogil=True)
-def _integrate_scan(hits, visits, ou, ov, eu, ev, hit, weight):  # pragma: no cover - compiled
+def _integrate_scan(hits, visits, col0, row0, ou, ov, eu, ev, hit, weight):  # pragma: no cover - compiled
     """Add one scan's visits and hits, each counted ``weight`` times (-1 takes a scan back out).
 
-    ``(ou, ov)`` is the laser in continuous window coordinates (cells: u right, v up, from the window's
-    lower-left corner); ``eu, ev`` float64 ``[B]`` the beam endpoints (already cut); ``hit`` bool ``[B]``
-    whether the endpoint's cell is an obstacle. Cells outside the window are skipped.
+    ``(ou, ov)`` is the laser in continuous GLOBAL cell coordinates (cells: u right, v up, from the map
+    frame's origin); ``eu, ev`` float64 ``[B]`` the beam endpoints (already cut); ``hit`` bool ``[B]``
+    whether the endpoint's cell is an obstacle. The traversal is done in global cells and only the
+    indexing subtracts the window's corner (``col0``, ``row0``), so a scan is traced the same way however
+    the window grew in between (which is what makes taking it back out exact). Cells outside the window
+    are skipped.
     """
     height, width = visits.shape
     x0 = int(math.floor(ou))
@@ -81,17 +84,17 @@ def _integrate_scan(hits, visits, ou, ov, eu, ev, hit, weight):  # pragma: no co
             t_y = math.inf
         steps = abs(jx - ix) + abs(jy - iy)
         for _ in range(steps):
-            if 0 <= iy < height and 0 <= ix < width:
-                visits[iy, ix] += weight
+            if 0 <= iy - row0 < height and 0 <= ix - col0 < width:
+                visits[iy - row0, ix - col0] += weight
             if ix == jx or (iy != jy and t_y <= t_x):
                 iy += step_y
                 t_y += delta_y
             else:
                 ix += step_x
                 t_x += delta_x
-        if hit[b] and 0 <= jy < height and 0 <= jx < width:
-            visits[jy, jx] += weight
-            hits[jy, jx] += weight
+        if hit[b] and 0 <= jy - row0 < height and 0 <= jx - col0 < width:
+            visits[jy - row0, jx - col0] += weight
+            hits[jy - row0, jx - col0] += weight
 
 
 def beam_angles(laser: dict[str, Any], beams: int) -> NDArray[np.float64]:
@@ -177,7 +180,7 @@ class GridMap:
 
     def cell_of(self, xy: ArrayLike) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
         """Global cell indices (column, row from the bottom) of map-frame points ``[..., 2]`` (m)."""
-        p = np.floor(np.asarray(xy, dtype=np.float64) / self.resolution).astype(np.intp)
+        p = np.floor(np.asarray(xy, dtype=np.float64) * (1.0 / self.resolution)).astype(np.intp)  # as the kernel
         return p[..., 0], p[..., 1]
 
     def ensure(self, xy: ArrayLike) -> None:
@@ -211,10 +214,10 @@ class GridMap:
         origin = np.asarray(laser_pose, dtype=np.float64)[:2]
         self.ensure(np.vstack([origin[None, :], endpoints]))
         scale = 1.0 / self.resolution
-        ou, ov = origin[0] * scale - self.col0, origin[1] * scale - self.row0
-        eu = np.ascontiguousarray(endpoints[:, 0] * scale - self.col0)
-        ev = np.ascontiguousarray(endpoints[:, 1] * scale - self.row0)
-        _integrate_scan(self.hits, self.visits, float(ou), float(ov), eu, ev, np.ascontiguousarray(hit), int(weight))
+        eu = np.ascontiguousarray(endpoints[:, 0] * scale)
+        ev = np.ascontiguousarray(endpoints[:, 1] * scale)
+        _integrate_scan(self.hits, self.visits, self.col0, self.row0, float(origin[0] * scale), float(origin[1] * scale),
+                        eu, ev, np.ascontiguousarray(hit), int(weight))
 
     def integrate_frame(self, base_pose: ArrayLike, ranges: ArrayLike, laser: dict[str, Any], *,
                         max_urange: float | None = None) -> None:

@@ -133,18 +133,23 @@ class GMapping:
     # ------------------------------------------------------------------ per reading
 
     def _used_beams(self, ranges: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
-        """Laser-frame endpoints ``lx, ly`` and free points ``lfx, lfy`` of the beams the filter uses."""
+        """Laser-frame endpoints of the beams the filter uses.
+
+        Returns ``(lx, ly, mx, my, lfx, lfy)``: ``lx, ly`` every usable return (registered into the
+        maps), ``mx, my`` those of them the matcher and likelihood use (every ``lskip + 1``-th beam, as
+        the original counts), ``lfx, lfy`` the free points of the latter, one diagonal cell back.
+        """
         c = self.config
         angles = self._angles
         assert angles is not None
-        used = ~np.isnan(ranges) & (ranges > self.range_min) & (ranges < self.range_max) \
+        usable = ~np.isnan(ranges) & (ranges > self.range_min) & (ranges < self.range_max) \
             & (ranges <= self.max_urange) & (ranges <= self.max_range)
-        if c.lskip:
-            used &= np.arange(ranges.shape[0]) % (c.lskip + 1) == c.lskip  # as the original counts
-        r, a = ranges[used], angles[used]
-        cos_a, sin_a = np.cos(a), np.sin(a)
-        back = r - math.sqrt(2.0) * c.delta
-        return r * cos_a, r * sin_a, back * cos_a, back * sin_a
+        matched = usable & (np.arange(ranges.shape[0]) % (c.lskip + 1) == c.lskip)
+        r, a = ranges[usable], angles[usable]
+        lx, ly = r * np.cos(a), r * np.sin(a)
+        keep = matched[usable]
+        back = (r - math.sqrt(2.0) * c.delta)[keep]
+        return lx, ly, lx[keep], ly[keep], back * np.cos(a[keep]), back * np.sin(a[keep])
 
     def _register(self, lx: NDArray[np.float64], ly: NDArray[np.float64]) -> None:
         """Add the scan seen from every particle's pose to its map."""
@@ -205,11 +210,11 @@ class GMapping:
         due = self._due(t, laser_odometry)
         self._last_laser_odometry = laser_odometry
         if due:
-            lx, ly, lfx, lfy = self._used_beams(ranges)
+            lx, ly, mx, my, lfx, lfy = self._used_beams(ranges)
             if first:
                 self.lineage.add(self.poses)
             else:
-                self._update(lx, ly, lfx, lfy)
+                self._update(mx, my, lfx, lfy)
             self._register(lx, ly)
             self._scans.append(np.where(ranges > self.max_range, np.nan, ranges).astype(np.float32))
             self._processed.append(len(self._t))

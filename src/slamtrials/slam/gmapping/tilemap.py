@@ -133,7 +133,7 @@ class TileMaps:
 
     def cell_mean(self, particle: int, xy: NDArray[np.float64]) -> tuple[int, NDArray[np.float64]]:
         """Endpoint count and mean (m) of the cell holding map-frame point ``xy`` in ``particle``'s map."""
-        gc, gr = (int(math.floor(v / self.resolution)) for v in xy)
+        gc, gr = (int(math.floor(v * (1.0 / self.resolution))) for v in xy)  # exactly as the kernels
         lc, lr = gc - (self.tile_col0 << TILE_SHIFT), gr - (self.tile_row0 << TILE_SHIFT)
         _, rows, cols = self.directories.shape
         if lc < 0 or lr < 0 or (lr >> TILE_SHIFT) >= rows or (lc >> TILE_SHIFT) >= cols:

@@ -1,0 +1,69 @@
+"""``slamtrials trial``: one autonomous exploration run with online SLAM, written as a run folder."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from slamtrials.cli.main import make_console
+from slamtrials.errors import ConfigError
+
+__all__ = ["trial", "register", "TRIAL_PICTURE"]
+
+TRIAL_PICTURE = "run.png"
+
+
+def trial(
+    world: Annotated[str, typer.Option("--world", "-w", help="Bundled world name or floor-plan file.")],
+    out: Annotated[Path, typer.Option("--out", "-o", help="Run folder to write (frames.npz, estimate.tum, map.yaml/.pgm/.png, run.json, run.png).")],
+    seed: Annotated[int, typer.Option("--seed", "-s", help="Seed of every random draw of the trial (simulator and SLAM).")] = 0,
+    config: Annotated[Path | None, typer.Option("--config", "-c", help="YAML with sim/slam/explore/termination settings; default: the paper's set-up.")] = None,
+    resolution: Annotated[float | None, typer.Option("--resolution", help="Metres per pixel, for a bare PNG/PGM floor plan.")] = None,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace a run already stored in --out.")] = False,
+) -> None:
+    """Let the robot explore WORLD on its own, mapped online by SLAM, until the map stops changing."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from slamtrials.io.runfolder import RUN_FILE, write_run
+    from slamtrials.io.yamlfile import read_yaml_mapping
+    from slamtrials.report.runplot import save_run_figure
+    from slamtrials.trial import TrialConfig, run_trial
+    from slamtrials.worlds import load_world
+
+    if seed < 0:
+        raise ConfigError(f"--seed must be a non-negative integer, got {seed}")
+    if (out / RUN_FILE).exists() and not overwrite:
+        raise ConfigError(f"{out}: already holds a run; choose another --out or pass --overwrite")
+    trial_config = TrialConfig()
+    if config is not None:
+        try:
+            trial_config = TrialConfig.from_dict(read_yaml_mapping(config))
+        except ConfigError as exc:
+            raise ConfigError(f"{config}: {exc}") from None
+    the_world = load_world(world, **({} if resolution is None else {"resolution": resolution}))
+    console = make_console()
+    columns = (TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[status]}"), TimeElapsedColumn())
+    with Progress(*columns, console=console, transient=True, disable=not console.is_terminal) as progress:
+        task = progress.add_task(f"{the_world.name} seed {seed}", total=trial_config.termination.max_time, status="")
+
+        def report(p) -> None:
+            progress.update(task, completed=p.t,
+                            status=f"{p.t:6.0f} s simulated, {p.known_free_area:7.0f} of {p.reachable_area:.0f} m^2 mapped")
+
+        record = run_trial(the_world, trial_config, seed, on_progress=report)
+    record.metadata.update(world_source=str(world))
+    write_run(out, record)
+    save_run_figure(the_world, record, out / TRIAL_PICTURE, title=f"{the_world.name}, seed {seed}")
+    info = record.metadata["trial"]
+    console.print(
+        f"{out}: {info['termination_reason']} after {info['duration_s']:.0f} s simulated in {info['wall_time_s']:.1f} s "
+        f"({info['realtime_factor']:.0f}x real time); mapped {100 * info['mapped_fraction']:.1f} % of the reachable "
+        f"{info['reachable_area_m2']:.0f} m^2, travelled {info['distance_m']:.0f} m, {info['slam_updates']} SLAM updates",
+        soft_wrap=True, highlight=False)
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``trial`` command to ``app``."""
+    app.command("trial")(trial)

@@ -1,0 +1,99 @@
+"""Configuration of one trial: simulator, SLAM algorithm, explorer and termination rule (pydantic).
+
+``TrialConfig()`` is the paper's set-up: the paper's robot and laser (:class:`~slamtrials.sim.SimConfig`),
+``gmapping`` with the ``paper`` preset, frontier exploration and the snapshot termination rule. The
+explorer drives the simulated robot, so its motion limits, footprint and control period are always taken
+from ``sim`` (:meth:`TrialConfig.explore_config`); the ``explore`` section holds the rest.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from slamtrials.errors import ConfigError
+from slamtrials.explore import ExploreConfig, TerminationConfig
+from slamtrials.sim import SimConfig
+from slamtrials.slam import get_algorithm, resolve_config
+
+__all__ = ["SlamSettings", "TrialConfig"]
+
+_MODEL_CONFIG = ConfigDict(extra="forbid", frozen=True)
+
+#: ExploreConfig fields that describe the robot and are copied from SimConfig.
+_ROBOT_FIELDS = ("robot_radius", "max_linear_speed", "max_angular_speed", "max_linear_accel", "max_angular_accel",
+                 "control_period")
+
+
+class SlamSettings(BaseModel):
+    """Which SLAM algorithm runs online, and with which parameters.
+
+    Attributes
+    ----------
+    algorithm:
+        Registry or entry-point name (``slamtrials.slam``).
+    preset:
+        One of the algorithm's presets, or ``None`` for its defaults.
+    params:
+        Parameter overrides applied after the preset.
+    """
+
+    model_config = _MODEL_CONFIG
+
+    algorithm: str = Field("gmapping", min_length=1, description="SLAM algorithm name")
+    preset: str | None = Field("paper", description="preset of the algorithm, or null for its defaults")
+    params: dict[str, Any] = Field(default_factory=dict, description="parameter overrides")
+
+    def resolved(self) -> BaseModel:
+        """The algorithm's validated config (raises :class:`ConfigError` naming the bad parameter)."""
+        return resolve_config(get_algorithm(self.algorithm), preset=self.preset, overrides=self.params)
+
+
+class TrialConfig(BaseModel):
+    """Everything a trial needs besides the world and the seed.
+
+    Attributes
+    ----------
+    sim:
+        Robot, laser, odometry and time step.
+    slam:
+        The online SLAM algorithm.
+    explore:
+        Frontier explorer settings (its robot fields are overridden from ``sim``).
+    termination:
+        The paper's snapshot rule and the hard time cap.
+    coverage_stride:
+        Every how many frames a scan is traced at its true pose to measure what the laser observed.
+    """
+
+    model_config = _MODEL_CONFIG
+
+    sim: SimConfig = Field(default_factory=SimConfig)
+    slam: SlamSettings = Field(default_factory=SlamSettings)
+    explore: ExploreConfig = Field(default_factory=ExploreConfig)
+    termination: TerminationConfig = Field(default_factory=TerminationConfig)
+    coverage_stride: int = Field(5, ge=1, le=1000, description="frames between scans traced for the observed area")
+
+    def explore_config(self) -> ExploreConfig:
+        """``explore`` with the robot's footprint, limits and control period taken from ``sim``."""
+        robot = self.sim.robot
+        values = {"robot_radius": robot.radius, "max_linear_speed": robot.max_linear_speed,
+                  "max_angular_speed": robot.max_angular_speed, "max_linear_accel": robot.max_linear_accel,
+                  "max_angular_accel": robot.max_angular_accel, "control_period": self.sim.dt}
+        assert set(values) == set(_ROBOT_FIELDS)
+        return ExploreConfig.from_dict({**self.explore.model_dump(), **values})
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> "TrialConfig":
+        """Validate a plain dict (e.g. from YAML), including the SLAM parameters; one-line ConfigError."""
+        try:
+            config = cls.model_validate(data)
+        except ValidationError as exc:
+            problems = []
+            for err in exc.errors():
+                field = ".".join(str(p) for p in err["loc"]) or "<root>"
+                problems.append(f"{field}: {err['msg']} (got {err.get('input')!r})")
+            raise ConfigError("trial config: " + "; ".join(problems)) from None
+        config.slam.resolved()
+        return config

@@ -1,0 +1,72 @@
+"""How much of a world a trial mapped and observed, measured against the true world.
+
+Both measures count the world's reachable free cells (free cells connected to the start, at the world
+map's resolution), so 1.0 means every place the robot could reach was covered:
+
+* :func:`mapped_fraction`: cells whose centre falls on a known (free or occupied) cell of the SLAM
+  map, after carrying the world into the map frame through the first frame (estimate vs truth);
+* :func:`observed_fraction`: cells crossed or hit by the laser, traced at the TRUE poses of every
+  ``stride``-th scan; what the exploration let the robot see, whatever SLAM made of it.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from slamtrials.geometry import compose1, inverse, transform_points
+from slamtrials.record import UNKNOWN, OccupancyGrid
+from slamtrials.slam import GridMap
+from slamtrials.worlds import World
+from slamtrials.worlds.world import cell_to_world
+
+__all__ = ["reachable_cell_centres", "mapped_fraction", "observed_fraction", "known_free_area"]
+
+
+def reachable_cell_centres(world: World) -> NDArray[np.float64]:
+    """float64 ``[K, 2]``: world-frame centres (m) of the world's free cells reachable from the start."""
+    rows, cols = np.nonzero(world.reachable_free())
+    return cell_to_world(world, rows, cols)
+
+
+def _lookup(grid: OccupancyGrid, xy: NDArray[np.float64]) -> NDArray[np.int8]:
+    """Cell values of map-frame points ``[K, 2]`` in ``grid`` (UNKNOWN outside it; origin theta 0)."""
+    height, width = grid.grid.shape
+    col = np.floor((xy[:, 0] - grid.origin[0]) / grid.resolution).astype(np.int64)
+    row_up = np.floor((xy[:, 1] - grid.origin[1]) / grid.resolution).astype(np.int64)
+    inside = (col >= 0) & (col < width) & (row_up >= 0) & (row_up < height)
+    values = np.full(xy.shape[0], UNKNOWN, dtype=np.int8)
+    values[inside] = grid.grid[height - 1 - row_up[inside], col[inside]]
+    return values
+
+
+def mapped_fraction(world: World, grid: OccupancyGrid, estimate0: NDArray[np.float64], truth0: NDArray[np.float64]) -> float:
+    """Fraction of reachable free world cells that the SLAM map ``grid`` knows.
+
+    ``estimate0`` and ``truth0`` are the first frame's pose in the map frame and in the world frame;
+    together they place the world in the map frame.
+    """
+    centres = reachable_cell_centres(world)
+    if centres.shape[0] == 0 or grid.grid.size == 0:
+        return 0.0
+    map_from_world = compose1(estimate0, inverse(truth0))
+    return float(np.mean(_lookup(grid, transform_points(map_from_world, centres)) != UNKNOWN))
+
+
+def observed_fraction(world: World, truth: NDArray[np.float64], scans: NDArray[np.float32], laser: dict[str, Any],
+                      stride: int) -> float:
+    """Fraction of reachable free world cells the laser saw (scans traced at their true poses)."""
+    centres = reachable_cell_centres(world)
+    if centres.shape[0] == 0:
+        return 0.0
+    seen = GridMap(world.resolution)
+    for k in range(0, truth.shape[0], stride):
+        seen.integrate_frame(truth[k], scans[k], laser)
+    return float(np.mean(_lookup(seen.occupancy(0.5), centres) != UNKNOWN))
+
+
+def known_free_area(grid: OccupancyGrid) -> float:
+    """Free area (m^2) of a SLAM map."""
+    return float(np.count_nonzero(grid.grid == 0)) * grid.resolution ** 2

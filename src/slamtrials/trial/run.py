@@ -1,0 +1,169 @@
+"""One trial: the simulated robot explores a world on its own, mapped online by a SLAM algorithm.
+
+Per simulator step (``sim.dt``, 0.1 s by default): the frame goes to the SLAM algorithm, which returns
+its pose estimate; the termination rule looks at the SLAM map; the explorer turns the estimate, the scan
+and the map into a velocity command; the simulator steps. The trial ends when
+
+* ``map_converged``: two consecutive map snapshots differ by less than the MSE threshold (the paper's
+  rule), or ``max_snapshots`` were taken;
+* ``no_frontiers``: the explorer has no reachable frontier left;
+* ``time_cap``: the hard cap on simulated time was reached.
+
+Seeds: the trial's seed feeds a ``numpy.random.SeedSequence``; its first child drives the simulator
+(odometry bias and any sensor noise), its second the SLAM algorithm. The explorer draws nothing. The
+same world, config and seed give the same run, bit for bit.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from slamtrials.explore import Explorer, SnapshotTermination
+from slamtrials.record import Frame, OccupancyGrid, RunRecord
+from slamtrials.sim import Simulator
+from slamtrials.slam import get_algorithm
+from slamtrials.trial.config import TrialConfig
+from slamtrials.trial.coverage import known_free_area, mapped_fraction, observed_fraction
+from slamtrials.worlds import World
+
+__all__ = ["run_trial", "TrialProgress", "TRIAL_FORMAT"]
+
+#: Version of the trial metadata layout in run.json.
+TRIAL_FORMAT = "slamtrials-trial/1"
+
+
+@dataclass(frozen=True)
+class TrialProgress:
+    """What a progress callback is told, every ``progress_period`` seconds of simulated time.
+
+    Attributes
+    ----------
+    t:
+        Simulated time (s).
+    max_time:
+        The hard cap on simulated time (s).
+    known_free_area:
+        Free area of the current SLAM map (m^2).
+    reachable_area:
+        Reachable free area of the true world (m^2).
+    """
+
+    t: float
+    max_time: float
+    known_free_area: float
+    reachable_area: float
+
+
+def _path_length(truth: np.ndarray) -> float:
+    return float(np.sum(np.hypot(np.diff(truth[:, 0]), np.diff(truth[:, 1]))))
+
+
+def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
+              on_progress: Callable[[TrialProgress], None] | None = None,
+              progress_period: float = 10.0) -> RunRecord:
+    """Explore ``world`` once with online SLAM and return the run.
+
+    Parameters
+    ----------
+    world:
+        The world; the robot starts at ``world.start``.
+    config:
+        The trial's settings; ``None`` means :class:`TrialConfig` defaults (the paper's set-up).
+    seed:
+        Non-negative seed of every random draw of the trial.
+    on_progress:
+        Called with a :class:`TrialProgress` every ``progress_period`` seconds of simulated time.
+
+    Returns
+    -------
+    RunRecord
+        Every frame (``t``, ``scans``, ``odometry``, ``truth``, ``stalled``), ``estimate`` (the SLAM
+        trajectory, map frame, one pose per frame), ``map`` (the final SLAM map), and ``metadata``:
+        ``trial`` (termination reason, mapped and observed fractions of the reachable free area,
+        distance travelled, simulated duration, wall time, SLAM updates, explorer counters, snapshot
+        MSEs), ``seed``, ``world``, the drawn odometry ``bias`` and the resolved ``config``.
+
+    Raises
+    ------
+    ConfigError
+        A bad seed or SLAM configuration.
+    SimulationError
+        The robot does not fit at the world's start pose.
+    """
+    from slamtrials.errors import ConfigError
+
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ConfigError(f"trial seed must be a non-negative integer, got {seed!r}")
+    config = TrialConfig() if config is None else config
+    slam_config = config.slam.resolved()
+    sequence = np.random.SeedSequence(int(seed))
+    sim_seed, slam_seed = sequence.spawn(2)
+    started = time.perf_counter()
+
+    sim = Simulator(world, config.sim, np.random.default_rng(sim_seed))
+    laser = sim.laser_info
+    slam = get_algorithm(config.slam.algorithm)(slam_config, dict(laser))
+    slam.reset(np.random.default_rng(slam_seed))
+    explorer = Explorer(config.explore_config())
+    termination = SnapshotTermination(config.termination)
+    reachable_area = float(np.count_nonzero(world.reachable_free())) * world.resolution ** 2
+    max_time = config.termination.max_time
+
+    frames: list[Frame] = []
+    frame = sim.observe()
+    next_report = 0.0
+    reason = None
+    while True:
+        frames.append(frame)
+        estimate = slam.process(frame)
+        grid = slam.occupancy()
+        reason = termination.check(frame.t, grid)
+        if reason is not None:
+            break
+        command = explorer.command(frame.t, estimate, frame.ranges, laser, grid)
+        if explorer.done:
+            reason = explorer.reason or "no_frontiers"
+            break
+        if on_progress is not None and frame.t >= next_report:
+            on_progress(TrialProgress(frame.t, max_time, known_free_area(grid), reachable_area))
+            next_report = frame.t + progress_period
+        frame = sim.step(command)
+
+    record = RunRecord.from_frames(frames, laser)
+    trajectory = slam.trajectory()
+    if len(trajectory) != len(record) or not np.array_equal(trajectory.t, record.t):
+        raise ConfigError(f"SLAM algorithm {config.slam.algorithm!r} returned {len(trajectory)} poses for "
+                          f"{len(record)} frames; trajectory() must hold one pose per processed frame")
+    record.estimate = trajectory.poses
+    final_map: OccupancyGrid = slam.occupancy()
+    record.map = final_map
+    wall = time.perf_counter() - started
+    duration = float(record.t[-1] - record.t[0])
+    stats = explorer.stats
+    record.metadata = {
+        **sim.metadata,
+        "seed": int(seed),
+        "trial": {
+            "format": TRIAL_FORMAT,
+            "termination_reason": reason,
+            "mapped_fraction": mapped_fraction(world, final_map, record.estimate[0], record.truth[0]),
+            "observed_fraction": observed_fraction(world, record.truth, record.scans, laser, config.coverage_stride),
+            "reachable_area_m2": reachable_area,
+            "mapped_free_area_m2": known_free_area(final_map),
+            "distance_m": _path_length(record.truth),
+            "duration_s": duration,
+            "wall_time_s": wall,
+            "realtime_factor": duration / max(wall, 1e-9),
+            "slam_updates": int(slam.updates),
+            "stalled_frames": int(np.count_nonzero(record.stalled)),
+            "explorer": {k: (round(v, 3) if isinstance(v, float) else v) for k, v in vars(stats).items()},
+            "snapshots": [[round(t, 3), round(mse, 4)] for t, mse in termination.history],
+        },
+        "config": config.model_dump(mode="json"),
+        "slam_config": slam_config.model_dump(mode="json"),
+    }
+    return record

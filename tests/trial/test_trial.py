@@ -1,0 +1,115 @@
+"""run_trial end to end: a small world is explored and mapped, the run is reproducible, bad input fails."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from slamtrials.errors import ConfigError
+from slamtrials.geometry import compose, inverse
+from slamtrials.io.runfolder import read_run, write_run
+from slamtrials.record import OCCUPIED, UNKNOWN
+from slamtrials.trial import TrialConfig, run_trial
+from slamtrials.trial.coverage import mapped_fraction
+from slamtrials.worlds import World
+
+RES = 0.05
+
+
+def two_rooms() -> World:
+    """An 8 m x 5 m box split by a wall with a 1 m door; the robot starts in the left room."""
+    height, width = int(5.0 / RES) + 2, int(8.0 / RES) + 2
+    occupied = np.zeros((height, width), dtype=bool)
+    occupied[:3, :] = occupied[-3:, :] = occupied[:, :3] = occupied[:, -3:] = True
+    wall = width // 2
+    occupied[:, wall:wall + 3] = True
+    door = slice(height // 2 - 10, height // 2 + 10)  # 1.0 m
+    occupied[door, wall:wall + 3] = False
+    return World(occupied, RES, name="two-rooms", start=np.array([1.5, 2.5, 0.0]))
+
+
+@pytest.fixture(scope="module")
+def world() -> World:
+    return two_rooms()
+
+
+@pytest.fixture(scope="module")
+def config() -> TrialConfig:
+    # a small world: snapshots every 60 s and a 15-minute cap keep the test short either way
+    return TrialConfig.from_dict({"termination": {"small_period": 60.0, "max_time": 900.0}})
+
+
+@pytest.fixture(scope="module")
+def record(world, config):
+    return run_trial(world, config, seed=4)
+
+
+def test_a_small_world_is_explored_and_mapped(record, world):
+    info = record.metadata["trial"]
+    assert info["termination_reason"] in ("map_converged", "no_frontiers")
+    assert info["mapped_fraction"] >= 0.9
+    assert info["observed_fraction"] >= 0.9
+    # the robot went through the door into the right room
+    assert np.any(record.truth[:, 0] > 4.2)
+    assert info["duration_s"] == pytest.approx(record.t[-1] - record.t[0])
+    assert info["distance_m"] > 3.0
+
+
+def test_the_map_and_estimate_agree_with_the_truth(record, world):
+    # estimate vs truth: the SLAM path, carried into the world frame through the first frame
+    world_from_map = compose(record.truth[0], inverse(record.estimate[0]))
+    error = np.hypot(*(compose(world_from_map, record.estimate)[:, :2] - record.truth[:, :2]).T)
+    assert error.max() < 0.25
+    # occupied cells of the final SLAM map lie on true walls
+    grid = record.map
+    rows, cols = np.nonzero(grid.grid == OCCUPIED)
+    assert rows.size > 100
+    xy_map = np.column_stack([grid.origin[0] + (cols + 0.5) * grid.resolution,
+                              grid.origin[1] + (grid.grid.shape[0] - rows - 0.5) * grid.resolution])
+    from slamtrials.geometry import transform_points
+    from slamtrials.worlds import world_to_cell
+    wr, wc = world_to_cell(world, transform_points(world_from_map, xy_map))
+    inside = (wr >= 0) & (wr < world.height) & (wc >= 0) & (wc < world.width)
+    near_wall = np.zeros(rows.size, dtype=bool)
+    for dr in (-2, -1, 0, 1, 2):
+        for dc in (-2, -1, 0, 1, 2):
+            r, c = np.clip(wr + dr, 0, world.height - 1), np.clip(wc + dc, 0, world.width - 1)
+            near_wall |= world.occupied[r, c]
+    assert np.mean(near_wall[inside]) > 0.95
+
+
+def test_mapped_fraction_counts_known_cells_of_the_true_free_space(record, world):
+    info = record.metadata["trial"]
+    assert mapped_fraction(world, record.map, record.estimate[0], record.truth[0]) == info["mapped_fraction"]
+    blank = type(record.map)(grid=np.full_like(record.map.grid, UNKNOWN), resolution=record.map.resolution,
+                             origin=record.map.origin)
+    assert mapped_fraction(world, blank, record.estimate[0], record.truth[0]) == 0.0
+
+
+def test_same_seed_same_trial_bit_for_bit(record, world, config):
+    again = run_trial(world, config, seed=4)
+    for name in ("t", "scans", "odometry", "truth", "stalled", "estimate"):
+        assert np.array_equal(getattr(again, name), getattr(record, name)), name
+    assert np.array_equal(again.map.grid, record.map.grid)
+    other = run_trial(world, config.model_copy(update={"termination": config.termination.model_copy(update={"max_time": 30.0})}), seed=5)
+    assert other.metadata["bias"] != record.metadata["bias"]
+
+
+def test_the_run_folder_keeps_estimate_and_map(record, tmp_path):
+    write_run(tmp_path / "run", record)
+    back = read_run(tmp_path / "run")
+    assert np.array_equal(back.estimate, record.estimate)
+    assert np.array_equal(back.map.grid, record.map.grid)
+    assert back.metadata["trial"]["termination_reason"] == record.metadata["trial"]["termination_reason"]
+    assert (tmp_path / "run" / "estimate.tum").is_file() and (tmp_path / "run" / "map.png").is_file()
+
+
+def test_bad_input_is_a_config_error(world):
+    with pytest.raises(ConfigError, match="seed"):
+        run_trial(world, TrialConfig(), seed=-1)
+    with pytest.raises(ConfigError, match="nonsense"):
+        TrialConfig.from_dict({"slam": {"params": {"nonsense": 1}}})
+    with pytest.raises(ConfigError, match="termination.max_time"):
+        TrialConfig.from_dict({"termination": {"max_time": -5}})
+    with pytest.raises(ConfigError, match="unknown_section|Extra inputs"):
+        TrialConfig.from_dict({"unknown_section": {}})

@@ -7,7 +7,7 @@
   (composed with the laser mount: the filter tracks the laser);
 * only beams with a return inside maxUrange and maxRange are registered into the particle maps;
 * ``trajectory()`` holds one pose per reading, the processed ones from the best particle's path and
-  the others carried by odometry.
+  the others carried by odometry from the processed reading nearest in time.
 """
 
 from __future__ import annotations
@@ -144,7 +144,7 @@ def test_lskip_thins_matching_but_not_registration():
     assert total_endpoints(algorithm, 0) == BEAMS
 
 
-def test_trajectory_has_one_pose_per_reading_carried_by_odometry_between_processed_ones():
+def test_trajectory_has_one_pose_per_reading_carried_by_odometry_from_the_nearest_processed_one():
     n = 14
     odometry = np.column_stack([-2.0 + 0.3 * np.arange(n), 0.02 * np.arange(n), 0.01 * np.arange(n)])
     times = 0.1 * np.arange(n)
@@ -154,7 +154,9 @@ def test_trajectory_has_one_pose_per_reading_carried_by_odometry_between_process
     path = algorithm.lineage.path(algorithm.best_particle)  # laser poses; the mount is 0 here
     np.testing.assert_allclose(trajectory.poses[processed], path, atol=1e-12)
     for k in range(n):
-        anchor = max(j for j in processed if j <= k)
+        before = max(j for j in processed if j <= k)
+        after = min((j for j in processed if j > k), default=before)
+        anchor = after if times[after] - times[k] < times[k] - times[before] else before
         expected = compose(trajectory.poses[anchor], ominus(odometry[anchor], odometry[k]))
         np.testing.assert_allclose(trajectory.poses[k], expected, atol=1e-9)
     # perfect odometry in a box: the matcher keeps the estimate on the true path (within a few cm)

@@ -5,7 +5,7 @@ GMapping with slam_gmapping's defaults (30 particles), seed 1, over all 1,988 sc
 evaluated as ``slamtrials evaluate -e trajectory.clf -r mit-csail.relations`` does. Every one of the
 1,172 relations must match and the mean translational error must be at most 0.06 m (the C++ original
 gives 0.048 m, spec/gmapping.md section 7; the published figure is 0.049 m; this implementation gave
-about 0.054 m when the test was written). Skipped when the data set is absent.
+about 0.048 m when the test was written). Skipped when the data set is absent.
 """
 
 from __future__ import annotations

@@ -35,8 +35,9 @@ does the test as intended, with the free point one diagonal cell (``sqrt(2) * de
 
 Estimates. :meth:`GMapping.process` returns the online estimate, the current best particle's pose.
 :meth:`GMapping.trajectory` returns the final best particle's path (one pose per processed reading, the
-way GMapping's results are evaluated), with the readings in between placed by odometry from the last
-processed reading before them.
+way GMapping's results are evaluated), with every other reading placed by odometry from the processed
+reading nearest to it in time, as the spec's evaluation carries relation timestamps to the nearest
+processed scan.
 """
 
 from __future__ import annotations
@@ -238,14 +239,17 @@ class GMapping:
         return self.published.occupancy()
 
     def trajectory(self) -> Trajectory:
-        """The final best particle's path, every reading placed by odometry from the processed one before it."""
+        """The final best particle's path; every reading is placed by odometry from the processed reading
+        nearest to it in time (before or after it; the earlier one on a tie)."""
         t = np.array(self._t, dtype=np.float64)
         if not self._processed:
             return Trajectory(t=t, poses=np.zeros((0, 3)))
         odometry = np.array(self._odometry, dtype=np.float64)
         processed = np.array(self._processed, dtype=np.intp)
         path = compose(self.lineage.path(self.best_particle), inverse(self.mount))
-        anchor = np.searchsorted(processed, np.arange(t.shape[0]), side="right") - 1
+        before = np.searchsorted(processed, np.arange(t.shape[0]), side="right") - 1
+        after = np.minimum(before + 1, processed.shape[0] - 1)
+        anchor = np.where(t[processed[after]] - t < t - t[processed[before]], after, before)
         poses = compose(path[anchor], ominus(odometry[processed[anchor]], odometry))
         return Trajectory(t=t, poses=poses)
 

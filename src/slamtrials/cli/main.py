@@ -74,6 +74,7 @@ def _register_commands() -> None:
     from slamtrials.cli import evaluate
     from slamtrials.cli import slam
     from slamtrials.cli import trial
+    from slamtrials.cli import campaign, config
 
     app.add_typer(worlds.app, name="worlds", help="List, show, load and generate floor plans.")
     simulate.register(app)
@@ -82,6 +83,8 @@ def _register_commands() -> None:
     evaluate.register(app)
     slam.register(app)
     trial.register(app)
+    campaign.register(app)
+    config.register(app)
 
 
 _register_commands()

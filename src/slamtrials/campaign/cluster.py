@@ -1,0 +1,86 @@
+"""Connecting to Dask: a LocalCluster on this machine by default, or an existing scheduler.
+
+* ``scheduler=None``: ``LocalCluster(n_workers=workers or os.cpu_count(), threads_per_worker=1,
+  processes=True)``, closed at the end. One single-threaded worker process per core: runs are
+  CPU-bound Python/numba code, so processes, not threads, give the speed-up.
+* ``scheduler="tcp://host:8786"``: a running Dask scheduler (e.g. one started by dask-jobqueue on
+  SLURM, or ``dask scheduler`` + ``dask worker``). Its workers must see the campaign folder at the same
+  path (a shared filesystem) and have slamtrials installed.
+* ``scheduler=<distributed.Client>``: used as it is, and left open.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Any
+
+from slamtrials.errors import ConfigError
+
+__all__ = ["dask_client", "check_workers", "CONNECT_TIMEOUT"]
+
+log = logging.getLogger(__name__)
+
+#: Seconds to wait for an existing scheduler to answer.
+CONNECT_TIMEOUT = 30.0
+
+
+def check_workers(workers: int | None) -> int:
+    """The number of local workers: ``workers`` or the CPU count; raise ConfigError below 1."""
+    if workers is None:
+        return max(os.cpu_count() or 1, 1)
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ConfigError(f"workers must be a positive integer, got {workers!r}")
+    return workers
+
+
+@contextmanager
+def dask_client(scheduler: Any = None, workers: int | None = None, *, allowed_failures: int | None = None,
+                timeout: float | None = None) -> Iterator[Any]:
+    """Yield a ``distributed.Client`` (see the module docstring); close what this function opened.
+
+    ``allowed_failures`` sets how many worker deaths a task may cause before the local cluster's
+    scheduler gives up on it (``distributed.scheduler.allowed-failures``, default 3); an existing
+    scheduler keeps its own setting.
+
+    Raises
+    ------
+    ConfigError
+        Bad ``workers``, or a scheduler address that cannot be reached within ``timeout`` seconds
+        (default :data:`CONNECT_TIMEOUT`).
+    """
+    from distributed import Client, LocalCluster
+
+    if isinstance(scheduler, Client):
+        yield scheduler
+        return
+    if scheduler is not None:
+        try:
+            client = Client(str(scheduler), timeout=timeout or CONNECT_TIMEOUT)
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise ConfigError(f"cannot connect to the Dask scheduler {scheduler!r}: {exc}") from None
+        log.info("connected to Dask scheduler %s", scheduler)
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    import dask
+
+    n = check_workers(workers)
+    settings = {} if allowed_failures is None else {"distributed.scheduler.allowed-failures": int(allowed_failures)}
+    with dask.config.set(settings):
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0")
+    try:
+        client = Client(cluster)
+    except BaseException:
+        cluster.close()
+        raise
+    log.info("started a local Dask cluster with %d worker processes (dashboard %s)", n, cluster.dashboard_link)
+    try:
+        yield client
+    finally:
+        client.close()
+        cluster.close()

@@ -1,0 +1,199 @@
+"""The campaign configuration: worlds, the trial's settings, the metric, the run-count rule, the seed.
+
+A campaign config is a YAML mapping validated by :class:`CampaignConfig` (pydantic, frozen, unknown keys
+rejected). Its ``sim``, ``slam``, ``explore``, ``termination`` and ``coverage_stride`` are those of
+:class:`slamtrials.trial.TrialConfig`; ``metric`` sets the relation sampling that turns each run into
+its two errors ``eps_t`` (m) and ``eps_r`` (rad); ``runs`` sets the paper's Section III-C rule that
+decides how many runs each world needs. :meth:`CampaignConfig.from_yaml` and
+:meth:`CampaignConfig.from_dict` raise one-line :class:`~slamtrials.errors.ConfigError` messages that
+name the file, the field path and the bad value. ``slamtrials config dump`` prints the defaults
+(:func:`slamtrials.campaign.dump.dump_default_yaml`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from slamtrials.errors import ConfigError, FormatError
+from slamtrials.explore import ExploreConfig, TerminationConfig
+from slamtrials.metric.runcount import DEFAULT_MIN_RUNS
+from slamtrials.metric.sampling import DEFAULT_CONFIDENCE, DEFAULT_MARGIN_R, DEFAULT_MARGIN_T, DEFAULT_PILOT
+from slamtrials.sim import SimConfig
+from slamtrials.trial import SlamSettings, TrialConfig
+
+__all__ = ["CampaignConfig", "MetricSettings", "RunSettings", "DEFAULT_MAX_RUNS", "RUN_TOLERANCE", "MAX_SEED"]
+
+_MODEL_CONFIG = ConfigDict(extra="forbid", frozen=True)
+
+#: Default cap on the runs of one world.
+DEFAULT_MAX_RUNS = 60
+#: Matching tolerance (s) of a run's estimate to its ground truth: they share the simulator's clock, so
+#: only the same frame's pose is taken directly (as ``slamtrials evaluate RUN`` does).
+RUN_TOLERANCE = 0.001
+#: Largest root seed (seeds are stored as SQLite 64-bit signed integers).
+MAX_SEED = 2**63 - 1
+
+
+class MetricSettings(BaseModel):
+    """Relation sampling of each run (IROS 2018 rule): pilot, then ``N = ceil(z^2 s^2 / d^2)`` relations.
+
+    A run's ``eps_t`` and ``eps_r`` are the mean translational (m) and rotational (rad) errors of its
+    estimate over the sampled relations (:func:`slamtrials.metric.sample_relations`).
+    """
+
+    model_config = _MODEL_CONFIG
+
+    confidence: float = Field(DEFAULT_CONFIDENCE, gt=0.0, lt=1.0, description="confidence level of a run's relation sampling")
+    margin_t: float = Field(DEFAULT_MARGIN_T, gt=0.0, le=100.0, description="margin of error of a run's mean translational error (m)")
+    margin_r: float = Field(DEFAULT_MARGIN_R, gt=0.0, le=3.2, description="margin of error of a run's mean rotational error (rad)")
+    pilot: int = Field(DEFAULT_PILOT, ge=2, le=1_000_000, description="pairs of the pilot sample that estimates the error spread")
+    distribution: Literal["normal", "t"] = Field("normal", description="quantile of the confidence level: normal or t")
+    tolerance: float = Field(RUN_TOLERANCE, gt=0.0, le=10.0, description="matching tolerance of estimate to ground-truth timestamps (s)")
+
+
+class RunSettings(BaseModel):
+    """How many runs each world gets: the paper's Section III-C rule, with a cap.
+
+    Start with ``initial`` runs; from the sample variances of the per-run ``eps_t`` and ``eps_r`` compute
+    ``N = ceil(z^2 s^2 / d^2)`` for each (margins ``margin_t``, ``margin_r``), take the larger, run up to
+    that many in total and estimate again, until the estimate is not larger than the runs done or
+    ``max_runs`` is reached (the world is then reported as capped).
+    """
+
+    model_config = _MODEL_CONFIG
+
+    initial: int = Field(DEFAULT_MIN_RUNS, ge=2, le=100_000, description="runs of the first variance estimate (10 in the paper)")
+    max_runs: int = Field(DEFAULT_MAX_RUNS, ge=2, le=100_000, description="cap on the runs of one world; a world that hits it is reported as capped")
+    confidence: float = Field(0.99, gt=0.0, lt=1.0, description="confidence level of a world's mean errors")
+    margin_t: float = Field(0.02, gt=0.0, le=100.0, description="margin of error of a world's mean translational error (m)")
+    margin_r: float = Field(0.02, gt=0.0, le=3.2, description="margin of error of a world's mean rotational error (rad)")
+    distribution: Literal["normal", "t"] = Field("normal", description="quantile of the confidence level: normal or t")
+    retries: int = Field(2, ge=0, le=100, description="times a run is retried when its worker dies or it fails unexpectedly")
+
+    @model_validator(mode="after")
+    def _cap_not_below_initial(self) -> "RunSettings":
+        if self.max_runs < self.initial:
+            raise ValueError(f"max_runs ({self.max_runs}) must be at least initial ({self.initial})")
+        return self
+
+
+class CampaignConfig(BaseModel):
+    """Everything a campaign needs: worlds, trial settings, metric, run-count rule, root seed, output.
+
+    Attributes
+    ----------
+    worlds:
+        World entries: bundled catalog names, floor-plan files (map_server ``.yaml``, Stage ``.world``,
+        HouseExpo ``.json``), or folders, which expand to the floor plans inside them (sorted).
+    sim, slam, explore, termination, coverage_stride:
+        The trial's settings (:class:`slamtrials.trial.TrialConfig`).
+    metric:
+        Relation sampling of each run.
+    runs:
+        The run-count rule.
+    seed:
+        Root seed; each (world, run index) gets its own stream (:mod:`slamtrials.campaign.seeds`).
+    output:
+        Campaign folder (``--out`` on the command line overrides it).
+    replay_of:
+        Set by ``slamtrials campaign replay``: the campaign whose recorded runs were re-evaluated.
+    """
+
+    model_config = _MODEL_CONFIG
+
+    worlds: list[str] = Field(min_length=1, description="bundled world names, floor-plan files or folders of them")
+    sim: SimConfig = Field(default_factory=SimConfig, description="simulated robot, laser and odometry")
+    slam: SlamSettings = Field(default_factory=SlamSettings, description="the SLAM algorithm under test")
+    explore: ExploreConfig = Field(default_factory=ExploreConfig, description="frontier explorer (its robot limits come from sim)")
+    termination: TerminationConfig = Field(default_factory=TerminationConfig, description="when a run ends: the paper's map snapshot rule and a time cap")
+    coverage_stride: int = Field(5, ge=1, le=1000, description="frames between scans traced for the observed area")
+    metric: MetricSettings = Field(default_factory=MetricSettings, description="relation sampling of each run")
+    runs: RunSettings = Field(default_factory=RunSettings, description="how many runs each world gets (paper Section III-C)")
+    seed: int = Field(0, ge=0, le=MAX_SEED, description="root seed of every random draw of the campaign")
+    output: str | None = Field(None, description="campaign folder; --out overrides it")
+    replay_of: str | None = Field(None, description="set by 'campaign replay': the campaign whose recorded runs are re-evaluated")
+
+    @model_validator(mode="after")
+    def _worlds_not_blank(self) -> "CampaignConfig":
+        for i, entry in enumerate(self.worlds):
+            if not entry.strip():
+                raise ValueError(f"worlds[{i}] is empty")
+        return self
+
+    def trial_config(self) -> TrialConfig:
+        """The :class:`~slamtrials.trial.TrialConfig` of every run of the campaign."""
+        return TrialConfig(sim=self.sim, slam=self.slam, explore=self.explore, termination=self.termination,
+                           coverage_stride=self.coverage_stride)
+
+    def identity(self) -> dict[str, Any]:
+        """The JSON form that decides whether two configs describe the same campaign (``output`` left out)."""
+        return self.model_dump(mode="json", exclude={"output"})
+
+    def digest(self) -> str:
+        """SHA-256 (hex) of :meth:`identity`, canonical JSON: a stored campaign only resumes with an equal one."""
+        text = json.dumps(self.identity(), sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+    @classmethod
+    def from_dict(cls, data: Any, *, source: str = "campaign config") -> "CampaignConfig":
+        """Validate a plain mapping (e.g. parsed YAML), including the SLAM algorithm's parameters.
+
+        Parameters
+        ----------
+        data:
+            The mapping.
+        source:
+            What to call it in error messages (e.g. the file name).
+
+        Raises
+        ------
+        ConfigError
+            One line: ``<source>: <field.path>: <problem> (got <value>)``, every problem joined by ``; ``.
+        """
+        if not isinstance(data, dict):
+            raise ConfigError(f"{source}: expected a mapping of settings, got {type(data).__name__}")
+        try:
+            config = cls.model_validate(data)
+        except ValidationError as exc:
+            raise ConfigError(f"{source}: " + "; ".join(_problem(err) for err in exc.errors())) from None
+        try:
+            config.slam.resolved()
+        except ConfigError as exc:
+            raise ConfigError(f"{source}: slam: {exc}") from None
+        return config
+
+    @classmethod
+    def from_yaml(cls, path: str | Path) -> "CampaignConfig":
+        """Read and validate a YAML campaign config.
+
+        Raises
+        ------
+        FormatError
+            Missing file or not YAML (naming the line).
+        ConfigError
+            A bad setting (naming the file, the field and the value).
+        """
+        from slamtrials.io.yamlfile import read_yaml_mapping
+
+        path = Path(path)
+        if path.is_dir():
+            raise FormatError(path, "is a folder; give a campaign config YAML file")
+        return cls.from_dict(read_yaml_mapping(path), source=str(path))
+
+
+def _problem(err: dict[str, Any]) -> str:
+    """One pydantic error as ``field.path: message (got value)``."""
+    field = ".".join(str(p) for p in err["loc"]) or "<root>"
+    if err.get("type") == "missing":
+        return f"{field}: required setting is missing"
+    value = err.get("input")
+    shown = repr(value)
+    if len(shown) > 80:
+        shown = shown[:77] + "..."
+    message = err["msg"].removeprefix("Value error, ")
+    return f"{field}: {message} (got {shown})"

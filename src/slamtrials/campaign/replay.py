@@ -1,0 +1,226 @@
+"""``replay_campaign``: evaluate another SLAM algorithm (or configuration) on a campaign's recorded runs.
+
+No simulation: for every done run of the source campaign, the recorded frames (laser, odometry, truth)
+are fed offline to the new algorithm, seeded like the trial's own SLAM stream (the second child of
+``SeedSequence(run seed)``, so replaying the original algorithm and parameters reproduces the original
+estimate), and the estimate is evaluated exactly as in the campaign (same relation sampling, same
+seed). Each replayed run becomes a complete run folder of the new campaign: ``frames.npz`` (the source
+frames with the new estimate), ``estimate.tum``, the new map, ``relations.txt``, ``errors.npz`` and a
+``run.json`` whose ``replay`` entry names the source run folder, the algorithm and its configuration.
+
+The new campaign's config is the source's with ``slam`` replaced and ``replay_of`` set to the source
+folder; its catalog has the same worlds and run indices. The run-count rule cannot add runs in a
+replay: a world whose errors under the new algorithm would need more runs than were recorded is
+reported as ``short``. Note that the robot's paths are those it explored with the first algorithm's
+maps (:data:`~slamtrials.campaign.events.REPLAY_NOTE`); the output says so.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from slamtrials.campaign.cluster import check_workers, dask_client
+from slamtrials.campaign.config import CampaignConfig, MetricSettings
+from slamtrials.campaign.driver import Plan, drive
+from slamtrials.campaign.events import REPLAY_NOTE, CampaignEvent, CampaignResult
+from slamtrials.campaign.execute import result_notes
+from slamtrials.campaign.folder import campaign_lock, check_campaign_folder, open_campaign, prepare_resume
+from slamtrials.campaign.loop import next_step
+from slamtrials.campaign.runfiles import publish_run
+from slamtrials.campaign.score import score_run
+from slamtrials.campaign.store import CampaignStore, WorldInfo
+from slamtrials.campaign.summary import summarize_store, write_summary_csv
+from slamtrials.campaign.task import failure, outcome, write_scored_run
+from slamtrials.errors import ConfigError, SlamtrialsError
+from slamtrials.record import Frame, RunRecord
+from slamtrials.trial import SlamSettings
+
+__all__ = ["replay_campaign", "ReplayTask", "replay_one", "replay_slam"]
+
+
+@dataclass(frozen=True)
+class ReplayTask:
+    """One recorded run to re-evaluate: where it is, where it goes, and with what.
+
+    Attributes
+    ----------
+    campaign:
+        Absolute path of the new campaign folder.
+    world, index, seed:
+        The run's world name, index and seed (as in the source campaign).
+    source:
+        Absolute path of the source run folder.
+    slam:
+        The new SLAM algorithm and parameters.
+    metric:
+        The relation sampling (the source campaign's).
+    extra:
+        Facts added to ``run.json`` under ``campaign``.
+    """
+
+    campaign: str
+    world: str
+    index: int
+    seed: int
+    source: str
+    slam: SlamSettings
+    metric: MetricSettings
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+def replay_slam(record: RunRecord, slam: SlamSettings, seed: int) -> RunRecord:
+    """Run ``slam`` over every frame of ``record``; return the record with the new ``estimate`` and ``map``.
+
+    The algorithm's random stream is the second child of ``SeedSequence(seed)``, as in
+    :func:`slamtrials.trial.run_trial`.
+
+    Raises
+    ------
+    ConfigError
+        A bad configuration, or an algorithm whose trajectory does not hold one pose per frame.
+    """
+    from slamtrials.slam import get_algorithm
+
+    config = slam.resolved()
+    algorithm = get_algorithm(slam.algorithm)(config, dict(record.laser))
+    sequence = np.random.SeedSequence(int(seed))
+    _, slam_seed = sequence.spawn(2)
+    algorithm.reset(np.random.default_rng(slam_seed))
+    for k in range(len(record)):
+        algorithm.process(Frame(t=float(record.t[k]), ranges=record.scans[k], odometry=record.odometry[k],
+                                truth=record.truth[k], stalled=bool(record.stalled[k])))
+    trajectory = algorithm.trajectory()
+    if len(trajectory) != len(record) or not np.array_equal(trajectory.t, record.t):
+        raise ConfigError(f"SLAM algorithm {slam.algorithm!r} returned {len(trajectory)} poses for {len(record)} frames")
+    metadata = dict(record.metadata)
+    metadata["slam_config"] = config.model_dump(mode="json")
+    return RunRecord(t=record.t, scans=record.scans, odometry=record.odometry, truth=record.truth, stalled=record.stalled,
+                     laser=record.laser, metadata=metadata, estimate=trajectory.poses, map=algorithm.occupancy())
+
+
+def replay_one(task: ReplayTask) -> dict[str, Any]:
+    """Re-evaluate one recorded run (see the module docstring); return what the driver records."""
+    from slamtrials.io.runfolder import read_run
+
+    started = time.perf_counter()
+    try:
+        source = read_run(task.source)
+        record = replay_slam(source, task.slam, task.seed)
+        score = score_run(record, task.seed, task.metric)
+    except SlamtrialsError as exc:
+        return failure(task.world, task.index, exc)
+    record.metadata["replay"] = {"source_run": task.source, "algorithm": task.slam.algorithm, "preset": task.slam.preset,
+                                 "params": dict(task.slam.params), "wall_time_s": time.perf_counter() - started,
+                                 "note": REPLAY_NOTE}
+    record.metadata["campaign"] = {"world": task.world, "index": task.index, "seed": task.seed, "eps_t": score.eps_t,
+                                   "eps_r": score.eps_r, "relations": int(score.sampled.count),
+                                   "metric": task.metric.model_dump(mode="json"), **task.extra}
+    publish_run(task.campaign, task.world, task.index, lambda folder: write_scored_run(folder, record, score))
+    return outcome(task.world, task.index, record, score, started)
+
+
+class ReplayPlanner:
+    """Every recorded run once; then the run-count rule's verdict on the new errors (no runs added)."""
+
+    def __init__(self, config: CampaignConfig, folder: Path, source: Path, recorded: dict[str, dict[int, tuple[int, str]]]):
+        self.config = config
+        self.folder = folder
+        self.source = source
+        self.recorded = recorded
+
+    def plan(self, world: WorldInfo, results: dict[int, tuple[float, float]]) -> Plan:
+        recorded = self.recorded.get(world.name, {})
+        missing = tuple(i for i in sorted(recorded) if i not in results)
+        if missing:
+            return Plan(len(recorded), missing, None, None)
+        step = next_step(results, self.config.runs)
+        if step.finished:
+            return Plan(step.target, (), "capped" if step.capped else "done", step.decision)
+        note = (f"short of runs: the rule asks for {step.target} runs (runs {', '.join(map(str, step.missing[:5]))}"
+                f"{'...' if len(step.missing) > 5 else ''} missing) but the source campaign recorded {len(recorded)}")
+        return Plan(step.target, (), "short", step.decision, note)
+
+    def task(self, world: WorldInfo, index: int) -> tuple[Callable[[Any], dict], ReplayTask, int]:
+        seed, folder = self.recorded[world.name][index]
+        task = ReplayTask(str(self.folder), world.name, index, seed, str(self.source / folder), self.config.slam, self.config.metric,
+                          extra={"root_seed": self.config.seed, "replay_of": str(self.source)})
+        return replay_one, task, seed
+
+
+def _recorded_runs(store: CampaignStore) -> dict[str, dict[int, tuple[int, str]]]:
+    """``{world: {index: (seed, folder)}}`` of the source's done runs, each checked to be complete."""
+    from slamtrials.io.runfolder import RUN_FILE
+
+    recorded: dict[str, dict[int, tuple[int, str]]] = {w.name: {} for w in store.worlds()}
+    for run in store.runs():
+        if run.status != "done":
+            continue
+        folder = run.folder or f"runs/{run.world}/{run.idx:03d}"
+        if not (store.folder / folder / RUN_FILE).is_file():
+            raise ConfigError(f"{store.folder / folder}: recorded run {run.world} #{run.idx} is missing its run folder")
+        recorded[run.world][run.idx] = (run.seed, folder)
+    return recorded
+
+
+def replay_campaign(source: str | Path, folder: str | Path, algorithm: str, preset: str | None = None,
+                    params: dict[str, Any] | None = None, *, scheduler: Any = None, workers: int | None = None,
+                    on_event: Callable[[CampaignEvent], None] | None = None) -> CampaignResult:
+    """Re-evaluate the recorded runs of campaign ``source`` with ``algorithm`` into a new campaign ``folder``.
+
+    Calling it again with the same arguments resumes an interrupted replay.
+
+    Parameters
+    ----------
+    source:
+        Folder of the campaign whose runs are replayed.
+    folder:
+        Folder of the new (replay) campaign.
+    algorithm, preset, params:
+        The SLAM algorithm, its preset (None: its defaults) and parameter overrides.
+    scheduler, workers, on_event:
+        As for :func:`slamtrials.campaign.run_campaign`.
+
+    Returns
+    -------
+    CampaignResult
+        Its ``notes`` start with :data:`~slamtrials.campaign.events.REPLAY_NOTE`.
+
+    Raises
+    ------
+    ConfigError
+        ``source`` is not a campaign, a recorded run folder is missing, a bad algorithm or parameter, or
+        ``folder`` holds something else; before any work starts.
+    """
+    started = time.perf_counter()
+    if scheduler is None:
+        check_workers(workers)
+    source = Path(source).absolute()
+    folder = Path(folder).absolute()
+    if folder == source:
+        raise ConfigError(f"{folder}: the replay needs its own folder, not the source campaign's")
+    with CampaignStore.open(source) as src:
+        base = src.config()
+        worlds = src.world_infos()
+        recorded = _recorded_runs(src)
+    data = base.model_dump(mode="json")
+    data.update(slam={"algorithm": algorithm, "preset": preset, "params": dict(params or {})}, replay_of=str(source),
+                output=str(folder))
+    config = CampaignConfig.from_dict(data, source="replay")
+
+    check_campaign_folder(folder, config, worlds, kind="replay")  # before starting a cluster; touches nothing
+    planner = ReplayPlanner(config, folder, source, recorded)
+    with dask_client(scheduler, workers, allowed_failures=config.runs.retries) as client:
+        store = open_campaign(folder, config, worlds, kind="replay")
+        with store, campaign_lock(folder):
+            prepare_resume(store)
+            counts = drive(store, client, worlds, planner, retries=config.runs.retries, on_event=on_event, prefix="replay")
+            summary = summarize_store(store)
+            csv_path = write_summary_csv(folder, summary, config.runs.confidence)
+    return CampaignResult(folder, tuple(summary), csv_path, counts.done, counts.failed, time.perf_counter() - started,
+                          (REPLAY_NOTE, *result_notes(summary)))

@@ -1,0 +1,115 @@
+"""The per-world summary of a campaign, like the paper's Table I, read from the catalog.
+
+For each world: its status, the runs done, the mean and standard deviation of the per-run errors
+``eps_t`` (m) and ``eps_r`` (rad), their confidence intervals (:func:`slamtrials.metric.environment_stats`
+at the run-count rule's confidence and distribution), whether the cap stopped it, and how its runs
+ended. :func:`write_summary_csv` saves it as ``summary.csv`` (atomically).
+
+CSV columns: ``world, status, runs, runs_needed, capped, eps_t_mean, eps_t_std, eps_t_std_population,
+eps_t_ci_low, eps_t_ci_high, eps_r_mean, eps_r_std, eps_r_std_population, eps_r_ci_low, eps_r_ci_high,
+confidence, failed_runs, terminations`` (``std`` has divisor ``n - 1``, ``std_population`` divisor ``n``
+as printed in the paper; empty cells where a value is undefined; ``terminations`` as
+``reason:count;...``).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+
+from slamtrials.atomicfile import atomic_write_text
+from slamtrials.campaign.store import CampaignStore
+from slamtrials.metric.stats import EnvironmentStats, environment_stats
+
+__all__ = ["WorldSummary", "summarize_store", "load_summary", "write_summary_csv", "SUMMARY_FILE", "CSV_COLUMNS"]
+
+SUMMARY_FILE = "summary.csv"
+CSV_COLUMNS = ("world", "status", "runs", "runs_needed", "capped", "eps_t_mean", "eps_t_std", "eps_t_std_population",
+               "eps_t_ci_low", "eps_t_ci_high", "eps_r_mean", "eps_r_std", "eps_r_std_population", "eps_r_ci_low",
+               "eps_r_ci_high", "confidence", "failed_runs", "terminations")
+
+
+@dataclass(frozen=True)
+class WorldSummary:
+    """One row of the summary.
+
+    Attributes
+    ----------
+    world, status:
+        Campaign name and status (pending, running, done, capped, failed, short).
+    runs:
+        Done runs.
+    runs_needed:
+        Runs the rule asked for at its last decision (None before the first).
+    capped:
+        The cap stopped the world before the margins were reached.
+    eps_t, eps_r:
+        Statistics of the per-run errors (m, rad); None without runs.
+    failed_runs:
+        Runs that failed.
+    terminations:
+        ``{termination reason: runs}``.
+    note:
+        The world's note (why it failed, why a replay is short).
+    """
+
+    world: str
+    status: str
+    runs: int
+    runs_needed: int | None
+    capped: bool
+    eps_t: EnvironmentStats | None
+    eps_r: EnvironmentStats | None
+    failed_runs: int
+    terminations: dict[str, int]
+    note: str | None = None
+
+
+def summarize_store(store: CampaignStore) -> list[WorldSummary]:
+    """The summary rows of every world of ``store``, in campaign order."""
+    settings = store.config().runs
+    rows = []
+    runs = store.runs()
+    for world in store.worlds():
+        mine = [r for r in runs if r.world == world.name]
+        done = [r for r in mine if r.status == "done"]
+        stats_t = stats_r = None
+        if done:
+            stats_t = environment_stats([r.eps_t for r in done], confidence=settings.confidence, distribution=settings.distribution)
+            stats_r = environment_stats([r.eps_r for r in done], confidence=settings.confidence, distribution=settings.distribution)
+        reasons = Counter(r.termination or "unknown" for r in done)
+        rows.append(WorldSummary(world.name, world.status, len(done), world.runs_needed, bool(world.capped), stats_t, stats_r,
+                                 sum(r.status == "failed" for r in mine), dict(sorted(reasons.items())), world.note))
+    return rows
+
+
+def load_summary(folder: str | Path) -> list[WorldSummary]:
+    """The summary of the campaign in ``folder`` (read from its catalog)."""
+    with CampaignStore.open(folder) as store:
+        return summarize_store(store)
+
+
+def _number(value: float | None) -> str:
+    return "" if value is None or (isinstance(value, float) and math.isnan(value)) else repr(float(value))
+
+
+def _stats_cells(stats: EnvironmentStats | None) -> list[str]:
+    if stats is None:
+        return [""] * 5
+    return [_number(stats.mean), _number(stats.std_sample), _number(stats.std_population), _number(stats.ci_low), _number(stats.ci_high)]
+
+
+def write_summary_csv(folder: str | Path, rows: list[WorldSummary], confidence: float) -> Path:
+    """Write ``<folder>/summary.csv`` atomically and return its path."""
+    text = io.StringIO()
+    writer = csv.writer(text, lineterminator="\n")
+    writer.writerow(CSV_COLUMNS)
+    for row in rows:
+        terminations = ";".join(f"{k}:{v}" for k, v in row.terminations.items())
+        writer.writerow([row.world, row.status, row.runs, "" if row.runs_needed is None else row.runs_needed, int(row.capped),
+                         *_stats_cells(row.eps_t), *_stats_cells(row.eps_r), repr(confidence), row.failed_runs, terminations])
+    return atomic_write_text(Path(folder) / SUMMARY_FILE, text.getvalue())

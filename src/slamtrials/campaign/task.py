@@ -1,0 +1,142 @@
+"""One run of a campaign, as executed on a Dask worker: trial, evaluation, run folder.
+
+:func:`run_one` takes a :class:`RunTask` (everything the run needs, small and picklable), loads the
+world (cached per worker process), runs the trial (:func:`slamtrials.trial.run_trial`, or the injected
+``trial_fn``), evaluates it (:func:`slamtrials.campaign.score.score_run`) and publishes the run folder
+atomically (:func:`slamtrials.campaign.runfiles.publish_run`):
+
+``run.json`` (written last), ``frames.npz``, ``estimate.tum``, ``map.yaml``/``map.pgm``/``map.png``,
+``relations.txt`` (the sampled relations) and ``errors.npz`` (their errors). ``run.json`` also holds,
+under ``campaign``, the world, run index, seed, ``eps_t``, ``eps_r`` and the metric settings, besides the
+trial's own metadata (resolved trial config, termination reason, timings).
+
+It returns a plain dict that the driver stores. Errors that are properties of the run (a
+:class:`~slamtrials.errors.SlamtrialsError`, e.g. a start pose in a wall) come back as
+``{"status": "failed", ...}``; anything else (a bug, a lost worker) propagates so that Dask retries it.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from slamtrials.campaign.config import MetricSettings
+from slamtrials.campaign.runfiles import publish_run, relative_run_folder
+from slamtrials.campaign.score import RunScore, score_run
+from slamtrials.campaign.worldset import load_world_cached
+from slamtrials.errors import SlamtrialsError
+from slamtrials.record import RunRecord
+from slamtrials.trial import TrialConfig
+from slamtrials.worlds import World
+
+__all__ = ["RunTask", "TrialFn", "run_one", "write_scored_run", "worker_name", "outcome", "failure"]
+
+#: A trial: ``(world, config, seed) -> RunRecord`` with ``estimate`` [T, 3]; :func:`slamtrials.trial.run_trial` by default.
+TrialFn = Callable[[World, TrialConfig, int], RunRecord]
+
+
+@dataclass(frozen=True)
+class RunTask:
+    """Everything one run needs.
+
+    Attributes
+    ----------
+    campaign:
+        Absolute path of the campaign folder (shared by the driver and the workers).
+    world, ref:
+        The world's campaign name and what loads it (catalog name or absolute file).
+    index, seed:
+        Run index within the world (0-based) and the run's seed (:func:`slamtrials.campaign.seeds.run_seed`).
+    trial:
+        The trial's settings.
+    metric:
+        The relation sampling.
+    trial_fn:
+        The trial function; None means :func:`slamtrials.trial.run_trial`.
+    extra:
+        Facts added to ``run.json`` under ``campaign``.
+    """
+
+    campaign: str
+    world: str
+    ref: str
+    index: int
+    seed: int
+    trial: TrialConfig
+    metric: MetricSettings
+    trial_fn: TrialFn | None = None
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+def worker_name() -> str:
+    """``host:pid`` of the process running the task."""
+    return f"{socket.gethostname()}:{os.getpid()}"
+
+
+def write_scored_run(folder: Path, record: RunRecord, score: RunScore) -> None:
+    """Write relations, errors, then the run folder (``run.json`` last) into ``folder``."""
+    from slamtrials.io.errorsfile import write_errors
+    from slamtrials.io.relations import write_relations
+    from slamtrials.io.runfolder import write_run
+
+    write_relations(folder / "relations.txt", score.sampled.relations)
+    write_errors(folder / "errors.npz", score.sampled.relations, score.sampled.errors)
+    write_run(folder, record)
+
+
+def outcome(task_world: str, index: int, record: RunRecord, score: RunScore, started: float) -> dict[str, Any]:
+    """The result dict the driver stores for a done run."""
+    trial = record.metadata.get("trial", {}) if isinstance(record.metadata.get("trial"), dict) else {}
+    sampled = score.sampled
+    return {
+        "status": "done",
+        "world": task_world,
+        "index": index,
+        "eps_t": score.eps_t,
+        "eps_r": score.eps_r,
+        "relations": int(sampled.count),
+        "termination": trial.get("termination_reason"),
+        "mapped_fraction": trial.get("mapped_fraction"),
+        "sim_duration": float(record.t[-1] - record.t[0]) if len(record) else 0.0,
+        "wall_time": time.perf_counter() - started,
+        "worker": worker_name(),
+        "folder": relative_run_folder(task_world, index),
+        "details": {
+            "frames": len(record),
+            "distance_m": trial.get("distance_m"),
+            "observed_fraction": trial.get("observed_fraction"),
+            "slam_updates": trial.get("slam_updates"),
+            "relation_std_t": sampled.std_t,
+            "relation_std_r": sampled.std_r,
+            "relations_capped": bool(sampled.capped),
+        },
+    }
+
+
+def failure(world: str, index: int, exc: BaseException) -> dict[str, Any]:
+    """The result dict of a run that failed for a reason of its own (not retried)."""
+    return {"status": "failed", "world": world, "index": index, "error": f"{type(exc).__name__}: {exc}", "worker": worker_name()}
+
+
+def run_one(task: RunTask) -> dict[str, Any]:
+    """Run, evaluate and store one run (see the module docstring); return what the driver records."""
+    from slamtrials.trial import run_trial
+
+    started = time.perf_counter()
+    try:
+        world = load_world_cached(task.ref)
+        trial_fn = task.trial_fn or run_trial
+        record = trial_fn(world, task.trial, task.seed)
+        score = score_run(record, task.seed, task.metric)
+    except SlamtrialsError as exc:
+        return failure(task.world, task.index, exc)
+    record.metadata["campaign"] = {"world": task.world, "ref": task.ref, "index": task.index, "seed": task.seed,
+                                   "eps_t": score.eps_t, "eps_r": score.eps_r, "relations": int(score.sampled.count),
+                                   "metric": task.metric.model_dump(mode="json"), **task.extra}
+    publish_run(task.campaign, task.world, task.index, lambda folder: write_scored_run(folder, record, score))
+    return outcome(task.world, task.index, record, score, started)

@@ -1,0 +1,211 @@
+"""``slamtrials campaign``: run, resume, watch and replay campaigns (thin wrappers over slamtrials.campaign).
+
+* ``campaign run CONFIG.yaml --out DIR [--scheduler ADDRESS] [--workers N]``: run a campaign; the same
+  command, or ``campaign run --out DIR`` without a config, resumes an interrupted one.
+* ``campaign status DIR``: progress and the summary so far.
+* ``campaign replay DIR --algorithm NAME [--preset P] [--set key=value ...] --out NEW``: evaluate
+  another SLAM algorithm or configuration on the recorded runs of DIR, without simulating.
+
+The end of ``run`` and ``replay`` is the per-world table (the paper's Table I: runs, mean and standard
+deviation of eps_t and eps_r, confidence intervals), also saved as ``DIR/summary.csv``.
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from slamtrials.cli.main import make_app, make_console
+from slamtrials.errors import ConfigError
+
+__all__ = ["app", "register", "summary_table", "EXIT_INTERRUPTED"]
+
+app = make_app(help="Run, resume, watch and replay campaigns: repeat runs until every world's error is known.")
+
+EXIT_INTERRUPTED = 130
+
+SchedulerOpt = Annotated[str | None, typer.Option("--scheduler", help="Address of a running Dask scheduler (e.g. tcp://host:8786); default: a local cluster.")]
+WorkersOpt = Annotated[int | None, typer.Option("--workers", "-j", help="Worker processes of the local cluster (default: one per core).")]
+
+
+def _quiet_dask() -> None:
+    """Dask's loggers log at INFO by default; follow the root logger's level instead (``-v`` shows them)."""
+    import distributed  # noqa: F401  (its import applies dask's logging config, which we then override)
+
+    level = logging.getLogger().getEffectiveLevel()
+    if level > logging.INFO:
+        for name in ("distributed", "dask"):
+            logging.getLogger(name).setLevel(level)
+
+
+def _fmt(value: float | None, digits: int = 3) -> str:
+    return "-" if value is None or value != value else f"{value:.{digits}f}"
+
+
+def summary_table(rows, confidence: float, title: str):
+    """A rich Table of summary rows (:class:`slamtrials.campaign.WorldSummary`), the paper's Table I."""
+    from rich.table import Table
+
+    pct = f"{100 * confidence:g} %"
+    table = Table(title=title, caption=f"eps_t in m, eps_r in rad: mean and sample std over the runs; "
+                                       f"+-: half width of the {pct} confidence interval of the mean")
+    table.add_column("world", no_wrap=True)
+    table.add_column("status")
+    table.add_column("runs", justify="right")
+    for column in ("eps_t", "std", "+-", "eps_r", "std", "+-"):
+        table.add_column(column, justify="right", no_wrap=True)
+    table.add_column("runs ended by")
+    for row in rows:
+        cells = []
+        for stats in (row.eps_t, row.eps_r):
+            if stats is None:
+                cells += ["-", "-", "-"]
+            else:
+                digits = 3 if stats is row.eps_t else 4
+                cells += [_fmt(stats.mean, digits), _fmt(stats.std_sample, digits), _fmt(stats.half_width, digits)]
+        needed = f"/{row.runs_needed}" if row.runs_needed is not None and row.runs_needed > row.runs else ""
+        reasons = ", ".join(f"{k} {v}" for k, v in row.terminations.items())
+        table.add_row(row.world, row.status, f"{row.runs}{needed}", *cells, reasons)
+    return table
+
+
+class _Progress:
+    """Progress bars per world, fed by campaign events; a line per finished world when not a terminal."""
+
+    def __init__(self, console):
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+        self.console = console
+        self.progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                                 TextColumn("{task.fields[status]}"), TimeElapsedColumn(), console=console,
+                                 disable=not console.is_terminal)
+        self.tasks: dict[str, int] = {}
+
+    def __enter__(self):
+        self.progress.__enter__()
+        return self
+
+    def __exit__(self, *exc):
+        self.progress.__exit__(*exc)
+
+    def __call__(self, event) -> None:
+        task = self.tasks.get(event.world)
+        if task is None:
+            task = self.tasks[event.world] = self.progress.add_task(event.world, total=max(event.target, event.done), status="")
+        total = max(event.target, event.done)
+        if event.kind == "run_failed":
+            self.progress.update(task, completed=event.done, total=total, status=f"run {event.index} failed")
+        elif event.kind == "world_done":
+            self.progress.update(task, completed=event.done, total=event.done if event.status != "short" else total, status=event.status)
+            self.console.print(f"{event.world}: {event.status} with {event.done} runs"
+                               f"{' (' + event.message + ')' if event.message else ''}", highlight=False, soft_wrap=True)
+        else:
+            status = "running" if event.kind != "start" else (event.status or "")
+            self.progress.update(task, completed=event.done, total=total, status=status)
+
+
+def _finish(console, result, config_confidence: float, title: str) -> None:
+    console.print(summary_table(result.summary, config_confidence, title))
+    for note in result.notes:
+        console.print(f"note: {note}", highlight=False, soft_wrap=True)
+    console.print(f"{result.runs_done} runs done ({result.runs_failed} failed) in {result.wall_time:.0f} s; "
+                  f"summary: {result.summary_csv}", highlight=False, soft_wrap=True)
+
+
+@app.command("run")
+def run(
+    config: Annotated[Path | None, typer.Argument(help="Campaign config YAML ('slamtrials config dump' prints one); omit to resume --out.")] = None,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="Campaign folder (default: 'output' of the config); an existing one is resumed.")] = None,
+    scheduler: SchedulerOpt = None,
+    workers: WorkersOpt = None,
+) -> None:
+    """Run a campaign: per world, repeat runs until its mean errors are known (or resume one)."""
+    from slamtrials.campaign import CampaignConfig, run_campaign
+    from slamtrials.campaign.store import CampaignStore, is_campaign
+
+    if config is None and out is None:
+        raise ConfigError("give a campaign config, or --out DIR of a campaign to resume")
+    campaign_config = CampaignConfig.from_yaml(config) if config is not None else None
+    if campaign_config is None and not is_campaign(out):
+        raise ConfigError(f"{out}: not a campaign folder (campaign.sqlite missing); give a config to start one")
+    if campaign_config is None:
+        with CampaignStore.open(out) as store:
+            confidence = store.config().runs.confidence
+    else:
+        confidence = campaign_config.runs.confidence
+    _quiet_dask()
+    console = make_console()
+    folder = out or (Path(campaign_config.output) if campaign_config and campaign_config.output else None)
+    try:
+        with _Progress(console) as progress:
+            result = run_campaign(campaign_config, out, scheduler=scheduler, workers=workers, on_event=progress)
+    except KeyboardInterrupt:
+        typer.echo(f"interrupted; resume with: slamtrials campaign run --out {folder}", err=True)
+        raise typer.Exit(EXIT_INTERRUPTED) from None
+    _finish(console, result, confidence, f"Campaign {result.folder}")
+
+
+@app.command("status")
+def status(folder: Annotated[Path, typer.Argument(help="Campaign folder.")]) -> None:
+    """Show a campaign's progress: per world, its status, runs done and needed, and the errors so far."""
+    from rich.table import Table
+
+    from slamtrials.campaign import campaign_status
+
+    state = campaign_status(folder)
+    console = make_console()
+    config = state.config
+    what = f"replay of {config.replay_of}" if state.kind == "replay" else "campaign"
+    console.print(f"{folder}: {what}, algorithm {config.slam.algorithm} (preset {config.slam.preset}), seed {config.seed}, "
+                  f"runs: initial {config.runs.initial}, cap {config.runs.max_runs}, margins {config.runs.margin_t:g} m / "
+                  f"{config.runs.margin_r:g} rad at {100 * config.runs.confidence:g} %; created {state.created}",
+                  highlight=False, soft_wrap=True)
+    table = Table(title="Progress")
+    for column, justify in (("world", "left"), ("status", "left"), ("done", "right"), ("needed", "right"),
+                            ("running", "right"), ("failed", "right"), ("note", "left")):
+        table.add_column(column, justify=justify)
+    for world in state.worlds:
+        counts = state.runs.get(world.name, {})
+        table.add_row(world.name, world.status, str(counts.get("done", 0)), "-" if world.runs_target is None else str(world.runs_target),
+                      str(counts.get("running", 0)), str(counts.get("failed", 0)), world.note or "")
+    console.print(table)
+    console.print(summary_table(state.summary, config.runs.confidence, "Errors so far"))
+    console.print(f"{state.runs_done} runs done; {'finished' if state.finished else 'not finished'}", highlight=False)
+
+
+@app.command("replay")
+def replay(
+    source: Annotated[Path, typer.Argument(help="Folder of the campaign whose recorded runs are re-evaluated.")],
+    algorithm: Annotated[str, typer.Option("--algorithm", "-a", help="SLAM algorithm to evaluate (built-in: gmapping, odometry).")],
+    out: Annotated[Path, typer.Option("--out", "-o", help="Folder of the new campaign (an existing replay is resumed).")],
+    preset: Annotated[str | None, typer.Option("--preset", "-p", help="Named parameter set of the algorithm.")] = None,
+    settings: Annotated[list[str] | None, typer.Option("--set", help="Parameter override key=value (value read as YAML); repeatable.")] = None,
+    scheduler: SchedulerOpt = None,
+    workers: WorkersOpt = None,
+) -> None:
+    """Evaluate another SLAM algorithm or configuration on a campaign's recorded runs, with no simulation."""
+    from slamtrials.campaign import REPLAY_NOTE, replay_campaign
+    from slamtrials.campaign.store import CampaignStore
+    from slamtrials.cli.slam import parse_settings
+
+    params = parse_settings(settings or [])
+    with CampaignStore.open(source) as store:
+        confidence = store.config().runs.confidence
+    _quiet_dask()
+    console = make_console()
+    console.print(f"note: {REPLAY_NOTE}", highlight=False, soft_wrap=True)
+    try:
+        with _Progress(console) as progress:
+            result = replay_campaign(source, out, algorithm, preset, params, scheduler=scheduler, workers=workers, on_event=progress)
+    except KeyboardInterrupt:
+        typer.echo("interrupted; resume with the same command", err=True)
+        raise typer.Exit(EXIT_INTERRUPTED) from None
+    _finish(console, result, confidence, f"Replay of {source} with {algorithm}")
+
+
+def register(root: typer.Typer) -> None:
+    """Add the ``campaign`` command group to ``root``."""
+    root.add_typer(app, name="campaign", help="Run, resume, watch and replay campaigns.")

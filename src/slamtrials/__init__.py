@@ -28,6 +28,13 @@ _PUBLIC = {
     "write_run": "slamtrials.io.runfolder",
     "read_run": "slamtrials.io.runfolder",
     "SlamtrialsError": "slamtrials.errors",
+    "make_algorithm": "slamtrials.slam",
+    "run_trial": "slamtrials.trial",
+    "TrialConfig": "slamtrials.trial",
+    "CampaignConfig": "slamtrials.campaign",
+    "run_campaign": "slamtrials.campaign",
+    "replay_campaign": "slamtrials.campaign",
+    "campaign_status": "slamtrials.campaign",
 }
 
 __all__ = ["__version__", *_PUBLIC]

@@ -21,19 +21,19 @@ from slamtrials.explore.planner import PlanResult, dijkstra
 from slamtrials.explore.termination import SnapshotTermination, snapshot_mse
 
 __all__ = [
-    "Explorer",
+    "Costmap",
     "ExploreConfig",
     "ExploreStats",
+    "Explorer",
+    "FollowCommand",
+    "Frontiers",
+    "GridFrame",
+    "PathFollower",
+    "PlanResult",
     "SnapshotTermination",
     "TerminationConfig",
-    "Costmap",
     "build_costmap",
-    "Frontiers",
-    "find_frontiers",
-    "PlanResult",
     "dijkstra",
-    "PathFollower",
-    "FollowCommand",
-    "GridFrame",
+    "find_frontiers",
     "snapshot_mse",
 ]

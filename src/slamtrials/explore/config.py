@@ -49,10 +49,24 @@ class ExploreConfig(BaseModel):
     be reached through unknown space (a room seen through a gap narrower than the robot, a laser ray
     leaking out of the building) counts as unreachable at once instead of costing a 30 s timeout.
 
+    Planning is local first: a goal is searched in a window of half-size ``local_radius`` around the
+    robot, which is the closest one in the whole map if the search settles it before reaching the
+    window's edge; otherwise the whole map is searched. While the robot heads for a goal outside the
+    window, the path found is kept (checked against each new local costmap) and the whole map is
+    searched again only every ``global_replan_period``.
+
+    Last resorts, when no frontier is reachable: if the robot is shut in (it reaches less than
+    ``shut_in_share`` of the passable cells), a plan with the lethal margin ``relaxed_margin`` (for
+    frontiers behind passages that only look too narrow), then view points within
+    ``view_distance`` of frontiers the robot cannot reach (off by default: in our trials they cost a
+    lot of time for little map).
+
     Recovery: the robot is stuck when, over ``stuck_time``, it moved less than ``stuck_ratio`` of what
-    it was commanded to move (the simulator stops the robot on a collision), or when the laser kept it
-    from moving forward for ``blocked_time``. It then backs off ``backoff_distance`` and turns
-    ``recovery_turn`` towards the more open side, and replans.
+    it was commanded to move (the simulator stops the robot on a collision), when it has followed a
+    path for ``idle_time`` without getting ``idle_distance`` away, when the caller reported
+    ``stall_steps`` collisions in a row, or when the laser kept it from moving forward for
+    ``blocked_time``. It then moves away from the obstacle it touches (or backs off
+    ``backoff_distance`` and turns ``recovery_turn`` towards the more open side), and replans.
     """
 
     model_config = _MODEL_CONFIG
@@ -60,6 +74,8 @@ class ExploreConfig(BaseModel):
     # --- robot and costmap ---------------------------------------------------------------------------
     robot_radius: float = Field(0.15, gt=0.0, le=5.0, description="footprint disc radius (m)")
     inflation_margin: float = Field(0.05, ge=0.0, le=5.0, description="lethal margin added to the radius (m)")
+    relaxed_margin: float = Field(0.0, ge=0.0, le=5.0, description="lethal margin of the last-resort plan through narrow passages (m)")
+    shut_in_share: float = Field(0.5, ge=0.0, le=1.0, description="plan through narrow passages only when the robot reaches less than this share of the passable cells")
     wall_cost: float = Field(10.0, ge=0.0, le=100.0, description="extra cost factor at the edge of the lethal zone")
     cost_decay_distance: float = Field(0.25, gt=0.0, le=10.0, description="decay length of the wall cost (m)")
     unknown_traversable: bool = Field(False, description="let paths cross unknown cells (at unknown_cost)")
@@ -68,6 +84,7 @@ class ExploreConfig(BaseModel):
     escape_cost: float = Field(50.0, ge=1.0, le=100.0, description="cost factor of crossing a lethal cell while escaping")
     # --- frontiers -----------------------------------------------------------------------------------
     min_frontier_length: float = Field(0.3, ge=0.0, le=100.0, description="smallest frontier kept: cells x resolution (m)")
+    view_distance: float = Field(0.0, ge=0.0, le=30.0, description="last resort: look at frontiers the robot cannot reach from reachable cells this close (m); 0 = never")
     min_unknown_area: float = Field(0.2, ge=0.0, le=1000.0, description="enclosed unknown pockets smaller than this make no frontier (m^2)")
     # --- motion limits and follower ------------------------------------------------------------------
     max_linear_speed: float = Field(0.7, gt=0.0, le=10.0, description="largest forward speed (m/s)")
@@ -77,9 +94,13 @@ class ExploreConfig(BaseModel):
     control_period: float = Field(0.1, gt=0.0, le=1.0, description="time between commands (s)")
     lookahead_distance: float = Field(0.6, gt=0.0, le=10.0, description="pure-pursuit look-ahead (m)")
     rotate_in_place_angle: float = Field(math.radians(50.0), gt=0.0, le=math.pi, description="heading error above which the robot turns in place (rad)")
+    narrow_speed: float = Field(0.25, gt=0.0, le=10.0, description="speed limit where the path's clearance is down to the lethal distance (m/s)")
+    narrow_clearance: float = Field(0.25, ge=0.0, le=10.0, description="clearance beyond the lethal distance from which full speed is allowed (m)")
     obstacle_margin: float = Field(0.03, ge=0.0, le=1.0, description="clearance added to the radius when checking the scan ahead (m)")
     stop_distance: float = Field(0.05, ge=0.0, le=2.0, description="distance kept from obstacles seen in the scan (m)")
     # --- goals ---------------------------------------------------------------------------------------
+    local_radius: float = Field(10.0, gt=0.0, le=1000.0, description="half-size of the window around the robot searched for a goal first (m)")
+    global_replan_period: float = Field(15.0, gt=0.0, le=3600.0, description="while heading for a goal outside that window, search the whole map this often (s)")
     replan_period: float = Field(3.0, gt=0.0, le=600.0, description="replan at least this often (s)")
     min_replan_interval: float = Field(1.0, ge=0.0, le=600.0, description="smallest time between event-driven replans (s)")
     goal_tolerance: float = Field(0.3, gt=0.0, le=10.0, description="a goal is reached within this distance (m)")
@@ -92,15 +113,18 @@ class ExploreConfig(BaseModel):
     # --- stuck detection and recovery ----------------------------------------------------------------
     stuck_time: float = Field(3.0, gt=0.0, le=600.0, description="window of the stuck test (s)")
     stuck_ratio: float = Field(0.3, gt=0.0, lt=1.0, description="stuck when moving less than this fraction of the commanded distance")
-    stuck_min_command: float = Field(0.3, gt=0.0, le=100.0, description="commanded distance over the window needed before the stuck test applies (m)")
+    stuck_min_command: float = Field(0.15, gt=0.0, le=100.0, description="commanded distance over the window needed before the stuck test applies (m)")
+    idle_time: float = Field(8.0, gt=0.0, le=600.0, description="recover after following a path this long without moving idle_distance (s)")
+    idle_distance: float = Field(0.1, gt=0.0, le=10.0, description="see idle_time (m)")
+    stall_steps: int = Field(3, ge=1, le=1000, description="recover after this many consecutive steps the caller reports as stalled (collisions)")
     blocked_time: float = Field(2.0, gt=0.0, le=600.0, description="recover after being held still by the scan this long (s)")
-    backoff_distance: float = Field(0.25, ge=0.0, le=5.0, description="distance backed off in a recovery (m)")
+    backoff_distance: float = Field(0.25, ge=0.0, le=5.0, description="distance moved away (or backed off) in a recovery (m)")
     backoff_speed: float = Field(0.15, gt=0.0, le=10.0, description="backing speed (m/s)")
-    recovery_turn: float = Field(math.radians(90.0), ge=0.0, le=2.0 * math.pi, description="turn in place after backing off (rad)")
+    recovery_turn: float = Field(math.radians(90.0), ge=0.0, le=2.0 * math.pi, description="turn in place after backing off, when not touching anything (rad)")
     max_recoveries_per_goal: int = Field(2, ge=1, le=100, description="blacklist a goal after this many recoveries on the way")
 
     @model_validator(mode="after")
-    def _consistent(self) -> "ExploreConfig":
+    def _consistent(self) -> ExploreConfig:
         if self.min_replan_interval > self.replan_period:
             raise ValueError(f"min_replan_interval ({self.min_replan_interval:g} s) must not exceed replan_period ({self.replan_period:g} s)")
         return self
@@ -111,7 +135,7 @@ class ExploreConfig(BaseModel):
         return self.robot_radius + self.inflation_margin
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> "ExploreConfig":
+    def from_dict(cls, data: dict[str, Any]) -> ExploreConfig:
         """Validate a plain dict; raise :class:`ConfigError` with a one-line message."""
         return _validate(cls, data, "explore")
 
@@ -145,6 +169,6 @@ class TerminationConfig(BaseModel):
     unknown_grey: int = Field(205, ge=0, le=255, description="grey level of unknown cells (ROS map_server's 205)")
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> "TerminationConfig":
+    def from_dict(cls, data: dict[str, Any]) -> TerminationConfig:
         """Validate a plain dict; raise :class:`ConfigError` with a one-line message."""
         return _validate(cls, data, "termination")

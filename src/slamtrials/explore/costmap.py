@@ -14,7 +14,7 @@ The distance transform is the separable exact algorithm of Felzenszwalb and Hutt
 numba (the same result as ``scipy.ndimage.distance_transform_edt``, several times faster on large maps,
 which matters because the explorer rebuilds its costmap at every replan). Squared distances are whole
 numbers of cells^2, so clearance and cost come from a table indexed by them (the wall term is dropped
-where it falls below 1e-4).
+where it falls below 0.01, i.e. beyond :func:`influence_distance`).
 """
 
 from __future__ import annotations
@@ -29,7 +29,16 @@ from numpy.typing import NDArray
 from slamtrials.explore.config import ExploreConfig
 from slamtrials.explore.gridframe import FREE_BELOW
 
-__all__ = ["Costmap", "build_costmap", "squared_distance_transform", "PASSABLE", "LETHAL", "UNKNOWN", "OCCUPIED"]
+__all__ = [
+    "LETHAL",
+    "OCCUPIED",
+    "PASSABLE",
+    "UNKNOWN",
+    "Costmap",
+    "build_costmap",
+    "influence_distance",
+    "squared_distance_transform",
+]
 
 #: Cell kinds of :attr:`Costmap.kind`.
 PASSABLE, LETHAL, UNKNOWN, OCCUPIED = 0, 1, 2, 3
@@ -94,8 +103,7 @@ def squared_distance_transform(target):  # pragma: no cover - compiled
                 run[c] = 0.0
             elif run[c] >= 0.0:
                 run[c] += 1.0
-                if run[c] < g[r, c]:
-                    g[r, c] = run[c]
+                g[r, c] = min(g[r, c], run[c])
     for r in range(height):
         for c in range(width):
             if g[r, c] < _FAR:
@@ -108,14 +116,25 @@ def squared_distance_transform(target):  # pragma: no cover - compiled
     return out
 
 
+#: The wall term of the cost is dropped where it falls below this.
+_NEGLIGIBLE = 0.01
+
+
+def influence_distance(config: ExploreConfig, resolution: float) -> float:
+    """Distance (m) from an obstacle beyond which it changes no cost: cells farther than this from the
+    edge of a window of the map have the same costs in the window's costmap as in the whole map's."""
+    cfg = config
+    return cfg.lethal_distance + cfg.cost_decay_distance * max(math.log(max(cfg.wall_cost, 1e-12) / _NEGLIGIBLE), 0.0) + 2 * resolution
+
+
 def _cost_table(resolution: float, lethal: float, wall_cost: float, decay: float) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
     """Clearance (m) and cost factor for every squared centre distance ``d2 = 0, 1, ..., n - 1`` (cells^2).
 
-    ``n`` is chosen so that beyond it the wall term is below 1e-4 of the base cost; the last entry
-    stands for every larger distance. Lethal entries cost ``inf``.
+    ``n`` is chosen so that beyond it the wall term is below ``_NEGLIGIBLE``; the last entry stands for
+    every larger distance. Lethal entries cost ``inf``.
     """
-    reach = lethal + decay * max(math.log(max(wall_cost, 1e-12) / 1e-4), 0.0) + resolution
-    n = int(math.ceil(reach / resolution + 1.0)) ** 2 + 1
+    reach = lethal + decay * max(math.log(max(wall_cost, 1e-12) / _NEGLIGIBLE), 0.0) + resolution
+    n = math.ceil(reach / resolution + 1.0) ** 2 + 1
     d = np.sqrt(np.arange(n, dtype=np.float64)) * resolution - 0.5 * resolution
     d = np.maximum(d, 0.0)
     cost = 1.0 + wall_cost * np.exp(-(d - lethal) / decay)
@@ -125,10 +144,12 @@ def _cost_table(resolution: float, lethal: float, wall_cost: float, decay: float
 
 
 @njit(cache=True, nogil=True)
-def _costs(grid, d2, resolution, clear_table, cost_table, unknown_traversable, unknown_cost, free_below):  # pragma: no cover
+def _costs(grid, d2, resolution, clear_table, cost_table, unknown_traversable, unknown_cost, free_below,
+           lethal, escape_cost):  # pragma: no cover
     height, width = grid.shape
     n = cost_table.shape[0]
     cost = np.empty((height, width), dtype=np.float32)
+    escape = np.empty((height, width), dtype=np.float32)
     kind = np.empty((height, width), dtype=np.int8)
     clearance = np.empty((height, width), dtype=np.float32)
     for r in range(height):
@@ -145,20 +166,25 @@ def _costs(grid, d2, resolution, clear_table, cost_table, unknown_traversable, u
             if value >= free_below:
                 cost[r, c] = np.inf
                 kind[r, c] = 3
+                escape[r, c] = 4.0 * escape_cost
             elif not (base < np.inf):
                 cost[r, c] = np.inf
                 kind[r, c] = 1
+                escape[r, c] = escape_cost * (1.0 + 2.0 * (lethal - clearance[r, c]) / lethal)
             elif value < 0:
                 if unknown_traversable:
                     cost[r, c] = base * unknown_cost
                     kind[r, c] = 0
+                    escape[r, c] = cost[r, c]
                 else:
                     cost[r, c] = np.inf
                     kind[r, c] = 2
+                    escape[r, c] = escape_cost
             else:
                 cost[r, c] = base
                 kind[r, c] = 0
-    return cost, kind, clearance
+                escape[r, c] = base
+    return cost, kind, clearance, escape
 
 
 @dataclass(frozen=True, eq=False)
@@ -177,12 +203,18 @@ class Costmap:
         (about 1e6 m when the grid has no occupied cell).
     resolution:
         Cell size (m).
+    escape:
+        float32 ``[H, W]``: cost factor of each cell for a robot escaping from a blocked cell (see
+        :mod:`slamtrials.explore.planner`): ``cost`` where passable; ``escape_cost`` for unknown cells;
+        from ``escape_cost`` at the lethal zone's edge to three times that at a wall for lethal cells,
+        so that an escape heads for open space; ``4 escape_cost`` for occupied cells.
     """
 
     cost: NDArray[np.float32]
     kind: NDArray[np.int8]
     clearance: NDArray[np.float32]
     resolution: float
+    escape: NDArray[np.float32]
 
 
 def build_costmap(grid: NDArray[np.int8], resolution: float, config: ExploreConfig) -> Costmap:
@@ -191,6 +223,7 @@ def build_costmap(grid: NDArray[np.int8], resolution: float, config: ExploreConf
     d2 = squared_distance_transform(grid >= FREE_BELOW)
     clear_table, cost_table = _cost_table(float(resolution), float(config.lethal_distance), float(config.wall_cost),
                                           float(config.cost_decay_distance))
-    cost, kind, clearance = _costs(grid, d2, float(resolution), clear_table, cost_table, bool(config.unknown_traversable),
-                                   float(config.unknown_cost), FREE_BELOW)
-    return Costmap(cost=cost, kind=kind, clearance=clearance, resolution=float(resolution))
+    cost, kind, clearance, escape = _costs(grid, d2, float(resolution), clear_table, cost_table,
+                                           bool(config.unknown_traversable), float(config.unknown_cost), FREE_BELOW,
+                                           float(config.lethal_distance), float(config.escape_cost))
+    return Costmap(cost=cost, kind=kind, clearance=clearance, resolution=float(resolution), escape=escape)

@@ -3,24 +3,31 @@
 Each call of :meth:`Explorer.command` runs, in this order:
 
 1. a manoeuvre under way (the initial full turn, a look-around turn, a recovery) gives the command;
-2. stuck or blocked (:mod:`slamtrials.explore.recovery`): start a recovery; after
+2. stuck, idle, bumped or blocked (:mod:`slamtrials.explore.recovery`): start a recovery; after
    ``max_recoveries_per_goal`` recoveries on the way to one goal, blacklist the goal;
 3. goal bookkeeping: a goal within ``goal_tolerance`` is reached (and remembered, so its frontier
    cells are skipped from now on: a frontier still there once the robot stands on it cannot be seen
    from there); a goal whose remaining path length did not shrink by ``progress_distance`` for
-   ``goal_timeout`` is blacklisted; a goal that no longer borders unknown space triggers a replan;
-4. planning, every ``replan_period`` and on the events above (at most every ``min_replan_interval``):
-   crop the map to its known part, build the costmap and the frontiers, and run Dijkstra from the
-   robot to the closest frontier cell by path cost, skipping cells near failed or reached goals and
-   keeping the current goal unless another is clearly cheaper (``goal_hysteresis``);
-5. the path follower gives the command.
+   ``goal_timeout`` is blacklisted; a goal whose frontier no longer borders unknown space triggers a
+   replan;
+4. planning (:mod:`slamtrials.explore.goalsearch`), every ``replan_period`` and on the events above (at
+   most every ``min_replan_interval``): first in a window around the robot (``local_radius`` plus a
+   rim where obstacles still change costs): a goal that Dijkstra settles before reaching the window's
+   edge is the closest in the whole map too. Otherwise, if the robot is heading for a goal beyond the
+   window and its path is still clear, it keeps going (searching the whole map every
+   ``global_replan_period``); else the whole known map is searched. The cost of a step thus stays
+   about the same however large the building;
+5. the path follower (:mod:`slamtrials.explore.follower`) gives the command.
 
-When no frontier is left the explorer first clears the failed-goal blacklist (up to
-``blacklist_resets`` times), then turns a full circle where it stands (once per place), and then is
-done (``reason == "no_frontiers"``).
+When no reachable frontier is left and the robot can reach less than ``shut_in_share`` of the map's
+passable cells, the explorer plans again with the lethal zone shrunk to ``robot_radius +
+relaxed_margin`` (frontiers in the open behind a passage that only looks too narrow, e.g. the way out
+of a room whose door the robot went through before the door frame was mapped), then,
+if ``view_distance`` > 0, heads for view points of the frontiers it cannot reach (each looked at once).
+When none is left either, it clears the failed-goal blacklist (up to ``blacklist_resets`` times), then
+turns a full circle where it stands (once per place), and then is done (``reason == "no_frontiers"``).
 
-The costmap and frontiers are cached per map object: if the caller passes the same map object again
-(because its SLAM map was not updated), replanning only reruns Dijkstra. Everything is deterministic.
+Everything is deterministic: the same calls give the same commands.
 """
 
 from __future__ import annotations
@@ -34,17 +41,16 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from slamtrials.explore.config import ExploreConfig
-from slamtrials.explore.costmap import PASSABLE, Costmap, build_costmap
+from slamtrials.explore.costmap import influence_distance
 from slamtrials.explore.follower import PathFollower
-from slamtrials.explore.frontiers import Frontiers, find_frontiers
-from slamtrials.explore.goals import GoalRecord, exclude_discs
-from slamtrials.explore.gridframe import FREE_BELOW, GridFrame, map_arrays
-from slamtrials.explore.planner import dijkstra
-from slamtrials.explore.recovery import Recovery, StuckMonitor, segment_clear
+from slamtrials.explore.frontiers import frontier_near
+from slamtrials.explore.goals import GoalRecord
+from slamtrials.explore.goalsearch import Found, GoalSearch
+from slamtrials.explore.gridframe import GridFrame, map_arrays
+from slamtrials.explore.recovery import Recovery, StuckMonitor
 
-__all__ = ["Explorer", "ExploreStats", "crop_known"]
+__all__ = ["ExploreStats", "Explorer"]
 
-_CROP_MARGIN = 2  # unknown cells kept around the known part of the map
 _LOOK_SPACING = 1.0  # m: a look-around turn is done at most once within this distance
 _REROUTE_SLACK = 1.0  # m: a new path this much longer than the best restarts the goal's progress count
 
@@ -78,35 +84,6 @@ class ExploreStats:
     plan_seconds: float = 0.0
 
 
-@dataclass(frozen=True, eq=False)
-class _Prepared:
-    """Costmap and frontiers of the known part of one map."""
-
-    frame: GridFrame  # of the cropped window
-    costmap: Costmap
-    frontiers: Frontiers
-
-
-def crop_known(grid: NDArray[np.int8], margin: int = _CROP_MARGIN) -> tuple[NDArray[np.int8], int, int] | None:
-    """The bounding box of the known cells of ``grid`` plus ``margin`` unknown cells all round.
-
-    Returns ``(window int8 [h, w], row0, col0)`` with ``(row0, col0)`` the grid cell of the window's
-    top-left cell (negative when the margin sticks out of the grid), or ``None`` if no cell is known.
-    """
-    known = grid >= 0
-    rows = np.flatnonzero(known.any(axis=1))
-    if rows.size == 0:
-        return None
-    cols = np.flatnonzero(known.any(axis=0))
-    r0, r1 = int(rows[0]) - margin, int(rows[-1]) + 1 + margin
-    c0, c1 = int(cols[0]) - margin, int(cols[-1]) + 1 + margin
-    window = np.full((r1 - r0, c1 - c0), -1, dtype=np.int8)
-    sr0, sr1 = max(r0, 0), min(r1, grid.shape[0])
-    sc0, sc1 = max(c0, 0), min(c1, grid.shape[1])
-    window[sr0 - r0:sr1 - r0, sc0 - c0:sc1 - c0] = grid[sr0:sr1, sc0:sc1]
-    return window, r0, c0
-
-
 class Explorer:
     """Frontier exploration on an online occupancy map (see the module docstring).
 
@@ -124,6 +101,7 @@ class Explorer:
 
     def __init__(self, config: ExploreConfig | None = None):
         self.config = ExploreConfig() if config is None else config
+        self._search = GoalSearch(self.config)
         self._follower = PathFollower(self.config)
         self._monitor = StuckMonitor(self.config)
         self._recovery = Recovery(self.config)
@@ -147,10 +125,12 @@ class Explorer:
         self._last_plan = -math.inf
         self._want_plan = True
         self._stuck = False
+        self._stalls = 0
+        self._following = False
         self._blocked_since: float | None = None
-        self._prepared_for: Any = None
-        self._prepared: _Prepared | None = None
+        self._last_global = -math.inf
         self._checked_for: Any = None
+        self._search.reset()
         self._follower.reset()
         self._monitor.reset()
         self._recovery.reset()
@@ -193,7 +173,8 @@ class Explorer:
 
     # --- the control step --------------------------------------------------------------------------------
 
-    def command(self, t: float, pose: ArrayLike, ranges: ArrayLike, laser: dict[str, Any], occupancy: Any) -> tuple[float, float]:
+    def command(self, t: float, pose: ArrayLike, ranges: ArrayLike, laser: dict[str, Any], occupancy: Any, *,
+                stalled: bool = False) -> tuple[float, float]:
         """The velocity command ``(v m/s, w rad/s)`` for the next control period.
 
         Parameters
@@ -211,10 +192,17 @@ class Explorer:
             The current map: an object with ``grid`` (int8 ``[H, W]``, 100 occupied, 0 free, -1
             unknown, row 0 at the top), ``resolution`` (m) and ``origin`` (float64 ``[3]``, the map-frame
             pose of the lower-left corner of cell ``(H - 1, 0)``).
+        stalled:
+            Whether the robot bumped into something during the last step (the simulator's
+            :attr:`~slamtrials.record.Frame.stalled`, Stage's stall flag), if the caller knows. After
+            ``stall_steps`` such steps in a row while following a path, the robot recovers at once
+            instead of waiting for the stuck test.
         """
+        self._stalls = self._stalls + 1 if stalled else 0
+        self._following = False
         v, w = self._decide(float(t), np.asarray(pose, dtype=np.float64), ranges, laser, occupancy)
         self._follower.remember(v, w)
-        self._stuck = self._monitor.update(float(t), pose, v, self.config.control_period)
+        self._stuck = self._monitor.update(float(t), pose, v, self.config.control_period, self._following)
         return v, w
 
     def _decide(self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: dict[str, Any],
@@ -240,7 +228,8 @@ class Explorer:
             self._want_plan = True
         # 2. stuck or blocked
         blocked_long = self._blocked_since is not None and t - self._blocked_since >= cfg.blocked_time
-        if self._stuck or blocked_long:
+        bumped = self._stalls >= cfg.stall_steps and self._follower.has_path
+        if self._stuck or blocked_long or bumped:
             return self._start_recovery(t, pose, ranges, laser, occupancy)
         # 3. goal bookkeeping
         if self._goal is not None:
@@ -253,7 +242,9 @@ class Explorer:
                 self._give_up_goal()
             elif occupancy is not self._checked_for:
                 self._checked_for = occupancy
-                if not _borders_unknown(occupancy, self._goal.xy):
+                grid, _, _ = map_arrays(occupancy)
+                row, col = (int(v) for v in GridFrame.of(occupancy).to_cell(self._goal.target))
+                if not frontier_near(grid, row, col):
                     self._want_plan = True
         # 4. planning
         since = t - self._last_plan
@@ -269,6 +260,7 @@ class Explorer:
             self._blocked_since = None
             return 0.0, 0.0
         out = self._follower.command(pose, ranges, laser)
+        self._following = True
         if out.blocked:
             if self._blocked_since is None:
                 self._blocked_since = t
@@ -292,16 +284,15 @@ class Explorer:
                         occupancy: Any) -> tuple[float, float]:
         self.stats.recoveries += 1
         self._stuck = False
+        self._stalls = 0
         self._blocked_since = None
         self._monitor.reset()
         if self._goal is not None:
             self._goal.recoveries += 1
             if self._goal.recoveries >= self.config.max_recoveries_per_goal:
                 self._give_up_goal()
-        self._follower.clear()
-        cfg = self.config
-        behind = pose[:2] - (cfg.backoff_distance + 0.05) * np.array([math.cos(pose[2]), math.sin(pose[2])])
-        self._recovery.start(t, ranges, laser, back_off=segment_clear(occupancy, pose[:2], behind, cfg.robot_radius))
+        self._follower.reset()
+        self._recovery.start(t, pose, ranges, laser, occupancy)
         cmd = self._recovery.command(t)
         return (0.0, 0.0) if cmd is None else cmd
 
@@ -318,23 +309,6 @@ class Explorer:
 
     # --- planning ------------------------------------------------------------------------------------------
 
-    def _prepare(self, occupancy: Any) -> _Prepared | None:
-        if occupancy is self._prepared_for and self._prepared is not None:
-            return self._prepared
-        cfg = self.config
-        grid, resolution, _ = map_arrays(occupancy)
-        cropped = crop_known(grid)
-        if cropped is None:
-            return None
-        window, r0, c0 = cropped
-        frame = GridFrame.of(occupancy).sub(r0, c0, window.shape[0], window.shape[1])
-        costmap = build_costmap(window, resolution, cfg)
-        frontiers = find_frontiers(window, min_cells=max(1, int(math.ceil(cfg.min_frontier_length / resolution - 1e-9))),
-                                   min_unknown_cells=int(math.ceil(cfg.min_unknown_area / resolution**2 - 1e-9)))
-        self._prepared_for = occupancy
-        self._prepared = _Prepared(frame, costmap, frontiers)
-        return self._prepared
-
     def _plan(self, t: float, pose: NDArray[np.float64], occupancy: Any) -> None:
         started = time.perf_counter()
         try:
@@ -347,51 +321,82 @@ class Explorer:
         self._last_plan = t
         self._want_plan = False
         self.stats.replans += 1
-        prepared = self._prepare(occupancy)
-        if prepared is None:
+        grid, resolution, _ = map_arrays(occupancy)
+        whole = self._search.known_box(occupancy, grid)
+        if whole is None:
             self._nothing_found(t, pose, any_frontier=True)
             return
-        frame, costmap = prepared.frame, prepared.costmap
-        row, col = (int(v) for v in frame.to_cell(pose[:2]))
-        if not frame.inside(row, col):
-            self._nothing_found(t, pose, any_frontier=True)
-            return
-        base = prepared.frontiers.mask & (costmap.kind == PASSABLE)
-        candidates = base.copy()
-        exclude_discs(candidates, frame, self._visited, cfg.blacklist_radius)
-        open_candidates = candidates.copy()
-        exclude_discs(candidates, frame, self._blacklist, cfg.blacklist_radius)
-        keep = None
-        if self._goal is not None:
-            near = candidates.copy()
-            exclude_discs(near, frame, [self._goal.xy], cfg.blacklist_radius)
-            keep = candidates & ~near
-        escape = cfg.escape_radius / frame.resolution
-        result = dijkstra(costmap.cost, costmap.kind, (row, col), goal=candidates, keep=keep, ratio=cfg.goal_hysteresis,
-                          escape_radius=escape, escape_cost=cfg.escape_cost)
-        if result.goal is None:
-            if self._blacklist and self._resets_left > 0 and open_candidates.any():
-                reachable = dijkstra(costmap.cost, costmap.kind, (row, col), goal=open_candidates,
-                                     escape_radius=escape, escape_cost=cfg.escape_cost)
-                if reachable.goal is not None:
-                    self._resets_left -= 1
-                    self._blacklist.clear()
-                    self.stats.blacklist_resets += 1
-                    result = reachable
-            if result.goal is None:
-                self._nothing_found(t, pose, any_frontier=False)
-                return
-        cells = result.path_to(*result.goal)
-        path = frame.to_xy(cells[:, 0], cells[:, 1])
-        path[0] = pose[:2]
-        goal_xy = path[-1].copy()
+        row, col = (int(v) for v in GridFrame.of(occupancy).to_cell(pose[:2]))
+        half = math.ceil(cfg.local_radius / resolution)
+        rim = math.ceil(influence_distance(cfg, resolution) / resolution) + 1
+        local = (row - half - rim, row + half + rim + 1, col - half - rim, col + half + rim + 1)
+        if local[0] <= whole[0] and local[1] >= whole[1] and local[2] <= whole[2] and local[3] >= whole[3]:
+            outcome = self._try(t, pose, occupancy, grid, whole, None)  # the window holds the whole map
+        else:
+            inner = (rim, local[1] - local[0] - rim, rim, local[3] - local[2] - rim)
+            outcome = self._try(t, pose, occupancy, grid, local, inner)
+            if outcome == "edge":
+                if t - self._last_global < cfg.global_replan_period and self._can_keep_goal(pose):
+                    return  # keep heading for the far goal
+                outcome = self._try(t, pose, occupancy, grid, whole, None)
+        if outcome == "none":
+            outcome = self._last_resorts(t, pose, occupancy, grid, whole)
+        if outcome == "none" and self._blacklist and self._resets_left > 0:
+            self._resets_left -= 1
+            self._blacklist.clear()
+            self.stats.blacklist_resets += 1
+            outcome = self._try(t, pose, occupancy, grid, whole, None)
+            if outcome == "none":
+                outcome = self._last_resorts(t, pose, occupancy, grid, whole)
+        if outcome in ("none", "lost"):
+            self._nothing_found(t, pose, any_frontier=outcome == "lost")
+
+    def _last_resorts(self, t: float, pose: NDArray[np.float64], occupancy: Any, grid: NDArray[np.int8],
+                      box: tuple[int, int, int, int]) -> str:
+        """No frontier is reachable: try narrow passages (the relaxed costmap), then view points."""
+        cfg = self.config
+        outcome = "none"
+        if cfg.relaxed_margin < cfg.inflation_margin and self._search.reachable_share < cfg.shut_in_share:
+            outcome = self._try(t, pose, occupancy, grid, box, None, relaxed=True)
+        if outcome == "none" and self.config.view_distance > 0.0:
+            outcome = self._try(t, pose, occupancy, grid, box, None, views=True)
+        return outcome
+
+    def _try(self, t: float, pose: NDArray[np.float64], occupancy: Any, grid: NDArray[np.int8],
+             box: tuple[int, int, int, int], inner: tuple[int, int, int, int] | None, *,
+             views: bool = False, relaxed: bool = False) -> str:
+        """One goal search (:meth:`GoalSearch.search`); take its goal. Returns ``"goal"``, ``"edge"``,
+        ``"none"`` or ``"lost"``."""
+        if inner is None:
+            self._last_global = t
+        outcome, found = self._search.search(pose, occupancy, grid, box, inner, visited=self._visited,
+                                             blacklist=self._blacklist,
+                                             current=None if self._goal is None else self._goal.xy,
+                                             views=views, relaxed=relaxed)
+        if outcome == "undecided" and self._can_keep_goal(pose):
+            return "goal"  # the current goal beyond the window may still be the better one
+        if found is None:
+            return outcome
+        self._take(t, found)
+        return "goal"
+
+    def _take(self, t: float, found: Found) -> None:
+        """Make ``found`` the goal and follow its path."""
+        path = found.path
         length = float(np.hypot(*np.diff(path, axis=0).T).sum()) if len(path) > 1 else 0.0
-        if self._goal is not None and (result.kept or math.dist(goal_xy, self._goal.xy) <= cfg.blacklist_radius):
+        goal_xy = found.goal.copy()
+        if self._goal is not None and (found.kept or math.dist(goal_xy, self._goal.xy) <= self.config.blacklist_radius):
             self._goal.xy = goal_xy
+            self._goal.target = found.target
             self._goal.rerouted(t, length, _REROUTE_SLACK)
         else:
-            self._goal = GoalRecord(xy=goal_xy, since=t, best=length, last_progress=t)
-        self._follower.set_path(path)
+            self._goal = GoalRecord(xy=goal_xy, target=found.target, since=t, best=length, last_progress=t)
+        self._follower.set_path(path, found.clearance)
+
+    def _can_keep_goal(self, pose: NDArray[np.float64]) -> bool:
+        """Whether the robot can keep following its path to the current goal."""
+        return (self._goal is not None and self._follower.has_path
+                and self._search.path_clear(self._follower.path, pose))
 
     def _nothing_found(self, t: float, pose: NDArray[np.float64], *, any_frontier: bool) -> None:
         """No goal: look around once here, else (with a map) finish."""
@@ -403,27 +408,3 @@ class Explorer:
         if not any_frontier:
             self._done = True
             self._reason = "no_frontiers"
-
-
-def _borders_unknown(occupancy: Any, xy: NDArray[np.float64], reach: int = 2) -> bool:
-    """Whether a free cell within ``reach`` cells of map-frame point ``xy`` has an unknown 4-neighbour."""
-    grid, _, _ = map_arrays(occupancy)
-    frame = GridFrame.of(occupancy)
-    row, col = (int(v) for v in frame.to_cell(xy))
-    r0, r1 = max(row - reach - 1, 0), min(row + reach + 2, grid.shape[0])
-    c0, c1 = max(col - reach - 1, 0), min(col + reach + 2, grid.shape[1])
-    if r0 >= r1 or c0 >= c1:
-        return False
-    patch = grid[r0:r1, c0:c1]
-    unknown = patch < 0
-    free = (patch >= 0) & (patch < FREE_BELOW)
-    near = np.zeros_like(unknown)
-    near[1:, :] |= unknown[:-1, :]
-    near[:-1, :] |= unknown[1:, :]
-    near[:, 1:] |= unknown[:, :-1]
-    near[:, :-1] |= unknown[:, 1:]
-    hits = free & near
-    # only the cells within reach of the goal's cell count (the patch has one extra ring for neighbours)
-    lo_r, lo_c = max(row - reach, 0) - r0, max(col - reach, 0) - c0
-    hi_r, hi_c = min(row + reach + 1, grid.shape[0]) - r0, min(col + reach + 1, grid.shape[1]) - c0
-    return bool(hits[lo_r:hi_r, lo_c:hi_c].any())

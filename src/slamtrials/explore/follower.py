@@ -9,10 +9,12 @@ Per call, with the robot at ``pose`` (map frame) and the path as map-frame point
    in place: ``w = sign(e) min(w_max, k |e|, sqrt(2 alpha |e|))`` with ``k = 2.5 /s`` (it can stop
    turning in time), ``v = 0``;
 4. otherwise pure pursuit: curvature ``kappa = 2 sin(e) / l`` (``l`` the distance to the target),
-   ``v = min(v_max, sqrt(2 a s_end), sqrt(2 a (s_free - stop_distance)), w_max / |kappa|)`` with
-   ``s_end`` the remaining path length and ``s_free`` how far the robot can go along the arc of
+   ``v = min(v_max, v_narrow, sqrt(2 a s_end), sqrt(2 a (s_free - stop_distance)), w_max / |kappa|)``
+   with ``s_end`` the remaining path length, ``s_free`` how far the robot can go along the arc of
    curvature ``kappa`` before its disc (radius + ``obstacle_margin``) touches a scan point
-   (:func:`free_travel`), and ``w = kappa v``;
+   (:func:`free_travel`), and ``v_narrow`` a limit from the smallest clearance of the path in the next
+   metre (``narrow_speed`` at the lethal distance, rising linearly to ``v_max`` at
+   ``narrow_clearance`` beyond it; only when the path's clearances were given), and ``w = kappa v``;
 5. acceleration: ``v`` may rise by at most ``max_linear_accel * dt`` per call (braking is left to the
    robot's own limits, which the speed caps above respect), ``w`` changes by at most
    ``max_angular_accel * dt``.
@@ -20,9 +22,11 @@ Per call, with the robot at ``pose`` (map frame) and the path as map-frame point
 If the scan blocks the arc, steps 2 to 4 are tried again with a short look-ahead (0.25 m), which
 tracks the path more tightly in narrow places. If that is blocked too, the robot *creeps*: it turns in
 place to face the path point 0.15 m ahead, then inches straight towards it at 0.15 m/s at most,
-keeping only 1 cm from the scan's points (the path itself keeps off walls by the costmap's lethal
-distance). If even that is impossible it reports itself *blocked* (the explorer starts a recovery if
-this lasts).
+keeping no margin beyond its radius from the scan's points (the path itself keeps off walls by the
+costmap's lethal distance). If even that is impossible it reports itself *blocked* (the explorer
+starts a recovery if this lasts). Once the short look-ahead or creeping was needed, it is kept (also
+across new paths) until the robot has moved 0.4 m: switching back and forth between look-aheads would
+make it turn back and forth on the spot.
 """
 
 from __future__ import annotations
@@ -32,11 +36,12 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from slamtrials.explore.config import ExploreConfig
 
-__all__ = ["PathFollower", "FollowCommand", "scan_points", "free_travel", "turn_rate"]
+__all__ = ["FollowCommand", "PathFollower", "free_travel", "scan_points", "turn_rate"]
 
 _K_TURN = 2.5
 _SEARCH_AHEAD = 60  # path points searched for progress per call
@@ -45,7 +50,10 @@ _SHORT_LOOKAHEAD = 0.25  # m: look-ahead tried when the normal one leads into an
 _CREEP_LOOKAHEAD = 0.15  # m: target of the creeping mode
 _CREEP_ALIGN = math.radians(8.0)  # heading error (rad) up to which the robot creeps straight
 _CREEP_SPEED = 0.15  # m/s
-_CREEP_MARGIN = 0.01  # m: clearance kept while creeping
+_CREEP_MARGIN = 0.0  # m: clearance kept beyond the radius while creeping
+_NARROW_AHEAD = 1.0  # m of path ahead whose clearance limits the speed
+_TARGET_WINDOW = 3.0  # m of path ahead searched for the look-ahead target
+_TIGHT_RELEASE = 0.4  # m: after a short look-ahead or creeping was needed, keep it up for this distance
 
 
 def turn_rate(error: float, max_rate: float, max_accel: float) -> float:
@@ -71,19 +79,59 @@ def _beam_directions(beams: int, laser: dict[str, Any]) -> tuple[NDArray[np.floa
     return found
 
 
+@njit(cache=True, nogil=True)
+def _scan_points(ranges, cos, sin, mx, my, range_min, range_max):  # pragma: no cover - compiled
+    out = np.empty((ranges.shape[0], 2), dtype=np.float64)
+    k = 0
+    for b in range(ranges.shape[0]):
+        r = ranges[b]
+        if r > range_min and r < range_max:  # False for NaN
+            out[k, 0] = mx + r * cos[b]
+            out[k, 1] = my + r * sin[b]
+            k += 1
+    return out[:k]
+
+
 def scan_points(ranges: ArrayLike, laser: dict[str, Any]) -> NDArray[np.float64]:
     """float64 ``[K, 2]`` scan returns in the robot base frame (m).
 
     Beams with NaN, ``r <= range_min`` or ``r >= range_max`` (no return) are left out. ``laser`` is the
     geometry dict (``angle_min``, ``angle_increment``, ``range_min``, ``range_max``, optional ``mount``).
     """
-    r = np.asarray(ranges, dtype=np.float64)
+    r = np.ascontiguousarray(ranges, dtype=np.float64)
     cos, sin = _beam_directions(r.shape[0], laser)
     mount = laser.get("mount", (0.0, 0.0, 0.0))
-    mx, my = float(mount[0]), float(mount[1])
-    ok = (r > float(laser.get("range_min", 0.0))) & (r < float(laser["range_max"]))
-    r = r[ok]
-    return np.column_stack([mx + r * cos[ok], my + r * sin[ok]])
+    return _scan_points(r, cos, sin, float(mount[0]), float(mount[1]), float(laser.get("range_min", 0.0)),
+                        float(laser["range_max"]))
+
+
+@njit(cache=True, nogil=True)
+def _free_travel(points, curvature, half_width, horizon):  # pragma: no cover - compiled
+    best = horizon
+    h2 = half_width * half_width
+    if abs(curvature) < 0.05:
+        for k in range(points.shape[0]):
+            x = points[k, 0]
+            y = points[k, 1]
+            if x > 0.0 and abs(y) < half_width:
+                travel = x - math.sqrt(h2 - y * y)
+                best = min(best, travel)
+    else:
+        radius = 1.0 / abs(curvature)
+        for k in range(points.shape[0]):
+            x = points[k, 0]
+            ys = points[k, 1] if curvature > 0.0 else -points[k, 1]  # mirror right turns into left ones
+            rho = math.hypot(x, ys - radius)
+            gap = rho - radius
+            if abs(gap) >= half_width:
+                continue
+            beta = math.atan2(ys - radius, x)  # angle around the turning centre
+            swept = (beta + 0.5 * math.pi) % (2.0 * math.pi)  # from the robot's position, counter-clockwise
+            if swept >= math.pi:
+                continue
+            travel = radius * swept - math.sqrt(h2 - gap * gap)
+            best = min(best, travel)
+    return min(max(best, 0.0), horizon)
 
 
 def free_travel(points: NDArray[np.float64], curvature: float, half_width: float, horizon: float = 5.0) -> float:
@@ -94,7 +142,7 @@ def free_travel(points: NDArray[np.float64], curvature: float, half_width: float
     points:
         float64 ``[K, 2]`` obstacle points in the robot base frame (m), x forward, y left.
     curvature:
-        Curvature of the arc (1/m), positive turning left; 0 is straight ahead.
+        Curvature of the arc (1/m), positive turning left; 0 (below 0.05 in magnitude) is straight ahead.
     half_width:
         Radius (m) of the disc swept along the arc.
     horizon:
@@ -103,30 +151,12 @@ def free_travel(points: NDArray[np.float64], curvature: float, half_width: float
     Returns
     -------
     float
-        Arc length (m), in ``[0, horizon]``; 0 when a point is already inside the disc ahead of the centre.
+        Arc length (m), in ``[0, horizon]``: for each point within ``half_width`` of the arc (and ahead,
+        on the first half turn), the arc length to it minus the disc's half chord there; 0 when a point
+        is already inside the disc ahead of the centre.
     """
-    if points.shape[0] == 0:
-        return horizon
-    x, y = points[:, 0], points[:, 1]
-    if abs(curvature) < 0.05:
-        near = (x > 0.0) & (np.abs(y) < half_width)
-        if not near.any():
-            return horizon
-        travel = x[near] - np.sqrt(half_width**2 - y[near] ** 2)
-    else:
-        radius = 1.0 / abs(curvature)
-        ys = y if curvature > 0 else -y  # mirror right turns into left ones
-        rho = np.hypot(x, ys - radius)
-        near = np.abs(rho - radius) < half_width
-        if not near.any():
-            return horizon
-        beta = np.arctan2(ys[near] - radius, x[near])  # angle around the turning centre
-        swept = np.mod(beta + 0.5 * math.pi, 2.0 * math.pi)  # from the robot's position, counter-clockwise
-        ahead = swept < math.pi
-        if not ahead.any():
-            return horizon
-        travel = radius * swept[ahead] - np.sqrt(half_width**2 - (rho[near][ahead] - radius) ** 2)
-    return float(min(max(travel.min(), 0.0), horizon))
+    pts = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
+    return float(_free_travel(pts, float(curvature), float(half_width), float(horizon)))
 
 
 @dataclass(frozen=True)
@@ -161,8 +191,12 @@ class PathFollower:
     def __init__(self, config: ExploreConfig):
         self.config = config
         self._path = np.zeros((0, 2))
+        self._clearance: NDArray[np.float64] | None = None
         self._remaining = np.zeros(0)
+        self._narrow_end = np.zeros(0, dtype=np.intp)
+        self._window_end = np.zeros(0, dtype=np.intp)
         self._index = 0
+        self._tight: tuple[int, float, float] | None = None  # (level, x, y) where tight following began
         self._v = 0.0
         self._w = 0.0
 
@@ -176,12 +210,21 @@ class PathFollower:
         """Whether a path is set."""
         return self._path.shape[0] > 0
 
-    def set_path(self, path: ArrayLike) -> None:
-        """Follow ``path``, float ``[N, 2]`` map-frame points (m), from its start."""
+    def set_path(self, path: ArrayLike, clearance: ArrayLike | None = None) -> None:
+        """Follow ``path``, float ``[N, 2]`` map-frame points (m), from its start.
+
+        ``clearance``, float ``[N]`` (m), is each point's distance to the nearest obstacle (the
+        costmap's clearance); it lets the robot slow down in narrow places.
+        """
         points = np.asarray(path, dtype=np.float64).reshape(-1, 2)
         self._path = points
+        self._clearance = None if clearance is None else np.asarray(clearance, dtype=np.float64).reshape(-1)
         seg = np.hypot(*np.diff(points, axis=0).T) if len(points) > 1 else np.zeros(0)
         self._remaining = np.concatenate([np.cumsum(seg[::-1])[::-1], [0.0]]) if len(points) else np.zeros(0)
+        # for each point, the index of the last point within _NARROW_AHEAD and _TARGET_WINDOW along the path
+        along = self._remaining[0] - self._remaining if len(points) else np.zeros(0)
+        self._narrow_end = np.searchsorted(along, along + _NARROW_AHEAD, side="right") - 1
+        self._window_end = np.searchsorted(along, along + _TARGET_WINDOW, side="right") - 1
         self._index = 0
 
     def clear(self) -> None:
@@ -189,8 +232,9 @@ class PathFollower:
         self.set_path(np.zeros((0, 2)))
 
     def reset(self) -> None:
-        """Forget the path and the remembered velocity."""
+        """Forget the path, the remembered velocity and the tight-following state."""
         self.clear()
+        self._tight = None
         self._v = 0.0
         self._w = 0.0
 
@@ -224,9 +268,12 @@ class PathFollower:
         if end_dist < cfg.goal_tolerance:
             return self._limited(0.0, 0.0, finished=True)
         points = scan_points(ranges, laser)
-        blocked = False
-        for lookahead in (cfg.lookahead_distance, _SHORT_LOOKAHEAD):
-            tx, ty = self._target(x, y, lookahead)
+        if self._tight is not None and math.hypot(x - self._tight[1], y - self._tight[2]) >= _TIGHT_RELEASE:
+            self._tight = None  # got through the tight spot: back to normal following
+        level = 0 if self._tight is None else self._tight[0]
+        lookaheads = (cfg.lookahead_distance, _SHORT_LOOKAHEAD)
+        while level < len(lookaheads):
+            tx, ty = self._target(x, y, lookaheads[level])
             error = math.remainder(math.atan2(ty - y, tx - x) - theta, 2.0 * math.pi)
             if abs(error) > cfg.rotate_in_place_angle:
                 return self._limited(0.0, turn_rate(error, cfg.max_angular_speed, cfg.max_angular_accel))
@@ -234,12 +281,13 @@ class PathFollower:
             curvature = 2.0 * math.sin(error) / dist
             free = free_travel(points, curvature, cfg.robot_radius + cfg.obstacle_margin)
             v_scan = math.sqrt(2.0 * cfg.max_linear_accel * max(free - cfg.stop_distance, 0.0))
-            blocked = v_scan < _BLOCKED_SPEED
-            if not blocked:
+            if v_scan >= _BLOCKED_SPEED:
                 break
-        if blocked:
+            level += 1
+            self._tight = (level, x, y)
+        if level >= len(lookaheads):
             return self._creep(x, y, theta, points, to_end)
-        v = min(cfg.max_linear_speed, math.sqrt(2.0 * cfg.max_linear_accel * to_end), v_scan)
+        v = min(cfg.max_linear_speed, math.sqrt(2.0 * cfg.max_linear_accel * to_end), v_scan, self._narrow_limit())
         if abs(curvature) > 1e-9:
             v = min(v, cfg.max_angular_speed / abs(curvature))
         return self._limited(v, curvature * v, pure_pursuit=True, curvature=curvature)
@@ -252,18 +300,29 @@ class PathFollower:
         if abs(error) > _CREEP_ALIGN:
             return self._limited(0.0, turn_rate(error, cfg.max_angular_speed, cfg.max_angular_accel))
         free = free_travel(points, 0.0, cfg.robot_radius + _CREEP_MARGIN)
-        v = min(_CREEP_SPEED, math.sqrt(2.0 * cfg.max_linear_accel * max(free - _CREEP_MARGIN, 0.0)),
+        v = min(_CREEP_SPEED, math.sqrt(2.0 * cfg.max_linear_accel * max(free - 0.01, 0.0)),
                 math.sqrt(2.0 * cfg.max_linear_accel * to_end))
         if v < _BLOCKED_SPEED:
             return self._limited(0.0, 0.0, blocked=True)
         return self._limited(v, 0.0)
 
+    def _narrow_limit(self) -> float:
+        """Speed limit (m/s) from the smallest clearance of the next metre of path."""
+        cfg = self.config
+        if self._clearance is None or self._clearance.shape[0] != self._path.shape[0] or cfg.narrow_clearance <= 0.0:
+            return cfg.max_linear_speed
+        least = float(self._clearance[self._index:self._narrow_end[self._index] + 1].min())
+        share = min(max((least - cfg.lethal_distance) / cfg.narrow_clearance, 0.0), 1.0)
+        return cfg.narrow_speed + share * (cfg.max_linear_speed - cfg.narrow_speed)
+
     def _target(self, x: float, y: float, lookahead: float) -> tuple[float, float]:
-        """The first path point from the current one at least ``lookahead`` from (x, y), else the last."""
-        path = self._path
-        ahead = np.hypot(path[self._index:, 0] - x, path[self._index:, 1] - y)
+        """The first path point from the current one at least ``lookahead`` from (x, y), else the last
+        within ``_TARGET_WINDOW`` along the path."""
+        end = int(self._window_end[self._index]) + 1
+        path = self._path[self._index:end]
+        ahead = np.hypot(path[:, 0] - x, path[:, 1] - y)
         beyond = np.flatnonzero(ahead >= lookahead)
-        tx, ty = path[self._index + int(beyond[0])] if beyond.size else path[-1]
+        tx, ty = path[int(beyond[0])] if beyond.size else path[-1]
         return float(tx), float(ty)
 
     def _limited(self, v: float, w: float, *, blocked: bool = False, finished: bool = False,

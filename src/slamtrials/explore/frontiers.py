@@ -22,7 +22,7 @@ from scipy import ndimage
 
 from slamtrials.explore.gridframe import FREE_BELOW
 
-__all__ = ["Frontiers", "find_frontiers", "frontier_mask", "effective_unknown"]
+__all__ = ["Frontiers", "effective_unknown", "find_frontiers", "frontier_mask", "frontier_near"]
 
 _FOUR = ndimage.generate_binary_structure(2, 1)
 _EIGHT = ndimage.generate_binary_structure(2, 2)
@@ -92,9 +92,8 @@ def _classify_unknown(grid, min_unknown_cells):  # pragma: no cover - compiled
             for k in range(4):
                 nr = r + drs[k]
                 nc = c + dcs[k]
-                if 0 <= nr < height and 0 <= nc < width and grid[nr, nc] >= 0 and status[nr, nc] == 0:
-                    if grid[nr, nc] < 50:
-                        near_free = True
+                if 0 <= nr < height and 0 <= nc < width and 0 <= grid[nr, nc] < 50:
+                    near_free = True
             if not near_free:
                 continue
             # flood fill
@@ -210,8 +209,7 @@ def _label_frontiers(grid, status, min_cells):  # pragma: no cover - compiled
                     labels[u // width, u % width] = -1
     for r in range(height):
         for c in range(width):
-            if labels[r, c] < 0:
-                labels[r, c] = 0
+            labels[r, c] = max(labels[r, c], 0)
     return labels, sizes[:kept].copy(), sum_r[:kept].copy(), sum_c[:kept].copy()
 
 
@@ -259,3 +257,18 @@ def find_frontiers(grid: NDArray[np.int8], *, min_cells: int = 1, min_unknown_ce
     labels, sizes, sum_r, sum_c = _label_frontiers(grid, status, max(int(min_cells), 1))
     centroids = np.column_stack([sum_r / sizes, sum_c / sizes]) if sizes.size else np.zeros((0, 2))
     return Frontiers(labels > 0, labels, sizes, centroids)
+
+
+def frontier_near(grid: NDArray[np.int8], row: int, col: int, reach: int = 2) -> bool:
+    """Whether a free cell within ``reach`` cells (Chebyshev) of cell ``(row, col)`` has an unknown
+    4-neighbour: a cheap check, done every step, that a goal still lies on a frontier."""
+    height, width = grid.shape
+    r0, r1 = max(row - reach - 1, 0), min(row + reach + 2, height)
+    c0, c1 = max(col - reach - 1, 0), min(col + reach + 2, width)
+    if r0 >= r1 or c0 >= c1:
+        return False
+    patch = frontier_mask(grid[r0:r1, c0:c1])
+    # only the cells within reach count (the patch has one more ring, for their neighbours)
+    lo_r, lo_c = max(row - reach, 0) - r0, max(col - reach, 0) - c0
+    hi_r, hi_c = min(row + reach + 1, height) - r0, min(col + reach + 1, width) - c0
+    return bool(patch[lo_r:hi_r, lo_c:hi_c].any())

@@ -6,7 +6,7 @@ Goals are kept as map-frame points (m), not cells, so they survive a map that gr
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -24,6 +24,9 @@ class GoalRecord:
     ----------
     xy:
         float64 ``[2]`` goal point (map frame, m).
+    target:
+        float64 ``[2]`` the frontier cell the goal is for (map frame, m): the goal itself, or for a
+        frontier the robot cannot reach, the frontier cell it is to look at from the goal.
     since:
         Time (s) the goal was first chosen.
     best:
@@ -35,6 +38,7 @@ class GoalRecord:
     """
 
     xy: NDArray[np.float64]
+    target: NDArray[np.float64]
     since: float
     best: float = math.inf
     last_progress: float = 0.0
@@ -58,7 +62,7 @@ def exclude_discs(mask: NDArray[np.bool_], frame: GridFrame, points: list[NDArra
     if not points or radius <= 0.0:
         return
     res = frame.resolution
-    n = int(math.ceil(radius / res))
+    n = math.ceil(radius / res)
     height, width = mask.shape
     offsets = np.arange(-n, n + 1)
     disc = (offsets[:, None] ** 2 + offsets[None, :] ** 2) * res * res <= radius * radius

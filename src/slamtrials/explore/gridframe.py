@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["GridFrame", "map_arrays", "FREE_BELOW"]
+__all__ = ["FREE_BELOW", "GridFrame", "map_arrays"]
 
 #: Cell values ``0 <= value < FREE_BELOW`` are free, ``>= FREE_BELOW`` occupied, negative unknown
 #: (a trinary map holds 0, 100 and -1; a probability map 0..100 is split at 50).
@@ -62,7 +62,7 @@ class GridFrame:
     origin: tuple[float, float, float]
 
     @classmethod
-    def of(cls, occupancy: Any) -> "GridFrame":
+    def of(cls, occupancy: Any) -> GridFrame:
         """The frame of a map object with ``grid``, ``resolution`` and ``origin``."""
         grid, resolution, origin = map_arrays(occupancy)
         return cls(int(grid.shape[0]), int(grid.shape[1]), resolution, (float(origin[0]), float(origin[1]), float(origin[2])))
@@ -93,7 +93,7 @@ class GridFrame:
         """Whether cell ``(row, col)`` lies in the grid."""
         return 0 <= row < self.height and 0 <= col < self.width
 
-    def sub(self, row0: int, col0: int, height: int, width: int) -> "GridFrame":
+    def sub(self, row0: int, col0: int, height: int, width: int) -> GridFrame:
         """The frame of the window whose top-left cell is ``(row0, col0)`` of this grid (may stick out)."""
         u = col0 * self.resolution
         v = (self.height - row0 - height) * self.resolution

@@ -8,9 +8,9 @@ cost-to-come field from the robot's cell and can stop at the first goal cell it 
 closest by path cost), which keeps replanning cheap when a frontier is near.
 
 Escape. When the robot's own cell is blocked (a SLAM error or a bump put it inside the inflated zone
-of a wall), blocked cells within ``escape_radius`` cells of it may be crossed, at ``escape_cost`` per
-unit length (four times that for occupied cells), but only from blocked cells: the search leaves the
-blocked region by the cheapest way and never re-enters it.
+of a wall), blocked cells within ``escape_radius`` cells of it may be crossed, at their ``escape`` cost
+factor (:attr:`~slamtrials.explore.costmap.Costmap.escape`: high, and highest near walls), but only
+from blocked cells: the search leaves the blocked region by the cheapest way and never re-enters it.
 
 Hysteresis. A ``keep`` mask (the current goal's neighbourhood) can be given: the current goal is kept
 unless some other goal cell is cheaper than ``ratio`` times its cost, so that the robot does not swing
@@ -26,7 +26,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
-__all__ = ["PlanResult", "dijkstra", "extract_path"]
+__all__ = ["UNREACHED", "PlanResult", "dijkstra", "extract_path"]
 
 _SQRT2 = math.sqrt(2.0)
 
@@ -34,15 +34,20 @@ _SQRT2 = math.sqrt(2.0)
 _SCALE = 256  # cost units per cell of unit cost
 _CAP = 512.0  # largest cell cost factor
 _UNREACHED = np.iinfo(np.int64).max
+#: :attr:`PlanResult.cost_to_come` of cells the search did not reach.
+UNREACHED = _UNREACHED
 
 
 @njit(cache=True, nogil=True)
-def _dijkstra(cost, kind, sr, sc, goal, keep, use_goal, use_keep, ratio, escape_r2, escape_cost, max_cost):  # pragma: no cover
+def _dijkstra(cost, escape, sr, sc, goal, keep, use_goal, use_keep, ratio, escape_r2, max_cost,
+              ir0, ir1, ic0, ic1):  # pragma: no cover
     """Dijkstra with a circular bucket queue (Dial) over integer costs in units of 1 / 256.
 
     Each open cell sits in exactly one bucket (a doubly linked list threaded through per-cell arrays),
-    and moves when its cost improves, so memory is fixed at a few arrays of the grid's size.
-    Returns (dist int64 [H * W] with _UNREACHED where not reached, parent int64 [H * W], found, kept).
+    and moves when its cost improves, so memory is fixed at a few arrays of the grid's size. Settling a
+    cell outside rows [ir0, ir1) x columns [ic0, ic1) stops the search (the boundary was reached).
+    Returns (dist int64 [H * W] with _UNREACHED where not reached, parent int64 [H * W], found, kept,
+    cost of the first goal settled or -1, cost at which the boundary was reached or -1).
     """
     height, width = cost.shape
     n = height * width
@@ -56,8 +61,6 @@ def _dijkstra(cost, kind, sr, sc, goal, keep, use_goal, use_keep, ratio, escape_
     cap = 512.0
     mask = (1 << 18) - 1  # more buckets than the largest edge weight, sqrt(2) * cap * scale
     head = np.full(mask + 1, -1, dtype=np.int32)
-    escape_q = int(min(escape_cost, cap) * scale + 0.5)
-    escape_occ_q = int(min(4.0 * escape_cost, cap) * scale + 0.5)
     drs = np.array([-1, 1, 0, 0, -1, -1, 1, 1])
     dcs = np.array([0, 0, -1, 1, -1, 1, -1, 1])
     start = sr * width + sc
@@ -70,6 +73,8 @@ def _dijkstra(cost, kind, sr, sc, goal, keep, use_goal, use_keep, ratio, escape_
     found = -1
     kept = False
     first = -1
+    first_cost = -1
+    boundary = -1
     bound = unreached
     if max_cost < 1e15:
         bound = int(max_cost * scale)
@@ -88,19 +93,23 @@ def _dijkstra(cost, kind, sr, sc, goal, keep, use_goal, use_keep, ratio, escape_
         settled[u] = True
         r = u // width
         c = u - r * width
+        if r < ir0 or r >= ir1 or c < ic0 or c >= ic1:
+            boundary = current
+            break
         if use_keep and keep[r, c]:
             found = u
             kept = True
             break
         if use_goal and first < 0 and goal[r, c]:
             first = u
+            first_cost = current
             if not use_keep:
                 break
             bound = min(bound, int(current / ratio) + 1)
         cf = cost[r, c]
         u_blocked = not (cf < np.inf)
         if u_blocked:
-            cu = escape_occ_q if kind[r, c] == 3 else escape_q
+            cu = int(min(escape[r, c], cap) * scale + 0.5)
         else:
             cu = int(min(cf, cap) * scale + 0.5)
         for k in range(8):
@@ -119,7 +128,10 @@ def _dijkstra(cost, kind, sr, sc, goal, keep, use_goal, use_keep, ratio, escape_
                     continue
                 if (nr - sr) * (nr - sr) + (nc - sc) * (nc - sc) > escape_r2:
                     continue
-                cv = escape_occ_q if kind[nr, nc] == 3 else escape_q
+                ev = escape[nr, nc]
+                if not (ev < np.inf):
+                    continue
+                cv = int(min(ev, cap) * scale + 0.5)
             if k < 4:
                 nd = current + ((cu + cv) >> 1)
             else:
@@ -148,7 +160,7 @@ def _dijkstra(cost, kind, sr, sc, goal, keep, use_goal, use_keep, ratio, escape_
                 head[b] = v
     if found < 0:
         found = first
-    return dist, parent, found, kept
+    return dist, parent, found, kept, first_cost, boundary
 
 
 @njit(cache=True, nogil=True)
@@ -183,6 +195,10 @@ class PlanResult:
         Whether the goal found lies in the ``keep`` mask (the current goal was kept).
     width:
         Grid width (cells), to unflatten indices.
+    first_cost:
+        Cost (cells x cost factor) of the cheapest goal cell, or ``None`` if none was settled.
+    boundary_cost:
+        Cost at which the search settled its first cell outside ``interior`` and stopped, or ``None``.
     """
 
     cost_to_come: NDArray[np.int64]
@@ -190,6 +206,8 @@ class PlanResult:
     goal: tuple[int, int] | None
     kept: bool
     width: int
+    first_cost: float | None = None
+    boundary_cost: float | None = None
 
     @property
     def distance(self) -> NDArray[np.float64]:
@@ -215,15 +233,16 @@ def extract_path(parent: NDArray[np.int64], index: int, width: int, reached: boo
     return np.column_stack([chain // width, chain % width])
 
 
-def dijkstra(cost: NDArray[np.float32], kind: NDArray[np.int8], start: tuple[int, int], *,
-             goal: NDArray[np.bool_] | None = None, keep: NDArray[np.bool_] | None = None, ratio: float = 1.0,
-             escape_radius: float = 0.0, escape_cost: float = 50.0, max_cost: float = math.inf) -> PlanResult:
+def dijkstra(cost: NDArray[np.float32], start: tuple[int, int], *, goal: NDArray[np.bool_] | None = None,
+             keep: NDArray[np.bool_] | None = None, ratio: float = 1.0, escape: NDArray[np.float32] | None = None,
+             escape_radius: float = 0.0, max_cost: float = math.inf,
+             interior: tuple[int, int, int, int] | None = None) -> PlanResult:
     """Cost-to-come from ``start`` over the costmap, optionally stopping at the cheapest goal cell.
 
     Parameters
     ----------
-    cost, kind:
-        :attr:`Costmap.cost` and :attr:`Costmap.kind` (``[H, W]``; ``inf`` cost = blocked).
+    cost:
+        float32 ``[H, W]`` cost factor per unit length (:attr:`Costmap.cost`); ``inf`` = blocked.
     start:
         ``(row, col)`` of the robot's cell; must lie in the grid.
     goal:
@@ -232,12 +251,17 @@ def dijkstra(cost: NDArray[np.float32], kind: NDArray[np.int8], start: tuple[int
     keep:
         bool ``[H, W]`` cells of the current goal: returned unless another goal cell costs less than
         ``ratio`` times as much (see the module docstring).
+    escape:
+        float32 ``[H, W]`` cost factors of blocked cells when escaping (:attr:`Costmap.escape`; ``inf``
+        = never); ``None`` disables escaping.
     escape_radius:
         Radius (cells) around ``start`` within which blocked cells may be crossed from blocked cells.
-    escape_cost:
-        Cost factor of such a crossing (occupied cells: four times as much).
     max_cost:
         Stop when the cheapest open cell costs more than this (cells x cost factor).
+    interior:
+        ``(row0, row1, col0, col1)``: stop as soon as a cell outside rows ``[row0, row1)`` and columns
+        ``[col0, col1)`` is settled (a search in a window around the robot, whose outer rim is only
+        there to make the costs right: see :attr:`PlanResult.boundary_cost`). ``None``: the whole grid.
     """
     height, width = cost.shape
     sr, sc = int(start[0]), int(start[1])
@@ -246,9 +270,15 @@ def dijkstra(cost: NDArray[np.float32], kind: NDArray[np.int8], start: tuple[int
     use_goal = goal is not None
     use_keep = keep is not None and bool(keep.any()) and use_goal
     dummy = np.zeros((1, 1), dtype=np.bool_)
-    dist, parent, found, kept = _dijkstra(
-        np.ascontiguousarray(cost, dtype=np.float32), np.ascontiguousarray(kind, dtype=np.int8), sr, sc,
+    if escape is None:
+        escape, escape_radius = cost, -1.0
+    ir0, ir1, ic0, ic1 = (-1, height + 1, -1, width + 1) if interior is None else (int(v) for v in interior)
+    dist, parent, found, kept, first_cost, boundary = _dijkstra(
+        np.ascontiguousarray(cost, dtype=np.float32), np.ascontiguousarray(escape, dtype=np.float32), sr, sc,
         np.ascontiguousarray(goal) if use_goal else dummy, np.ascontiguousarray(keep) if use_keep else dummy,
-        use_goal, use_keep, float(ratio), float(escape_radius) ** 2, float(escape_cost), float(max_cost))
+        use_goal, use_keep, float(ratio), math.copysign(float(escape_radius) ** 2, escape_radius), float(max_cost),
+        ir0, ir1, ic0, ic1)
     where = None if found < 0 else (int(found // width), int(found % width))
-    return PlanResult(cost_to_come=dist, parent=parent, goal=where, kept=bool(kept), width=width)
+    return PlanResult(cost_to_come=dist, parent=parent, goal=where, kept=bool(kept), width=width,
+                      first_cost=None if first_cost < 0 else first_cost / _SCALE,
+                      boundary_cost=None if boundary < 0 else boundary / _SCALE)

@@ -4,12 +4,17 @@
 position. The robot is stuck when it was commanded to move at least ``stuck_min_command`` metres over
 that window but moved (net) less than ``stuck_ratio`` of it: the simulator stops a robot that bumps
 into a wall, and a robot wedged against an obstacle that the map does not show (or shows elsewhere,
-after a SLAM error) does not move either.
+after a SLAM error) does not move either. It is also stuck when it has been following a path for
+``idle_time`` without getting ``idle_distance`` away from where it was (turning back and forth, or
+held still by the scan).
 
-:class:`Recovery` is a fixed manoeuvre, timed in simulated seconds: back off ``backoff_distance`` at
-``backoff_speed`` (the laser sees nothing behind, so this is blind, but it retraces where the robot
-came from; it is skipped when the map shows an obstacle there, see :func:`segment_clear`), then turn
-in place by ``recovery_turn`` towards the side where the scan sees more room.
+:class:`Recovery` is a short open-loop manoeuvre, timed in simulated seconds. A robot touching an
+obstacle (a scan point within 3 cm of its edge: it bumped into something) turns until the direction
+away from that point is straight ahead or behind, and moves ``backoff_distance`` away at
+``backoff_speed`` (less if the map shows less room). Otherwise it backs off ``backoff_distance`` (the laser sees nothing behind, so
+this is blind, but it retraces where the robot came from; it is skipped when the map shows an
+obstacle there, see :func:`segment_clear`), then turns in place by ``recovery_turn`` towards the side
+where the scan sees more room. Either move is dropped when the map shows no room for it.
 """
 
 from __future__ import annotations
@@ -22,9 +27,12 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from slamtrials.explore.config import ExploreConfig
+from slamtrials.explore.follower import scan_points
 from slamtrials.explore.gridframe import FREE_BELOW, GridFrame, map_arrays
 
-__all__ = ["StuckMonitor", "Recovery", "open_side", "segment_clear"]
+__all__ = ["Recovery", "StuckMonitor", "open_side", "segment_clear"]
+
+_CONTACT = 0.03  # m: a scan point this close to the robot's edge means the robot touches an obstacle
 
 
 class StuckMonitor:
@@ -34,16 +42,24 @@ class StuckMonitor:
         self.config = config
         self._samples: deque[tuple[float, float, float, float]] = deque()  # (t, x, y, commanded distance)
         self._commanded = 0.0
+        self._anchor: tuple[float, float, float] | None = None  # (t, x, y) where idling began
 
     def reset(self) -> None:
         """Forget the history."""
         self._samples.clear()
         self._commanded = 0.0
+        self._anchor = None
 
-    def update(self, t: float, pose: ArrayLike, v_command: float, dt: float) -> bool:
+    def update(self, t: float, pose: ArrayLike, v_command: float, dt: float, following: bool = True) -> bool:
         """Record that at time ``t`` (s) the robot was at ``pose`` and was then commanded ``v_command``
-        (m/s) for ``dt`` s; return whether it is stuck."""
+        (m/s) for ``dt`` s, while following a path or not; return whether it is stuck."""
         x, y = float(pose[0]), float(pose[1])  # type: ignore[index]
+        if not following:
+            self._anchor = None
+        elif self._anchor is None or math.hypot(x - self._anchor[1], y - self._anchor[2]) >= self.config.idle_distance:
+            self._anchor = (t, x, y)
+        elif t - self._anchor[0] >= self.config.idle_time:
+            return True
         moved = max(float(v_command), 0.0) * dt
         self._samples.append((t, x, y, moved))
         self._commanded += moved
@@ -56,7 +72,7 @@ class StuckMonitor:
         commanded = self._commanded - moved
         if commanded < self.config.stuck_min_command:
             return False
-        t0, x0, y0, _ = self._samples[0]
+        _, x0, y0, _ = self._samples[0]
         return math.hypot(x - x0, y - y0) < self.config.stuck_ratio * commanded
 
 
@@ -98,7 +114,7 @@ def segment_clear(occupancy: Any, a: ArrayLike, b: ArrayLike, radius: float) -> 
 
 
 class Recovery:
-    """The back-off-and-turn manoeuvre (see the module docstring)."""
+    """The recovery manoeuvre (see the module docstring): open-loop phases timed in simulated seconds."""
 
     def __init__(self, config: ExploreConfig):
         self.config = config
@@ -113,22 +129,52 @@ class Recovery:
         """Abort any manoeuvre."""
         self._phases = []
 
-    def start(self, t: float, ranges: ArrayLike, laser: dict[str, Any], *, back_off: bool = True) -> None:
-        """Begin a manoeuvre at time ``t`` (s), turning towards the more open side of the scan.
+    def start(self, t: float, pose: ArrayLike, ranges: ArrayLike, laser: dict[str, Any], occupancy: Any) -> None:
+        """Begin a manoeuvre at time ``t`` (s) from ``pose`` (map frame) with the current scan and map.
 
-        ``back_off=False`` skips backing off (the caller saw an obstacle behind the robot).
+        If the scan shows an obstacle within ``_CONTACT`` of the robot's edge, the robot turns so
+        that the direction away from that point is straight ahead (or straight behind, whichever
+        needs the smaller turn) and moves ``backoff_distance`` that way, if the map shows room for it.
+        Otherwise it backs off ``backoff_distance`` (if the map shows room behind) and turns
+        ``recovery_turn`` towards the side where the scan sees more room.
         """
         cfg = self.config
-        phases = []
+        x, y, theta = (float(v) for v in np.asarray(pose, dtype=np.float64)[:3])
+        rate = 0.8 * cfg.max_angular_speed
+        phases: list[tuple[float, float]] = []  # (duration, v, w) without the end times yet
+        points = scan_points(ranges, laser)
+        push = None
+        if points.shape[0] and cfg.backoff_distance > 0.0:
+            dist = np.hypot(points[:, 0], points[:, 1])
+            k = int(np.argmin(dist))
+            if dist[k] < cfg.robot_radius + _CONTACT:
+                away = math.atan2(-points[k, 1], -points[k, 0])  # robot frame
+                direction = 1.0 if abs(away) <= 0.5 * math.pi else -1.0
+                turn = away if direction > 0 else math.remainder(away - math.pi, 2.0 * math.pi)
+                heading = theta + away
+                ux, uy = math.cos(heading), math.sin(heading)
+                # from a little way out: the obstacle being touched (as the map shows it) is left behind
+                start = (x + _CONTACT * ux, y + _CONTACT * uy)
+                for share in (1.0, 0.6, 0.3):  # as far as the map shows room for
+                    length = share * cfg.backoff_distance
+                    if segment_clear(occupancy, start, (x + length * ux, y + length * uy), cfg.robot_radius - _CONTACT):
+                        push = (turn, direction, length)
+                        break
+        if push is not None:
+            turn, direction, length = push
+            phases.append((abs(turn) / rate, 0.0, math.copysign(rate, turn)))
+            phases.append((length / cfg.backoff_speed, direction * cfg.backoff_speed, 0.0))
+        else:
+            behind = (x - (cfg.backoff_distance + 0.05) * math.cos(theta), y - (cfg.backoff_distance + 0.05) * math.sin(theta))
+            if cfg.backoff_distance > 0.0 and segment_clear(occupancy, (x, y), behind, cfg.robot_radius):
+                phases.append((cfg.backoff_distance / cfg.backoff_speed, -cfg.backoff_speed, 0.0))
+            if cfg.recovery_turn > 0.0:
+                phases.append((cfg.recovery_turn / rate, 0.0, open_side(ranges, laser) * rate))
         end = t
-        if back_off and cfg.backoff_distance > 0.0:
-            end += cfg.backoff_distance / cfg.backoff_speed + cfg.backoff_speed / cfg.max_linear_accel
-            phases.append((end, -cfg.backoff_speed, 0.0))
-        if cfg.recovery_turn > 0.0:
-            rate = 0.8 * cfg.max_angular_speed
-            end += cfg.recovery_turn / rate + rate / cfg.max_angular_accel
-            phases.append((end, 0.0, open_side(ranges, laser) * rate))
-        self._phases = phases
+        self._phases = []
+        for duration, v, w in phases:
+            end += duration
+            self._phases.append((end, v, w))
 
     def command(self, t: float) -> tuple[float, float] | None:
         """The manoeuvre's command at time ``t``, or ``None`` once it is over."""

@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 from slamtrials.explore.config import TerminationConfig
 from slamtrials.explore.gridframe import FREE_BELOW, map_arrays
 
-__all__ = ["SnapshotTermination", "Snapshot", "map_image", "align_into", "downscale", "snapshot_mse", "free_area"]
+__all__ = ["Snapshot", "SnapshotTermination", "align_into", "downscale", "free_area", "map_image", "snapshot_mse"]
 
 
 def map_image(grid: NDArray[np.int8], unknown_grey: int = 205) -> NDArray[np.uint8]:
@@ -84,8 +84,8 @@ def align_into(older: Snapshot, newer: Snapshot, fill: int = 205) -> NDArray[np.
     if not math.isclose(older.resolution, newer.resolution, rel_tol=1e-9):
         raise ValueError(f"snapshots differ in resolution: {older.resolution} m vs {newer.resolution} m")
     res = newer.resolution
-    dc = int(round((older.origin[0] - newer.origin[0]) / res))  # older column 0 in newer columns
-    dv = int(round((older.origin[1] - newer.origin[1]) / res))  # older bottom row, in rows up from newer's bottom
+    dc = round((older.origin[0] - newer.origin[0]) / res)  # older column 0 in newer columns
+    dv = round((older.origin[1] - newer.origin[1]) / res)  # older bottom row, in rows up from newer's bottom
     oh, ow = older.image.shape
     nh, nw = newer.image.shape
     dr = nh - oh - dv  # older row 0 in newer rows (from the top)

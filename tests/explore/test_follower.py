@@ -1,0 +1,113 @@
+"""Path follower: scan geometry, free travel along arcs, pure pursuit, turning in place, obstacles."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from slamtrials.explore import ExploreConfig, PathFollower
+from slamtrials.explore.follower import free_travel, scan_points, turn_rate
+
+LASER = {"angle_min": -math.radians(135), "angle_increment": math.radians(0.5), "range_min": 0.0,
+         "range_max": 30.0, "mount": [0.0, 0.0, 0.0]}
+BEAMS = 541
+
+
+def empty_scan():
+    return np.full(BEAMS, 30.0, dtype=np.float32)
+
+
+def wall_scan(distance):
+    """A wall across the robot's path, ``distance`` m ahead (robot frame x = distance)."""
+    angles = LASER["angle_min"] + LASER["angle_increment"] * np.arange(BEAMS)
+    with np.errstate(divide="ignore"):
+        r = np.where(np.cos(angles) > 1e-6, distance / np.cos(angles), 30.0)
+    return np.minimum(r, 30.0).astype(np.float32)
+
+
+def test_scan_points_use_the_mount_and_drop_max_range():
+    laser = dict(LASER, mount=[0.1, 0.0, math.pi / 2])
+    r = empty_scan()
+    r[270] = 2.0  # the middle beam: straight ahead of the laser, which looks left
+    pts = scan_points(r, laser)
+    assert pts.shape == (1, 2)
+    assert np.allclose(pts[0], [0.1, 2.0], atol=1e-9)
+
+
+def test_free_travel_straight_and_on_arcs():
+    pts = np.array([[1.0, 0.0]])
+    assert math.isclose(free_travel(pts, 0.0, 0.2), 0.8)
+    assert free_travel(np.array([[1.0, 0.3]]), 0.0, 0.2) == 5.0  # beside the path
+    assert free_travel(np.array([[-1.0, 0.0]]), 0.0, 0.2) == 5.0  # behind
+    # on a left turn of radius 1 m, a point a quarter circle ahead, on the arc
+    travel = free_travel(np.array([[1.0, 1.0]]), 1.0, 0.2)
+    assert math.isclose(travel, math.pi / 2 - 0.2, abs_tol=1e-9)
+    # the same point for a right turn is off the arc
+    assert free_travel(np.array([[1.0, 1.0]]), -1.0, 0.2) == 5.0
+    assert free_travel(np.array([[0.1, 0.0]]), 0.0, 0.2) == 0.0
+
+
+def test_turn_rate_respects_limits():
+    assert turn_rate(0.0, 1.2, 1.7) == 0.0
+    assert turn_rate(3.0, 1.2, 1.7) == 1.2
+    assert turn_rate(-3.0, 1.2, 1.7) == -1.2
+    small = turn_rate(0.01, 1.2, 1.7)
+    assert 0 < small <= math.sqrt(2 * 1.7 * 0.01)
+
+
+def test_follows_a_straight_path_within_the_limits():
+    cfg = ExploreConfig()
+    follower = PathFollower(cfg)
+    follower.set_path(np.column_stack([np.linspace(0, 5, 101), np.zeros(101)]))
+    v_prev = 0.0
+    for _ in range(30):
+        out = follower.command([0.0, 0.0, 0.0], empty_scan(), LASER)
+        assert abs(out.w) < 1e-9 and out.v <= cfg.max_linear_speed + 1e-12
+        assert out.v - v_prev <= cfg.max_linear_accel * cfg.control_period + 1e-12
+        v_prev = out.v
+    assert math.isclose(v_prev, cfg.max_linear_speed)
+
+
+def test_turns_in_place_towards_a_path_behind():
+    follower = PathFollower(ExploreConfig())
+    follower.set_path(np.column_stack([np.linspace(0, -3, 61), np.zeros(61)]))
+    out = follower.command([0.0, 0.0, 0.0], empty_scan(), LASER)
+    assert out.v == 0.0 and out.w != 0.0
+
+
+def test_curves_towards_a_path_to_the_left():
+    follower = PathFollower(ExploreConfig())
+    follower.set_path(np.column_stack([np.linspace(0, 3, 61), np.linspace(0, 1.5, 61)]))
+    for _ in range(10):
+        out = follower.command([0.0, 0.0, 0.0], empty_scan(), LASER)
+    assert out.v > 0.0 and out.w > 0.0
+
+
+@pytest.mark.parametrize(("distance", "expect"), [(3.0, "full"), (0.6, "slow"), (0.25, "creep"), (0.155, "stopped")])
+def test_slows_down_and_stops_for_obstacles_in_the_scan(distance, expect):
+    cfg = ExploreConfig()
+    follower = PathFollower(cfg)
+    follower.set_path(np.column_stack([np.linspace(0, 5, 101), np.zeros(101)]))
+    follower.remember(cfg.max_linear_speed, 0.0)
+    out = follower.command([0.0, 0.0, 0.0], wall_scan(distance), LASER)
+    if expect == "full":
+        assert math.isclose(out.v, cfg.max_linear_speed)
+    elif expect == "slow":
+        assert 0.0 < out.v < cfg.max_linear_speed
+        room = distance - cfg.robot_radius - cfg.obstacle_margin - cfg.stop_distance
+        assert out.v <= math.sqrt(2 * cfg.max_linear_accel * room) + 1e-6
+    elif expect == "creep":  # too close for the normal margins: inch on slowly
+        assert 0.0 < out.v <= 0.15 and not out.blocked
+    else:
+        assert out.v == 0.0 and out.blocked
+
+
+def test_reports_the_end_of_the_path():
+    follower = PathFollower(ExploreConfig())
+    follower.set_path(np.array([[0.0, 0.0], [0.1, 0.0]]))
+    out = follower.command([0.05, 0.0, 0.0], empty_scan(), LASER)
+    assert out.finished and out.v == 0.0
+    follower.clear()
+    assert not follower.has_path and follower.command([0, 0, 0], empty_scan(), LASER).finished

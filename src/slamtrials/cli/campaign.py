@@ -18,7 +18,7 @@ from typing import Annotated
 
 import typer
 
-from slamtrials.cli.main import make_app, make_console
+from slamtrials.cli.common import make_app, make_console
 from slamtrials.errors import ConfigError
 
 __all__ = ["app", "register", "summary_table", "EXIT_INTERRUPTED"]

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from slamtrials.cli.main import make_app
+from slamtrials.cli.common import make_app
 
 __all__ = ["app", "dump", "register"]
 

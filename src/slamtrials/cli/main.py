@@ -11,43 +11,13 @@ import logging
 from typing import Annotated
 
 import typer
-from typer.core import TyperGroup
 
 from slamtrials.__about__ import __version__
-from slamtrials.errors import SlamtrialsError
+from slamtrials.cli.common import EXIT_BAD_INPUT, ErrorReportingGroup, make_app, make_console
 
-EXIT_BAD_INPUT = 2
-
-
-class ErrorReportingGroup(TyperGroup):
-    """A command group that turns expected errors into one line and exit status 2."""
-
-    def invoke(self, ctx):  # ctx: typer's (vendored) click Context
-        try:
-            return super().invoke(ctx)
-        except SlamtrialsError as exc:
-            typer.echo(f"error: {exc}", err=True)
-            raise typer.Exit(EXIT_BAD_INPUT) from None
-        except OSError as exc:  # missing, unreadable or unwritable files named on the command line
-            where = f"{exc.filename}: " if exc.filename else ""
-            typer.echo(f"error: {where}{exc.strerror or exc}", err=True)
-            raise typer.Exit(EXIT_BAD_INPUT) from None
-
-
-def make_app(**kwargs) -> typer.Typer:
-    """A typer app with slamtrials' defaults (error reporting, no shell-completion options)."""
-    return typer.Typer(cls=ErrorReportingGroup, add_completion=False, no_args_is_help=True, **kwargs)
-
+__all__ = ["app", "main", "make_app", "make_console", "ErrorReportingGroup", "EXIT_BAD_INPUT"]
 
 app = make_app(help="Repeatable SLAM evaluation: simulate, explore, map, measure, repeat until confident.")
-
-
-def make_console():
-    """A rich Console for command output; pipes and logs get 110 columns instead of rich's default 80."""
-    from rich.console import Console
-
-    console = Console()
-    return console if console.is_terminal else Console(width=110)
 
 
 def _version(value: bool) -> None:

@@ -8,7 +8,7 @@ from typing import Annotated
 
 import typer
 
-from slamtrials.cli.main import make_console
+from slamtrials.cli.common import make_console
 from slamtrials.errors import ConfigError
 
 RUN_PICTURE = "run.png"

@@ -11,7 +11,7 @@ from typing import Annotated, Any
 
 import typer
 
-from slamtrials.cli.main import make_console
+from slamtrials.cli.common import make_console
 from slamtrials.errors import ConfigError
 
 __all__ = ["slam", "register", "parse_settings"]

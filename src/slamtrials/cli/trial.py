@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from slamtrials.cli.main import make_console
+from slamtrials.cli.common import make_console
 from slamtrials.errors import ConfigError
 
 __all__ = ["trial", "register", "TRIAL_PICTURE"]

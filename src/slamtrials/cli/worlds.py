@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from slamtrials.cli.main import make_app, make_console
+from slamtrials.cli.common import make_app, make_console
 from slamtrials.errors import ConfigError
 
 app = make_app(help="List, show, describe and generate floor plans.")

@@ -1,0 +1,44 @@
+"""What every command module shares: the error-reporting group, the app factory and the console.
+
+Kept apart from :mod:`slamtrials.cli.main` (which imports every command module to register it) so that
+a command module can be imported on its own without a circular import.
+"""
+
+from __future__ import annotations
+
+import typer
+from typer.core import TyperGroup
+
+from slamtrials.errors import SlamtrialsError
+
+__all__ = ["EXIT_BAD_INPUT", "ErrorReportingGroup", "make_app", "make_console"]
+
+EXIT_BAD_INPUT = 2
+
+
+class ErrorReportingGroup(TyperGroup):
+    """A command group that turns expected errors into one line and exit status 2."""
+
+    def invoke(self, ctx):  # ctx: typer's (vendored) click Context
+        try:
+            return super().invoke(ctx)
+        except SlamtrialsError as exc:
+            typer.echo(f"error: {exc}", err=True)
+            raise typer.Exit(EXIT_BAD_INPUT) from None
+        except OSError as exc:  # missing, unreadable or unwritable files named on the command line
+            where = f"{exc.filename}: " if exc.filename else ""
+            typer.echo(f"error: {where}{exc.strerror or exc}", err=True)
+            raise typer.Exit(EXIT_BAD_INPUT) from None
+
+
+def make_app(**kwargs) -> typer.Typer:
+    """A typer app with slamtrials' defaults (error reporting, no shell-completion options)."""
+    return typer.Typer(cls=ErrorReportingGroup, add_completion=False, no_args_is_help=True, **kwargs)
+
+
+def make_console():
+    """A rich Console for command output; pipes and logs get 110 columns instead of rich's default 80."""
+    from rich.console import Console
+
+    console = Console()
+    return console if console.is_terminal else Console(width=110)

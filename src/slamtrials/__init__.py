@@ -35,6 +35,8 @@ _PUBLIC = {
     "run_campaign": "slamtrials.campaign",
     "replay_campaign": "slamtrials.campaign",
     "campaign_status": "slamtrials.campaign",
+    "load_campaign": "slamtrials.report",
+    "build_report": "slamtrials.report",
 }
 
 __all__ = ["__version__", *_PUBLIC]

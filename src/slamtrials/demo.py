@@ -1,81 +1,87 @@
-"""The main job until the campaign exists: scripted tours through bundled worlds, recorded and pictured.
+"""The README's main job: a small campaign on bundled worlds, then its HTML report.
 
-For each world: an automatic tour (:func:`slamtrials.sim.tour.tour_waypoints`) driven by the simulator
-with the paper's robot, laser and odometry; the run folder is written under
-``<out>/runs/<world>/000/`` as in DESIGN.md, with a picture of the true and odometry paths.
+:func:`run_demo` runs :func:`slamtrials.campaign.small_campaign_config` (the paper's robot, online
+GMapping, frontier exploration, the Section III-C run-count rule with a first batch of 5 runs and a cap
+of 10 per world, on three small bundled buildings) with :func:`slamtrials.campaign.run_campaign` on a
+local Dask cluster (one worker process per core by default), in the folder ``out``; then it writes the
+report (:func:`slamtrials.report.build.build_report`, ``<out>/report/index.html``). On 2 cores the
+campaign takes about 4 to 8 minutes. Calling it again on the same folder resumes an interrupted campaign
+(a finished one is not run again) and rebuilds the report.
 """
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
-import numpy as np
+from slamtrials.campaign.demo import DEMO_WORLDS
 
-__all__ = ["DEMO_WORLDS", "DemoRun", "run_demo"]
-
-#: Small bundled worlds of different kinds, each explored in well under a minute.
-DEMO_WORLDS = ("office_small_01", "lab_small_01")
+__all__ = ["DEMO_WORLDS", "DemoResult", "run_demo", "demo_config"]
 
 
 @dataclass(frozen=True)
-class DemoRun:
-    """Summary of one demo run: where it is and how it went."""
+class DemoResult:
+    """What :func:`run_demo` did.
 
-    world: str
-    folder: Path
-    frames: int
-    simulated_s: float
-    wall_s: float
-    distance_m: float
-    odometry_drift_m: float
-    outcome: str
-
-
-def run_demo(
-    out: str | Path,
-    worlds: Sequence[str] = DEMO_WORLDS,
-    *,
-    seed: int = 1,
-    on_run: Callable[[DemoRun], None] | None = None,
-) -> list[DemoRun]:
-    """Drive a tour through each of ``worlds`` and write its run folder and picture under ``out``.
-
-    Returns one :class:`DemoRun` per world; ``on_run`` is called after each (for progress output).
+    Attributes
+    ----------
+    campaign:
+        The campaign's :class:`~slamtrials.campaign.CampaignResult` (its ``summary`` is the paper's Table I).
+    report:
+        The report page, ``<out>/report/index.html``.
+    confidence:
+        Confidence level of the summary's intervals.
     """
-    from slamtrials.geometry import compose
-    from slamtrials.io.runfolder import write_run
-    from slamtrials.report.runplot import save_run_figure
-    from slamtrials.sim import SimConfig, simulate_waypoints
-    from slamtrials.sim.tour import tour_waypoints
-    from slamtrials.worlds import load_world
 
-    out = Path(out)
-    runs = []
-    for name in worlds:
-        world = load_world(name)
-        waypoints = tour_waypoints(world)
-        started = time.perf_counter()
-        record = simulate_waypoints(world, waypoints, SimConfig.paper(), seed=seed)
-        wall = time.perf_counter() - started
-        record.metadata.update(world_source=name, wall_time_s=round(wall, 3))
-        folder = write_run(out / "runs" / world.name / "000", record)
-        save_run_figure(world, record, folder / "run.png", title=f"{world.name}: scripted tour, seed {seed}")
-        steps = np.linalg.norm(np.diff(record.truth[:, :2], axis=0), axis=1)
-        odometry_end = compose(record.truth[0], record.odometry[-1])
-        run = DemoRun(
-            world=world.name,
-            folder=folder,
-            frames=len(record),
-            simulated_s=float(record.t[-1] - record.t[0]),
-            wall_s=wall,
-            distance_m=float(steps.sum()),
-            odometry_drift_m=float(np.linalg.norm(odometry_end[:2] - record.truth[-1, :2])),
-            outcome=str(record.metadata.get("outcome", "")),
-        )
-        runs.append(run)
-        if on_run is not None:
-            on_run(run)
-    return runs
+    campaign: Any
+    report: Path
+    confidence: float
+
+
+def demo_config(out: str | Path, worlds: Sequence[str] = DEMO_WORLDS, *, seed: int = 0):
+    """The demo's :class:`~slamtrials.campaign.CampaignConfig` (:func:`~slamtrials.campaign.small_campaign_config`)."""
+    from slamtrials.campaign import small_campaign_config
+
+    return small_campaign_config(tuple(worlds), seed, output=str(out))
+
+
+def run_demo(out: str | Path, worlds: Sequence[str] = DEMO_WORLDS, *, seed: int = 0, workers: int | None = None,
+             scheduler: Any = None, trial_fn: Callable | None = None, on_event: Callable | None = None,
+             repeats: int = 200, pdf: bool = True) -> DemoResult:
+    """Run (or resume) the demo campaign in ``out`` and write its report.
+
+    Parameters
+    ----------
+    out:
+        The campaign folder (created; an existing demo campaign of the same settings is resumed).
+    worlds:
+        World entries (bundled names, floor-plan files or folders).
+    seed:
+        Root seed of the campaign.
+    workers:
+        Worker processes of the local Dask cluster (default: one per core).
+    scheduler:
+        A Dask scheduler address or ``distributed.Client`` instead of a local cluster.
+    trial_fn:
+        A stand-in for :func:`slamtrials.trial.run_trial` (tests: :class:`slamtrials.campaign.testing.FakeTrial`).
+    on_event:
+        Progress callback of the campaign (:class:`~slamtrials.campaign.CampaignEvent`).
+    repeats:
+        Samplings of the report's relation-sampling check (Fig. 3).
+    pdf:
+        Also save the report's figures as PDF.
+
+    Raises
+    ------
+    ConfigError
+        A bad world, bad ``workers``, or an ``out`` that holds something other than this demo campaign.
+    """
+    from slamtrials.campaign import run_campaign
+    from slamtrials.report.build import build_report
+
+    config = demo_config(out, worlds, seed=seed)
+    result = run_campaign(config, out, scheduler=scheduler, workers=workers, trial_fn=trial_fn, on_event=on_event)
+    page = build_report(result.folder, repeats=repeats, pdf=pdf)
+    return DemoResult(result, page, config.runs.confidence)

@@ -45,6 +45,7 @@ def _register_commands() -> None:
     from slamtrials.cli import slam
     from slamtrials.cli import trial
     from slamtrials.cli import campaign, config
+    from slamtrials.cli import report
 
     app.add_typer(worlds.app, name="worlds", help="List, show, load and generate floor plans.")
     simulate.register(app)
@@ -55,6 +56,7 @@ def _register_commands() -> None:
     trial.register(app)
     campaign.register(app)
     config.register(app)
+    report.register(app)
 
 
 _register_commands()

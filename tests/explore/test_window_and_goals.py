@@ -74,3 +74,17 @@ def test_goal_progress_and_reroutes():
     assert goal.last_progress == 2.0  # about the same length: the clock keeps running
     goal.rerouted(4.0, 15.0, 1.0)
     assert (goal.best, goal.last_progress) == (15.0, 4.0)  # a much longer way round: a fresh start
+
+
+def test_coarsen_is_conservative_and_keeps_the_origin():
+    from slamtrials.explore.window import coarsen
+
+    grid = np.zeros((5, 6), dtype=np.int8)
+    grid[4, 0] = 100  # bottom-left cell occupied
+    grid[0, 5] = -1
+    coarse = coarsen(grid, 2)
+    assert coarse.shape == (3, 3)
+    assert coarse[2, 0] == 100  # the block of the bottom-left cell: the origin corner is kept
+    assert coarse[0, :].tolist() == [-1, -1, -1]  # the padding row at the top is unknown
+    assert coarse[1, 2] == 0 and coarse[2, 2] == 0
+    assert np.array_equal(coarsen(grid, 1), grid)

@@ -100,6 +100,7 @@ class ExploreConfig(BaseModel):
     stop_distance: float = Field(0.05, ge=0.0, le=2.0, description="distance kept from obstacles seen in the scan (m)")
     # --- goals ---------------------------------------------------------------------------------------
     local_radius: float = Field(10.0, gt=0.0, le=1000.0, description="half-size of the window around the robot searched for a goal first (m)")
+    global_coarsening: int = Field(2, ge=1, le=8, description="whole-map searches look at blocks of this many cells squared first (1 = full resolution only)")
     global_replan_period: float = Field(15.0, gt=0.0, le=3600.0, description="while heading for a goal outside that window, search the whole map this often (s)")
     replan_period: float = Field(3.0, gt=0.0, le=600.0, description="replan at least this often (s)")
     min_replan_interval: float = Field(1.0, ge=0.0, le=600.0, description="smallest time between event-driven replans (s)")

@@ -15,8 +15,10 @@ Each call of :meth:`Explorer.command` runs, in this order:
    rim where obstacles still change costs): a goal that Dijkstra settles before reaching the window's
    edge is the closest in the whole map too. Otherwise, if the robot is heading for a goal beyond the
    window and its path is still clear, it keeps going (searching the whole map every
-   ``global_replan_period``); else the whole known map is searched. The cost of a step thus stays
-   about the same however large the building;
+   ``global_replan_period``); else the whole known map is searched, first on a copy with cells
+   ``global_coarsening`` times larger (four times cheaper for a factor of 2), then, if that finds
+   nothing, at full resolution. The cost of a step thus stays about the same however large the
+   building;
 5. the path follower (:mod:`slamtrials.explore.follower`) gives the command.
 
 When no reachable frontier is left and the robot can reach less than ``shut_in_share`` of the map's
@@ -338,7 +340,10 @@ class Explorer:
             if outcome == "edge":
                 if t - self._last_global < cfg.global_replan_period and self._can_keep_goal(pose):
                     return  # keep heading for the far goal
-                outcome = self._try(t, pose, occupancy, grid, whole, None)
+                if cfg.global_coarsening > 1:
+                    outcome = self._try(t, pose, occupancy, grid, whole, None, coarse=cfg.global_coarsening)
+                if outcome != "goal":
+                    outcome = self._try(t, pose, occupancy, grid, whole, None)
         if outcome == "none":
             outcome = self._last_resorts(t, pose, occupancy, grid, whole)
         if outcome == "none" and self._blacklist and self._resets_left > 0:
@@ -364,7 +369,7 @@ class Explorer:
 
     def _try(self, t: float, pose: NDArray[np.float64], occupancy: Any, grid: NDArray[np.int8],
              box: tuple[int, int, int, int], inner: tuple[int, int, int, int] | None, *,
-             views: bool = False, relaxed: bool = False) -> str:
+             views: bool = False, relaxed: bool = False, coarse: int = 1) -> str:
         """One goal search (:meth:`GoalSearch.search`); take its goal. Returns ``"goal"``, ``"edge"``,
         ``"none"`` or ``"lost"``."""
         if inner is None:
@@ -372,7 +377,7 @@ class Explorer:
         outcome, found = self._search.search(pose, occupancy, grid, box, inner, visited=self._visited,
                                              blacklist=self._blacklist,
                                              current=None if self._goal is None else self._goal.xy,
-                                             views=views, relaxed=relaxed)
+                                             views=views, relaxed=relaxed, coarse=coarse)
         if outcome == "undecided" and self._can_keep_goal(pose):
             return "goal"  # the current goal beyond the window may still be the better one
         if found is None:

@@ -30,7 +30,9 @@ from numpy.typing import NDArray
 
 from slamtrials.explore.config import ExploreConfig
 from slamtrials.explore.costmap import (
+    OCCUPIED,
     PASSABLE,
+    UNKNOWN,
     Costmap,
     build_costmap,
     squared_distance_transform,
@@ -39,7 +41,7 @@ from slamtrials.explore.frontiers import Frontiers, find_frontiers
 from slamtrials.explore.goals import exclude_discs
 from slamtrials.explore.gridframe import GridFrame
 from slamtrials.explore.planner import UNREACHED, dijkstra
-from slamtrials.explore.window import crop, known_box
+from slamtrials.explore.window import coarsen, crop, known_box
 
 __all__ = ["CROP_MARGIN", "Found", "GoalSearch", "Prepared"]
 
@@ -105,7 +107,7 @@ class GoalSearch:
 
     def reset(self) -> None:
         """Forget the cached windows."""
-        self._cache: dict[bool, tuple[Box, Any, Prepared]] = {}  # relaxed -> (box, map object, prepared)
+        self._cache: dict[tuple[bool, int], tuple[Box, Any, Prepared]] = {}  # (relaxed, coarse) -> (box, map, prepared)
         self._box_for: Any = None
         self._box: Box | None = None
         self.latest: Prepared | None = None
@@ -118,12 +120,15 @@ class GoalSearch:
             self._box = known_box(grid, CROP_MARGIN)
         return self._box
 
-    def prepare(self, occupancy: Any, grid: NDArray[np.int8], box: Box, relaxed: bool = False) -> Prepared:
+    def prepare(self, occupancy: Any, grid: NDArray[np.int8], box: Box, relaxed: bool = False,
+                coarse: int = 1) -> Prepared:
         """Costmap and frontiers of the window ``box`` of the map (cached per map object and window).
 
-        ``relaxed`` uses ``relaxed_margin`` instead of ``inflation_margin``.
+        ``relaxed`` uses ``relaxed_margin`` instead of ``inflation_margin``; ``coarse`` > 1 works on a
+        copy of the window with cells ``coarse`` times larger (:func:`~slamtrials.explore.window.coarsen`).
         """
-        cached = self._cache.get(relaxed)
+        key = (relaxed, coarse)
+        cached = self._cache.get(key)
         if cached is not None and cached[0] == box and cached[1] is occupancy:
             return cached[2]
         cfg = self._relaxed if relaxed else self.config
@@ -131,18 +136,23 @@ class GoalSearch:
         window = crop(grid, r0, r1, c0, c1)
         resolution = float(occupancy.resolution)
         frame = GridFrame.of(occupancy).sub(r0, c0, r1 - r0, c1 - c0)
+        if coarse > 1:
+            window = coarsen(window, coarse)
+            resolution *= coarse
+            frame = GridFrame(window.shape[0], window.shape[1], resolution, frame.origin)
         costmap = build_costmap(window, resolution, cfg)
         frontiers = find_frontiers(window, min_cells=max(1, math.ceil(cfg.min_frontier_length / resolution - 1e-9)),
                                    min_unknown_cells=math.ceil(cfg.min_unknown_area / resolution**2 - 1e-9))
         prepared = Prepared(frame, costmap, frontiers)
-        self._cache[relaxed] = (box, occupancy, prepared)
-        self.latest = prepared
+        self._cache[key] = (box, occupancy, prepared)
+        if coarse == 1:
+            self.latest = prepared
         return prepared
 
     def search(self, pose: NDArray[np.float64], occupancy: Any, grid: NDArray[np.int8], box: Box,
                inner: Box | None, *, visited: list[NDArray[np.float64]], blacklist: list[NDArray[np.float64]],
-               current: NDArray[np.float64] | None, views: bool = False,
-               relaxed: bool = False) -> tuple[str, Found | None]:
+               current: NDArray[np.float64] | None, views: bool = False, relaxed: bool = False,
+               coarse: int = 1) -> tuple[str, Found | None]:
         """Look for a goal in window ``box`` of the map; with ``inner``, only as far as that part of it.
 
         Parameters
@@ -162,6 +172,9 @@ class GoalSearch:
             float64 ``[2]`` the current goal, kept unless another is clearly cheaper; or ``None``.
         views, relaxed:
             The kind of goal (module docstring).
+        coarse:
+            Search a copy of the window with cells this many times larger (cheaper; conservative: a
+            passage may close, so a search that finds nothing must be repeated at full resolution).
 
         Returns
         -------
@@ -172,8 +185,8 @@ class GoalSearch:
             when no goal is reachable; ``"lost"`` when the robot is off the window.
         """
         cfg = self.config
-        normal = self.prepare(occupancy, grid, box) if relaxed else None
-        prepared = self.prepare(occupancy, grid, box, relaxed)
+        normal = self.prepare(occupancy, grid, box, coarse=coarse) if relaxed else None
+        prepared = self.prepare(occupancy, grid, box, relaxed, coarse)
         frame, costmap = prepared.frame, prepared.costmap
         row, col = (int(v) for v in frame.to_cell(pose[:2]))
         if not frame.inside(row, col):
@@ -212,8 +225,10 @@ class GoalSearch:
         return outcome, Found(path=path, clearance=clearance, target=target, kept=result.kept)
 
     def path_clear(self, path: NDArray[np.float64], pose: NDArray[np.float64]) -> bool:
-        """Whether ``path`` (map frame) crosses no blocked cell of the latest costmap (cells within
-        ``escape_radius`` of the robot aside: it may be escaping from the lethal zone)."""
+        """Whether the robot still fits along ``path`` (map frame) in the latest full-resolution costmap:
+        no point on an occupied or unknown cell or closer than ``robot_radius`` to an obstacle (points
+        within ``escape_radius`` of the robot aside: it may be escaping from the lethal zone). Paths
+        from a coarse search may come closer to walls than the lethal distance; that is allowed."""
         prepared = self.latest
         if prepared is None or path.shape[0] == 0:
             return False
@@ -222,7 +237,10 @@ class GoalSearch:
         inside = (rows >= 0) & (rows < frame.height) & (cols >= 0) & (cols < frame.width)
         far = np.hypot(path[:, 0] - pose[0], path[:, 1] - pose[1]) > self.config.escape_radius
         check = inside & far
-        return bool((prepared.costmap.kind[rows[check], cols[check]] == PASSABLE).all())
+        kind = prepared.costmap.kind[rows[check], cols[check]]
+        clearance = prepared.costmap.clearance[rows[check], cols[check]]
+        blocked = (kind == OCCUPIED) | (kind == UNKNOWN) | (clearance < self.config.robot_radius)
+        return not bool(blocked.any())
 
     def _candidates(self, prepared: Prepared, visited: list[NDArray[np.float64]],
                     views: bool) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:

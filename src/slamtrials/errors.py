@@ -8,8 +8,10 @@ with status 2.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 __all__ = [
+    "validation_problems",
     "SlamtrialsError",
     "ConfigError",
     "FormatError",
@@ -84,3 +86,18 @@ class MetricError(SlamtrialsError):
         self.what = what
         self.index = index
         super().__init__(problem)
+
+
+def validation_problems(exc: Any) -> str:
+    """A pydantic ``ValidationError`` as one line: ``field.path: message (got value)``, joined by ``; ``."""
+    problems = []
+    for err in exc.errors():
+        field = ".".join(str(p) for p in err["loc"]) or "<root>"
+        if err.get("type") == "missing":
+            problems.append(f"{field}: required setting is missing")
+            continue
+        shown = repr(err.get("input"))
+        if len(shown) > 80:
+            shown = shown[:77] + "..."
+        problems.append(f"{field}: {err['msg'].removeprefix('Value error, ')} (got {shown})")
+    return "; ".join(problems)

@@ -19,7 +19,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from slamtrials.errors import ConfigError, FormatError
+from slamtrials.errors import ConfigError, FormatError, validation_problems
 from slamtrials.explore import ExploreConfig, TerminationConfig
 from slamtrials.metric.runcount import DEFAULT_MIN_RUNS
 from slamtrials.metric.sampling import DEFAULT_CONFIDENCE, DEFAULT_MARGIN_R, DEFAULT_MARGIN_T, DEFAULT_PILOT
@@ -160,7 +160,7 @@ class CampaignConfig(BaseModel):
         try:
             config = cls.model_validate(data)
         except ValidationError as exc:
-            raise ConfigError(f"{source}: " + "; ".join(_problem(err) for err in exc.errors())) from None
+            raise ConfigError(f"{source}: " + validation_problems(exc)) from None
         try:
             config.slam.resolved()
         except ConfigError as exc:
@@ -184,16 +184,3 @@ class CampaignConfig(BaseModel):
         if path.is_dir():
             raise FormatError(path, "is a folder; give a campaign config YAML file")
         return cls.from_dict(read_yaml_mapping(path), source=str(path))
-
-
-def _problem(err: dict[str, Any]) -> str:
-    """One pydantic error as ``field.path: message (got value)``."""
-    field = ".".join(str(p) for p in err["loc"]) or "<root>"
-    if err.get("type") == "missing":
-        return f"{field}: required setting is missing"
-    value = err.get("input")
-    shown = repr(value)
-    if len(shown) > 80:
-        shown = shown[:77] + "..."
-    message = err["msg"].removeprefix("Value error, ")
-    return f"{field}: {message} (got {shown})"

@@ -2,8 +2,8 @@
 
 :class:`Explorer` turns the SLAM pose, the laser scan and the SLAM map into velocity commands: it finds
 frontiers (:mod:`.frontiers`), plans to the closest one by path cost over an inflated costmap
-(:mod:`.costmap`, :mod:`.planner`), follows the path with pure pursuit while watching the scan
-(:mod:`.follower`), and gets itself unstuck (:mod:`.recovery`). :class:`SnapshotTermination` stops a
+(:mod:`.costmap`, :mod:`.planner`, :mod:`.goalsearch`), follows the path with pure pursuit while
+watching the scan (:mod:`.follower`), and gets itself unstuck (:mod:`.recovery`). :class:`SnapshotTermination` stops a
 run when two consecutive map snapshots barely differ (:mod:`.termination`).
 
 Maps are duck typed: any object with ``grid`` (int8 ``[H, W]``, 100 occupied, 0 free, -1 unknown,

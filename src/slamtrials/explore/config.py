@@ -17,7 +17,7 @@ from typing import Any, TypeVar
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from slamtrials.errors import ConfigError
+from slamtrials.errors import ConfigError, validation_problems
 
 __all__ = ["ExploreConfig", "TerminationConfig"]
 
@@ -29,11 +29,7 @@ def _validate(cls: type[_Model], data: dict[str, Any], what: str) -> _Model:
     try:
         return cls.model_validate(data)
     except ValidationError as exc:
-        problems = []
-        for err in exc.errors():
-            field = ".".join(str(p) for p in err["loc"]) or "<root>"
-            problems.append(f"{field}: {err['msg']} (got {err.get('input')!r})")
-        raise ConfigError(f"{what} config: " + "; ".join(problems)) from None
+        raise ConfigError(f"{what} config: " + validation_problems(exc)) from None
 
 
 class ExploreConfig(BaseModel):

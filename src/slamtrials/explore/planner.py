@@ -28,11 +28,9 @@ from numpy.typing import NDArray
 
 __all__ = ["UNREACHED", "PlanResult", "dijkstra", "extract_path"]
 
-_SQRT2 = math.sqrt(2.0)
-
-
 _SCALE = 256  # cost units per cell of unit cost
 _CAP = 512.0  # largest cell cost factor
+_BUCKETS = 1 << 18  # circular queue size: more than the largest edge weight, sqrt(2) * _CAP * _SCALE
 _UNREACHED = np.iinfo(np.int64).max
 #: :attr:`PlanResult.cost_to_come` of cells the search did not reach.
 UNREACHED = _UNREACHED
@@ -57,9 +55,9 @@ def _dijkstra(cost, escape, sr, sc, goal, keep, use_goal, use_keep, ratio, escap
     settled = np.zeros(n, dtype=np.bool_)
     nxt = np.empty(n, dtype=np.int32)
     prv = np.empty(n, dtype=np.int32)
-    scale = 256.0
-    cap = 512.0
-    mask = (1 << 18) - 1  # more buckets than the largest edge weight, sqrt(2) * cap * scale
+    scale = float(_SCALE)
+    cap = _CAP
+    mask = _BUCKETS - 1
     head = np.full(mask + 1, -1, dtype=np.int32)
     drs = np.array([-1, 1, 0, 0, -1, -1, 1, 1])
     dcs = np.array([0, 0, -1, 1, -1, 1, -1, 1])

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
-from slamtrials.errors import ConfigError
+from slamtrials.errors import ConfigError, validation_problems
 
 __all__ = ["RobotConfig", "LaserConfig", "OdometryConfig", "SimConfig"]
 
@@ -242,8 +242,4 @@ class SimConfig(BaseModel):
         try:
             return cls.model_validate(data)
         except ValidationError as exc:
-            problems = []
-            for err in exc.errors():
-                field = ".".join(str(p) for p in err["loc"]) or "<root>"
-                problems.append(f"{field}: {err['msg']} (got {err.get('input')!r})")
-            raise ConfigError("simulation config: " + "; ".join(problems)) from None
+            raise ConfigError("simulation config: " + validation_problems(exc)) from None

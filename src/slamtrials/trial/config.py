@@ -12,7 +12,7 @@ from typing import Any
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from slamtrials.errors import ConfigError
+from slamtrials.errors import ConfigError, validation_problems
 from slamtrials.explore import ExploreConfig, TerminationConfig
 from slamtrials.sim import SimConfig
 from slamtrials.slam import get_algorithm, resolve_config
@@ -90,10 +90,6 @@ class TrialConfig(BaseModel):
         try:
             config = cls.model_validate(data)
         except ValidationError as exc:
-            problems = []
-            for err in exc.errors():
-                field = ".".join(str(p) for p in err["loc"]) or "<root>"
-                problems.append(f"{field}: {err['msg']} (got {err.get('input')!r})")
-            raise ConfigError("trial config: " + "; ".join(problems)) from None
+            raise ConfigError("trial config: " + validation_problems(exc)) from None
         config.slam.resolved()
         return config

@@ -35,11 +35,11 @@ from benchutil import cpu_model
 HERE = Path(__file__).resolve().parent
 SHARED = Path(os.environ.get("SLAMTRIALS_SHARED", HERE.parent.parent / "shared"))
 FIELDS = ("world", "source", "seed", "reason", "mapped", "observed", "reachable_m2", "duration_s", "wall_s",
-          "ratio", "updates", "distance_m", "recoveries", "blacklisted", "passed")
+          "ratio", "updates", "slam_s", "distance_m", "turning_rad", "recoveries", "blacklisted", "passed")
 PASSING_REASONS = ("map_converged", "no_frontiers")
 
 
-def world_list(max_area: float | None) -> list[tuple[str, str, float]]:
+def world_list(max_area: float | None, names: list[str] | None = None) -> list[tuple[str, str, float]]:
     """``(name or path, source, free area m^2)`` of every world of the sweep, smallest first."""
     from slamtrials.worlds.catalog import catalog_entries
 
@@ -63,6 +63,8 @@ def world_list(max_area: float | None) -> list[tuple[str, str, float]]:
     worlds.sort(key=lambda w: (np.nan_to_num(w[2], nan=1e9), w[0]))
     if max_area is not None:
         worlds = [w for w in worlds if not (w[2] > max_area)]
+    if names:
+        worlds = [w for w in worlds if w[0] in names or (w[1] == "real" and Path(w[0]).parent.name in names)]
     return worlds
 
 
@@ -85,7 +87,8 @@ def one_trial(world_ref: str, source: str, seed: int, out: str) -> dict:
             "mapped": round(info["mapped_fraction"], 4), "observed": round(info["observed_fraction"], 4),
             "reachable_m2": round(info["reachable_area_m2"], 1), "duration_s": round(info["duration_s"], 1),
             "wall_s": round(info["wall_time_s"], 1), "ratio": round(info["realtime_factor"], 1),
-            "updates": info["slam_updates"], "distance_m": round(info["distance_m"], 1),
+            "updates": info["slam_updates"], "slam_s": round(info["slam_seconds"], 1),
+            "distance_m": round(info["distance_m"], 1), "turning_rad": round(info["turning_rad"], 1),
             "recoveries": info["explorer"]["recoveries"], "blacklisted": info["explorer"]["goals_blacklisted"],
             "passed": passed}
 
@@ -112,6 +115,8 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, default=3)
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     parser.add_argument("--max-area", type=float, default=None, help="skip worlds with more free area (m^2)")
+    parser.add_argument("--worlds", nargs="+", default=None, help="only these worlds (catalog names or real folder names)")
+    parser.add_argument("--first-seed", type=int, default=1, help="seeds are first-seed .. first-seed + seeds - 1")
     parser.add_argument("--out", type=Path, default=HERE.parent / "results" / "sweep")
     parser.add_argument("--resume", action="store_true", help="keep the rows already in DIR/trials.csv")
     args = parser.parse_args()
@@ -125,7 +130,8 @@ def main() -> None:
         with csv_path.open("w", newline="") as handle:
             csv.DictWriter(handle, FIELDS).writeheader()
     finished = {(r["world"], int(r["seed"])) for r in done}
-    jobs = [(ref, source, seed) for ref, source, _ in world_list(args.max_area) for seed in range(1, args.seeds + 1)]
+    jobs = [(ref, source, seed) for ref, source, _ in world_list(args.max_area, args.worlds)
+            for seed in range(args.first_seed, args.first_seed + args.seeds)]
     print(f"CPU: {cpu_model()}; {len(jobs)} trials, {args.jobs} at a time", flush=True)
     started = time.perf_counter()
     rows = list(done)
@@ -143,13 +149,14 @@ def main() -> None:
             except Exception as exc:  # a crashing trial is a failure to report, not a reason to stop the sweep
                 row = {"world": Path(ref).parent.name if "/" in ref else ref, "source": "?", "seed": seed,
                        "reason": f"error: {type(exc).__name__}: {exc}"[:200], "mapped": 0, "observed": 0,
-                       "reachable_m2": 0, "duration_s": 0, "wall_s": 0, "ratio": 0, "updates": 0,
-                       "distance_m": 0, "recoveries": 0, "blacklisted": 0, "passed": False}
+                       "reachable_m2": 0, "duration_s": 0, "wall_s": 0, "ratio": 0, "updates": 0, "slam_s": 0,
+                       "distance_m": 0, "turning_rad": 0, "recoveries": 0, "blacklisted": 0, "passed": False}
             rows.append(row)
             with csv_path.open("a", newline="") as handle:
                 csv.DictWriter(handle, FIELDS).writerow(row)
             print(f"{row['world']} seed {seed}: {row['reason']}, mapped {float(row['mapped']):.3f}, "
-                  f"{float(row['duration_s']):.0f} s in {float(row['wall_s']):.0f} s", flush=True)
+                  f"{float(row['duration_s']):.0f} s in {float(row['wall_s']):.0f} s, {row['updates']} updates, "
+                  f"{float(row['distance_m']):.0f} m, {float(row['turning_rad']):.0f} rad", flush=True)
     print(f"\nSweep wall time: {time.perf_counter() - started:.0f} s\n")
     print(table(rows))
 

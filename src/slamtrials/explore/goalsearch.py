@@ -16,7 +16,8 @@ looks for the cheapest goal cell by path cost in one window:
 
 Cells near failed goals (the blacklist) are never goals. The search can keep the current goal unless
 another is clearly cheaper (``goal_hysteresis``), and can be limited to the interior of a window (see
-:func:`slamtrials.explore.planner.dijkstra`).
+:func:`slamtrials.explore.planner.dijkstra`). With ``smooth_paths``, the path found is straightened
+where that costs no more (:mod:`slamtrials.explore.smoothing`).
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ from slamtrials.explore.frontiers import Frontiers, find_frontiers
 from slamtrials.explore.goals import exclude_discs
 from slamtrials.explore.gridframe import GridFrame
 from slamtrials.explore.planner import UNREACHED, dijkstra
+from slamtrials.explore.smoothing import resample_polyline, shortcut_path
 from slamtrials.explore.window import coarsen, crop, known_box
 
 __all__ = ["CROP_MARGIN", "Found", "GoalSearch", "Prepared"]
@@ -216,7 +218,13 @@ class GoalSearch:
             return ("edge" if inner is not None else "none"), None
         assert result.goal is not None
         cells = result.path_to(*result.goal)
-        path = frame.to_xy(cells[:, 0], cells[:, 1])
+        if cfg.smooth_paths and cells.shape[0] > 2:
+            corners = cells[shortcut_path(cells, costmap.cost)].astype(np.float64)
+            along = resample_polyline(corners, 1.0)  # (row, col), at most one cell apart
+            cells = np.clip(np.floor(along + 0.5).astype(np.int64), 0, np.array(costmap.cost.shape) - 1)
+            path = frame.to_xy(along[:, 0], along[:, 1])
+        else:
+            path = frame.to_xy(cells[:, 0], cells[:, 1])
         path[0] = pose[:2]
         target = path[-1].copy()
         if views:

@@ -62,6 +62,11 @@ def _path_length(truth: np.ndarray) -> float:
     return float(np.sum(np.hypot(np.diff(truth[:, 0]), np.diff(truth[:, 1]))))
 
 
+def _turning(truth: np.ndarray) -> float:
+    """Total absolute heading change (rad) of poses ``[N, 3]``."""
+    return float(np.sum(np.abs(np.remainder(np.diff(truth[:, 2]) + np.pi, 2.0 * np.pi) - np.pi)))
+
+
 def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
               on_progress: Callable[[TrialProgress], None] | None = None,
               progress_period: float = 10.0) -> RunRecord:
@@ -84,8 +89,8 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
         Every frame (``t``, ``scans``, ``odometry``, ``truth``, ``stalled``), ``estimate`` (the SLAM
         trajectory, map frame, one pose per frame), ``map`` (the final SLAM map), and ``metadata``:
         ``trial`` (termination reason, mapped and observed fractions of the reachable free area,
-        distance travelled, simulated duration, wall time, SLAM updates, explorer counters, snapshot
-        MSEs), ``seed``, ``world``, the drawn odometry ``bias`` and the resolved ``config``.
+        distance travelled, total turning of the true heading, simulated duration, wall time, SLAM
+        updates and the wall time spent in SLAM, explorer counters, snapshot MSEs), ``seed``, ``world``, the drawn odometry ``bias`` and the resolved ``config``.
 
     Raises
     ------
@@ -117,9 +122,12 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
     frame = sim.observe()
     next_report = 0.0
     reason = None
+    slam_seconds = 0.0
     while True:
         frames.append(frame)
+        tick = time.perf_counter()
         estimate = slam.process(frame)
+        slam_seconds += time.perf_counter() - tick
         grid = slam.occupancy()
         reason = termination.check(frame.t, grid)
         if reason is not None:
@@ -155,10 +163,12 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
             "reachable_area_m2": reachable_area,
             "mapped_free_area_m2": known_free_area(final_map),
             "distance_m": _path_length(record.truth),
+            "turning_rad": _turning(record.truth),
             "duration_s": duration,
             "wall_time_s": wall,
             "realtime_factor": duration / max(wall, 1e-9),
             "slam_updates": int(slam.updates),
+            "slam_seconds": slam_seconds,
             "stalled_frames": int(np.count_nonzero(record.stalled)),
             "explorer": {k: (round(v, 3) if isinstance(v, float) else v) for k, v in vars(stats).items()},
             "snapshots": [[round(t, 3), round(mse, 4)] for t, mse in termination.history],

@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from slamtrials.__about__ import __version__
+from slamtrials.__about__ import __version__, source_revision
 from slamtrials.atomicfile import atomic_write, atomic_write_text
 from slamtrials.errors import FormatError
 from slamtrials.io.mapfile import read_map, write_map, write_map_png
@@ -48,6 +48,12 @@ _ARRAYS: dict[str, tuple[type, int | None]] = {  # name -> (dtype, size of the l
 }
 _LASER_KEYS = ("angle_min", "angle_increment", "range_min", "range_max")
 
+
+
+def _revision() -> dict[str, str]:
+    """``{"source": commit}`` when running from a git checkout (see :func:`source_revision`), else empty."""
+    revision = source_revision()
+    return {"source": revision} if revision else {}
 
 def json_default(value: Any) -> Any:
     """``json.dumps(default=...)`` hook: numpy arrays and scalars, and paths, as plain JSON values."""
@@ -84,7 +90,8 @@ def write_run(folder: str | Path, record: RunRecord) -> Path:
     atomic_write(folder / FRAMES_FILE, lambda handle: np.savez_compressed(handle, **arrays))
     doc = {
         "format": RUN_FORMAT,
-        "versions": {"slamtrials": __version__, "python": platform.python_version(), "numpy": np.__version__},
+        "versions": {"slamtrials": __version__, **_revision(), "python": platform.python_version(),
+                     "numpy": np.__version__},
         "frames": len(record),
         "beams": int(record.scans.shape[1]) if record.scans.ndim == 2 else 0,
         "laser": record.laser,

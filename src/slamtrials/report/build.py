@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from slamtrials.__about__ import __version__
+from slamtrials.__about__ import __version__, source_revision
 from slamtrials.atomicfile import atomic_write_text
 from slamtrials.campaign.events import REPLAY_NOTE
 from slamtrials.errors import ConfigError, SlamtrialsError
@@ -146,7 +146,9 @@ def _versions() -> dict[str, str]:
     import matplotlib
     import scipy
 
-    return {"slamtrials": __version__, "python": platform.python_version(), "numpy": np.__version__,
+    revision = source_revision()
+    source = {"source": revision} if revision else {}
+    return {"slamtrials": __version__, **source, "python": platform.python_version(), "numpy": np.__version__,
             "scipy": scipy.__version__, "pandas": pd.__version__, "matplotlib": matplotlib.__version__}
 
 

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from matplotlib.ticker import MaxNLocator
 from numpy.typing import ArrayLike, NDArray
 from scipy import stats
 
@@ -98,7 +99,7 @@ def draw_world_errors(ax, runs: pd.DataFrame, world: str, metric: str = "eps_t",
     ax.set_xlabel("run (largest error first)")
     ax.set_ylabel(METRIC_LABELS[metric])
     ax.set_title(f"{world}: {st.n} runs", fontsize=10)
-    ax.legend(fontsize=7, loc="lower left", framealpha=0.9)
+    ax.legend(fontsize=7, loc="upper right", framealpha=0.9)  # the smallest bars are on the right
 
 
 def draw_sorted_errors(ax, runs: pd.DataFrame, worlds: list[str] | None = None, metric: str = "eps_t") -> None:
@@ -111,6 +112,7 @@ def draw_sorted_errors(ax, runs: pd.DataFrame, worlds: list[str] | None = None, 
     for world in names:
         values, _ = _world_values(runs, world, metric)
         ax.plot(np.arange(1, len(values) + 1), np.sort(values)[::-1], "o-", ms=3, lw=1.2, label=world, gid=f"world:{world}")
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("run (largest error first)")
     ax.set_ylabel(METRIC_LABELS[metric])
     ax.legend(fontsize=7)

@@ -25,6 +25,7 @@ import os
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
+import resource  # noqa: E402
 import shutil  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
@@ -48,9 +49,12 @@ def run_once(workers: int, folder: Path, initial: int, max_runs: int, seed: int,
         if not ready:
             ready.append(time.perf_counter())
 
+    cpu_before = resource.getrusage(resource.RUSAGE_SELF)
     started = time.perf_counter()
     result = run_campaign(config, folder, workers=workers, trial_fn=trial_fn, on_event=on_event)
     wall = time.perf_counter() - started
+    cpu_after = resource.getrusage(resource.RUSAGE_SELF)
+    driver_cpu = (cpu_after.ru_utime - cpu_before.ru_utime) + (cpu_after.ru_stime - cpu_before.ru_stime)
     with CampaignStore.open(folder) as store:
         run_seconds = sum(r.wall_time or 0.0 for r in store.runs())
     return {
@@ -61,6 +65,7 @@ def run_once(workers: int, folder: Path, initial: int, max_runs: int, seed: int,
         "runs_per_hour": 3600.0 * result.runs_done / wall,
         "run_seconds": run_seconds,
         "efficiency": run_seconds / (wall * workers),
+        "driver_cpu": driver_cpu,
         "load": (load_before, os.getloadavg()[0]),
         "summary": [(r.world, r.status, r.runs, r.eps_t.mean, r.eps_r.mean) for r in result.summary],
     }
@@ -99,13 +104,14 @@ def main() -> None:
     print(f"- Same runs and errors for every worker count: {'yes' if same else 'NO'}")
     print()
     print("| workers | runs | wall time (s) | cluster start (s) | runs per hour | run time summed (s) | efficiency | speed-up | "
-          "speed-up after start | load avg before/after |")
-    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
+          "speed-up after start | driver + scheduler CPU (s) | load avg before/after |")
+    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
     for r in rows:
         speedup = rows[0]["wall"] / r["wall"]
         after = (rows[0]["wall"] - rows[0]["startup"]) / (r["wall"] - r["startup"])
         print(f"| {r['workers']} | {r['runs']} | {r['wall']:.0f} | {r['startup']:.1f} | {r['runs_per_hour']:.0f} | {r['run_seconds']:.0f} | "
-              f"{100 * r['efficiency']:.0f} % | {speedup:.2f}x | {after:.2f}x | {r['load'][0]:.1f} / {r['load'][1]:.1f} |")
+              f"{100 * r['efficiency']:.0f} % | {speedup:.2f}x | {after:.2f}x | {r['driver_cpu']:.1f} | "
+              f"{r['load'][0]:.1f} / {r['load'][1]:.1f} |")
     print()
     print("| world | status | runs | eps_t mean (m) | eps_r mean (rad) |")
     print("|---|---|---:|---:|---:|")

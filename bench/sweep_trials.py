@@ -34,7 +34,7 @@ from benchutil import cpu_model
 
 HERE = Path(__file__).resolve().parent
 SHARED = Path(os.environ.get("SLAMTRIALS_SHARED", HERE.parent.parent / "shared"))
-FIELDS = ("world", "source", "seed", "reason", "mapped", "observed", "reachable_m2", "duration_s", "wall_s",
+FIELDS = ("world", "source", "seed", "reason", "mapped", "mapped_connected", "observed", "reachable_m2", "duration_s", "wall_s",
           "ratio", "updates", "slam_s", "distance_m", "turning_rad", "recoveries", "blacklisted", "passed")
 PASSING_REASONS = ("map_converged", "no_frontiers")
 
@@ -84,7 +84,8 @@ def one_trial(world_ref: str, source: str, seed: int, out: str) -> dict:
         save_run_figure(world, record, folder / f"{world.name}-{seed}.png",
                         title=f"{world.name} seed {seed}: {info['termination_reason']}, mapped {info['mapped_fraction']:.1%}")
     return {"world": world.name, "source": source, "seed": seed, "reason": info["termination_reason"],
-            "mapped": round(info["mapped_fraction"], 4), "observed": round(info["observed_fraction"], 4),
+            "mapped": round(info["mapped_fraction"], 4),
+            "mapped_connected": round(info["mapped_fraction_connected"], 4), "observed": round(info["observed_fraction"], 4),
             "reachable_m2": round(info["reachable_area_m2"], 1), "duration_s": round(info["duration_s"], 1),
             "wall_s": round(info["wall_time_s"], 1), "ratio": round(info["realtime_factor"], 1),
             "updates": info["slam_updates"], "slam_s": round(info["slam_seconds"], 1),
@@ -148,7 +149,7 @@ def main() -> None:
                 row = future.result()
             except Exception as exc:  # a crashing trial is a failure to report, not a reason to stop the sweep
                 row = {"world": Path(ref).parent.name if "/" in ref else ref, "source": "?", "seed": seed,
-                       "reason": f"error: {type(exc).__name__}: {exc}"[:200], "mapped": 0, "observed": 0,
+                       "reason": f"error: {type(exc).__name__}: {exc}"[:200], "mapped": 0, "mapped_connected": 0, "observed": 0,
                        "reachable_m2": 0, "duration_s": 0, "wall_s": 0, "ratio": 0, "updates": 0, "slam_s": 0,
                        "distance_m": 0, "turning_rad": 0, "recoveries": 0, "blacklisted": 0, "passed": False}
             rows.append(row)

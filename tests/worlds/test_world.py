@@ -67,3 +67,34 @@ def test_invalid_worlds_are_rejected(kwargs, message):
 def test_all_walls_has_no_free_space():
     with pytest.raises(WorldError, match="no free space"):
         World(np.ones((10, 10), bool), 0.05)
+
+
+def _two_rooms(gap_cells: int) -> World:
+    """Two 1.9 x 1.9 m rooms (0.05 m cells) joined by a doorway ``gap_cells`` cells wide in the middle wall."""
+    occ = _room(40, 81)
+    occ[:, 40] = True
+    occ[20 - gap_cells // 2:20 - gap_cells // 2 + gap_cells, 40] = False
+    return World(occ, 0.05, start=cell_to_world(World(occ, 0.05), 20, 20).tolist() + [0.0])
+
+
+def test_reachable_by_disc_stops_at_gaps_narrower_than_the_robot():
+    narrow = _two_rooms(4)  # 0.2 m: a 0.15 m radius robot cannot pass
+    wide = _two_rooms(10)  # 0.5 m
+    for world in (narrow, wide):
+        assert world.reachable_free()[20, 60]  # both doorways connect the free space
+    assert not narrow.reachable_by_disc(0.15)[20, 60]
+    assert wide.reachable_by_disc(0.15)[20, 60]
+    left = np.count_nonzero(narrow.reachable_by_disc(0.15))
+    assert np.count_nonzero(wide.reachable_by_disc(0.15)) > 1.9 * left
+    # the body covers cells next to walls, but not the corners a disc cannot get into
+    mask = wide.reachable_by_disc(0.15)
+    assert mask[1, 20] and mask[20, 1] and not mask[1, 1]
+    assert not (mask & wide.occupied).any()
+
+
+def test_reachable_by_disc_is_empty_when_the_robot_cannot_stand_anywhere():
+    occ = np.ones((20, 20), bool)
+    occ[8:12, 8:12] = False  # a 0.2 m pocket
+    world = World(occ, 0.05, start=[0.5, 0.5, 0.0])
+    assert world.reachable_free().any()
+    assert not world.reachable_by_disc(0.15).any()

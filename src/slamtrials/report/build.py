@@ -473,7 +473,7 @@ def _termination(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame) ->
     if len(mapped):
         cf.draw_explored(axes[1], mapped)
     picture = figs.save(fig, "termination", "Left: why the runs ended, per world (run counts). Right: the fraction of each "
-                                            "world's reachable free space that the final map shows as free, per run, and its mean.")
+                                            "world's free space the robot's footprint can reach that the final map knows (free or occupied), per run, and its mean.")
     rows = []
     for world in data.worlds["world"]:
         mine = done[done["world"] == world]

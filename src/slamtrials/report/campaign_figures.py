@@ -99,7 +99,10 @@ def draw_world_errors(ax, runs: pd.DataFrame, world: str, metric: str = "eps_t",
     ax.set_xlabel("run (largest error first)")
     ax.set_ylabel(METRIC_LABELS[metric])
     ax.set_title(f"{world}: {st.n} runs", fontsize=10)
-    ax.legend(fontsize=7, loc="upper right", framealpha=0.9)  # the smallest bars are on the right
+    top = max(float(values.max()) if values.size else 0.0, st.ci_high if st.n >= 2 else 0.0)
+    if math.isfinite(top) and top > 0.0:
+        ax.set_ylim(0.0, 1.4 * top)  # head room for the legend above the bars
+    ax.legend(fontsize=7, loc="upper right", framealpha=0.9)
 
 
 def draw_sorted_errors(ax, runs: pd.DataFrame, worlds: list[str] | None = None, metric: str = "eps_t") -> None:

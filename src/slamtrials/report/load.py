@@ -16,7 +16,7 @@ attempts       submissions by a driver
 eps_t, eps_r   the run's mean translational (m) and rotational (rad) error; NaN unless done
 relations      relations sampled to compute them
 termination    why the run ended (``map_converged``, ``no_frontiers``, ``time_cap``, ...)
-mapped         fraction of the reachable free space the final map shows as free (0..1)
+mapped         fraction of the free space the robot can reach that the final map knows (0..1)
 duration_s     simulated duration of the run (s)
 wall_s         wall-clock time of the run on its worker (s)
 worker         ``host:pid`` of the worker

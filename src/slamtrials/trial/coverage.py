@@ -1,7 +1,9 @@
 """How much of a world a trial mapped and observed, measured against the true world.
 
-Both measures count the world's reachable free cells (free cells connected to the start, at the world
-map's resolution), so 1.0 means every place the robot could reach was covered:
+Both measures count the world's reachable free cells at the world map's resolution: by default the
+free cells the robot's disc footprint can cover from the start (:meth:`World.reachable_by_disc`; space
+behind gaps narrower than the robot is not reachable), so 1.0 means every place the robot could reach
+was covered:
 
 * :func:`mapped_fraction`: cells whose centre falls on a known (free or occupied) cell of the SLAM
   map, after carrying the world into the map frame through the first frame (estimate vs truth);
@@ -25,9 +27,10 @@ from slamtrials.worlds.world import cell_to_world
 __all__ = ["reachable_cell_centres", "mapped_fraction", "observed_fraction", "known_free_area"]
 
 
-def reachable_cell_centres(world: World) -> NDArray[np.float64]:
-    """float64 ``[K, 2]``: world-frame centres (m) of the world's free cells reachable from the start."""
-    rows, cols = np.nonzero(world.reachable_free())
+def reachable_cell_centres(world: World, reachable: NDArray[np.bool_] | None = None) -> NDArray[np.float64]:
+    """float64 ``[K, 2]``: world-frame centres (m) of the cells of the bool ``[H, W]`` mask ``reachable``
+    (default: :meth:`World.reachable_free`, every free cell connected to the start)."""
+    rows, cols = np.nonzero(world.reachable_free() if reachable is None else reachable)
     return cell_to_world(world, rows, cols)
 
 
@@ -42,13 +45,15 @@ def _lookup(grid: OccupancyGrid, xy: NDArray[np.float64]) -> NDArray[np.int8]:
     return values
 
 
-def mapped_fraction(world: World, grid: OccupancyGrid, estimate0: NDArray[np.float64], truth0: NDArray[np.float64]) -> float:
-    """Fraction of reachable free world cells that the SLAM map ``grid`` knows.
+def mapped_fraction(world: World, grid: OccupancyGrid, estimate0: NDArray[np.float64], truth0: NDArray[np.float64],
+                    reachable: NDArray[np.bool_] | None = None) -> float:
+    """Fraction of the ``reachable`` world cells (bool ``[H, W]``, see :func:`reachable_cell_centres`)
+    that the SLAM map ``grid`` knows.
 
     ``estimate0`` and ``truth0`` are the first frame's pose in the map frame and in the world frame;
     together they place the world in the map frame.
     """
-    centres = reachable_cell_centres(world)
+    centres = reachable_cell_centres(world, reachable)
     if centres.shape[0] == 0 or grid.grid.size == 0:
         return 0.0
     map_from_world = compose1(estimate0, inverse(truth0))
@@ -56,9 +61,9 @@ def mapped_fraction(world: World, grid: OccupancyGrid, estimate0: NDArray[np.flo
 
 
 def observed_fraction(world: World, truth: NDArray[np.float64], scans: NDArray[np.float32], laser: dict[str, Any],
-                      stride: int) -> float:
-    """Fraction of reachable free world cells the laser saw (scans traced at their true poses)."""
-    centres = reachable_cell_centres(world)
+                      stride: int, reachable: NDArray[np.bool_] | None = None) -> float:
+    """Fraction of the ``reachable`` world cells the laser saw (scans traced at their true poses)."""
+    centres = reachable_cell_centres(world, reachable)
     if centres.shape[0] == 0:
         return 0.0
     seen = GridMap(world.resolution)

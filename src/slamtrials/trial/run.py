@@ -88,9 +88,11 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
     RunRecord
         Every frame (``t``, ``scans``, ``odometry``, ``truth``, ``stalled``), ``estimate`` (the SLAM
         trajectory, map frame, one pose per frame), ``map`` (the final SLAM map), and ``metadata``:
-        ``trial`` (termination reason, mapped and observed fractions of the reachable free area,
-        distance travelled, total turning of the true heading, simulated duration, wall time, SLAM
-        updates and the wall time spent in SLAM, explorer counters, snapshot MSEs), ``seed``, ``world``, the drawn odometry ``bias`` and the resolved ``config``.
+        ``trial`` (termination reason, mapped and observed fractions of the free area the robot's
+        footprint can reach (:meth:`World.reachable_by_disc`), the mapped fraction and area of all free
+        space connected to the start, distance travelled, total turning of the true heading, simulated
+        duration, wall time, SLAM updates and the wall time spent in SLAM, explorer counters, snapshot
+        MSEs), ``seed``, ``world``, the drawn odometry ``bias`` and the resolved ``config``.
 
     Raises
     ------
@@ -115,7 +117,8 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
     slam.reset(np.random.default_rng(slam_seed))
     explorer = Explorer(config.explore_config())
     termination = SnapshotTermination(config.termination)
-    reachable_area = float(np.count_nonzero(world.reachable_free())) * world.resolution ** 2
+    reachable = world.reachable_by_disc(config.sim.robot.radius)
+    reachable_area = float(np.count_nonzero(reachable)) * world.resolution ** 2
     max_time = config.termination.max_time
 
     frames: list[Frame] = []
@@ -158,9 +161,12 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
         "trial": {
             "format": TRIAL_FORMAT,
             "termination_reason": reason,
-            "mapped_fraction": mapped_fraction(world, final_map, record.estimate[0], record.truth[0]),
-            "observed_fraction": observed_fraction(world, record.truth, record.scans, laser, config.coverage_stride),
+            "mapped_fraction": mapped_fraction(world, final_map, record.estimate[0], record.truth[0], reachable),
+            "observed_fraction": observed_fraction(world, record.truth, record.scans, laser, config.coverage_stride,
+                                                   reachable),
             "reachable_area_m2": reachable_area,
+            "mapped_fraction_connected": mapped_fraction(world, final_map, record.estimate[0], record.truth[0]),
+            "connected_free_area_m2": float(np.count_nonzero(world.reachable_free())) * world.resolution ** 2,
             "mapped_free_area_m2": known_free_area(final_map),
             "distance_m": _path_length(record.truth),
             "turning_rad": _turning(record.truth),

@@ -134,6 +134,47 @@ class World:
             return np.zeros_like(self.occupied)
         return labels == labels[row, col]
 
+    def reachable_by_disc(self, radius: float, pose: ArrayLike | None = None) -> NDArray[np.bool_]:
+        """bool ``[H, W]``: free cells a robot with a disc footprint of ``radius`` m can cover, starting at
+        ``pose`` (default: the start pose).
+
+        The disc's centre may stand on a cell whose distance to the nearest occupied cell's edge
+        (:attr:`clearance` minus half a cell) is at least ``radius``; those cells 8-connected to the
+        start's cell are where the robot can go, and every free cell within ``radius`` of one of them is
+        covered by its body. Free space behind gaps narrower than the robot (a doorway drawn too
+        narrow, the streaks of laser rays in a map made by a real robot) is left out, which
+        :meth:`reachable_free` keeps. Exact to within a cell. If the start's cell itself does not pass
+        the test (the footprint touches a wall only by a fraction of a cell), the nearest cell that
+        does within ``radius`` stands in for it; if there is none, the result is empty.
+        """
+        pose = self.start if pose is None else np.asarray(pose, dtype=np.float64)
+        row, col = world_to_cell(self, pose[:2])
+        if not (0 <= row < self.height and 0 <= col < self.width):
+            return np.zeros_like(self.occupied)
+        fits = (self.clearance - 0.5 * self.resolution >= radius - 1e-9) & ~self.occupied
+        if not fits[row, col]:
+            reach = int(np.ceil(radius / self.resolution))
+            r0, c0 = max(row - reach, 0), max(col - reach, 0)
+            window = fits[r0:row + reach + 1, c0:col + reach + 1]
+            candidates = np.argwhere(window)
+            if candidates.size == 0:
+                return np.zeros_like(self.occupied)
+            nearest = candidates[np.argmin(np.hypot(candidates[:, 0] + r0 - row, candidates[:, 1] + c0 - col))]
+            row, col = int(nearest[0] + r0), int(nearest[1] + c0)
+        labels, _ = ndimage.label(fits, structure=np.ones((3, 3), dtype=bool))
+        centres = labels == labels[row, col]
+        # cells within `radius` of a reachable centre: distance transform of the complement, in the
+        # bounding box of the centres grown by the radius (all other cells are farther)
+        rows = np.flatnonzero(centres.any(axis=1))
+        cols = np.flatnonzero(centres.any(axis=0))
+        grow = int(np.ceil(radius / self.resolution)) + 1
+        r0, r1 = max(rows[0] - grow, 0), min(rows[-1] + grow + 1, self.height)
+        c0, c1 = max(cols[0] - grow, 0), min(cols[-1] + grow + 1, self.width)
+        out = np.zeros_like(self.occupied)
+        cells = ndimage.distance_transform_edt(~centres[r0:r1, c0:c1])
+        out[r0:r1, c0:c1] = (cells <= radius / self.resolution + 1e-9) & ~self.occupied[r0:r1, c0:c1]
+        return out
+
     def with_start(self, start: ArrayLike) -> "World":
         """A copy of this world with another start pose."""
         return World(self.occupied, self.resolution, self.origin, self.name, np.asarray(start, float), dict(self.metadata))

@@ -289,13 +289,14 @@ def _fig5(figs: _FigureWriter, done: pd.DataFrame) -> str:
 
 
 def draw_trap_pair(ax, low: np.ndarray, high: np.ndarray, labels: tuple[str, str], i_low: int, i_high: int,
-                   metric: str = "eps_t") -> None:
+                   metric: str = "eps_t", colors: tuple[str, str] = ("tab:blue", "tab:orange")) -> None:
     """Two samples side by side (``low``: lower mean) with their means and the most misleading pair ringed.
 
     The pair ``(low[i_low], high[i_high])`` is the single-run comparison that contradicts the means the
     most (the paper's Fig. 6); it is joined by a dashed line (gid ``"trap"``) when it is reversed.
+    ``colors`` are those of ``low`` and ``high`` (a comparison keeps one colour per campaign).
     """
-    for x, values, color in ((0, low, "tab:blue"), (1, high, "tab:orange")):
+    for x, values, color in ((0, low, colors[0]), (1, high, colors[1])):
         offsets = ((np.arange(len(values)) * cf.GOLDEN) % 1.0 - 0.5) * 0.35
         ax.plot(x + offsets, values, "o", ms=4, color=color, alpha=0.75)
         ax.plot([x - 0.3, x + 0.3], [values.mean()] * 2, color=color, lw=2.5, gid=f"mean:{x}")
@@ -757,16 +758,17 @@ def compare_report(campaign_a: str | Path, campaign_b: str | Path, out_dir: str 
             ia = int(np.flatnonzero(a["run"].to_numpy() == r["trap_run_a"])[0])
             ib = int(np.flatnonzero(b["run"].to_numpy() == r["trap_run_b"])[0])
             va, vb = a["eps_t"].to_numpy(), b["eps_t"].to_numpy()
+            color_a, color_b = "tab:blue", "tab:orange"
             if vb.mean() < va.mean():
-                draw_trap_pair(ax, vb, va, (name_b, name_a), ib, ia)
+                draw_trap_pair(ax, vb, va, (name_b, name_a), ib, ia, colors=(color_b, color_a))
             else:
-                draw_trap_pair(ax, va, vb, (name_a, name_b), ia, ib)
+                draw_trap_pair(ax, va, vb, (name_a, name_b), ia, ib, colors=(color_a, color_b))
             ax.set_title(f"{r['world']}: {r['verdict']}\n{r['trap_fraction']:.0%} of run pairs reversed", fontsize=8)
         for ax in axes[len(trap_rows):]:
             ax.set_visible(False)
         trap_picture = figs.save(fig, "trap", "The paper's Fig. 6 trap between the two campaigns: per world (most reversed "
-                                              "first), the runs of each and their means; ringed and joined: the single-run pair "
-                                              "that contradicts the means the most.")
+                                              "first), the runs of each and their means (A blue, B orange, the lower mean on the "
+                                              "left); ringed and joined: the single-run pair that contradicts the means the most.")
     csv_text = io.StringIO()
     comparison.table.to_csv(csv_text, index=False, lineterminator="\n")
     table_csv = atomic_write_text(out / COMPARE_CSV, csv_text.getvalue())

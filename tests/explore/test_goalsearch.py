@@ -6,6 +6,7 @@ import math
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 
 from slamtrials.explore import ExploreConfig
 from slamtrials.explore.costmap import influence_distance
@@ -82,7 +83,7 @@ def test_reached_and_failed_goals_are_skipped():
 
 
 def test_the_current_goal_is_kept_unless_clearly_worse():
-    cfg = ExploreConfig(goal_hysteresis=0.5)
+    cfg = ExploreConfig(goal_hysteresis=0.5, turn_penalty=0.0)
     occ = building([60, 220])
     pose = np.array([7.5, 6.0, 0.0])  # gap 1 at x = 3..4 m, gap 2 at x = 11..12 m: gap 1 is closer
     search = GoalSearch(cfg)
@@ -92,3 +93,22 @@ def test_the_current_goal_is_kept_unless_clearly_worse():
     _, kept = search.search(pose, occ, occ.grid, whole, None, visited=[], blacklist=[],
                             current=np.array([11.5, 9.8]))
     assert kept.kept and kept.goal[0] > 10.0
+
+
+@pytest.mark.parametrize(("x", "heading", "expect_east"), [
+    (7.5, 0.0, True),       # gaps 4.0 and 4.0 m away (gap 1 a little closer): facing east, the east one
+    (7.5, math.pi, False),  # facing west: the west one, which is also the closest
+    (5.5, 0.0, False),      # 2 m against 6 m: not worth the 3 m that turning round counts for
+])
+def test_a_goal_ahead_wins_when_turning_round_costs_more_than_it_saves(x, heading, expect_east):
+    occ = building([60, 220])  # gaps at x = 3..4 m and 11..12 m in the top wall
+    search = GoalSearch(ExploreConfig(turn_penalty=1.0))
+    whole = search.known_box(occ, occ.grid)
+    _, found = search.search(np.array([x, 6.0, heading]), occ, occ.grid, whole, None, visited=[], blacklist=[],
+                             current=None)
+    assert (found.goal[0] > 10.0) == expect_east
+    # without the penalty the closest gap wins whatever the heading
+    plain = GoalSearch(ExploreConfig(turn_penalty=0.0))
+    _, closest = plain.search(np.array([x, 6.0, heading]), occ, occ.grid, whole, None, visited=[], blacklist=[],
+                              current=None)
+    assert closest.goal[0] < 5.0

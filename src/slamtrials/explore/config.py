@@ -105,6 +105,7 @@ class ExploreConfig(BaseModel):
     goal_timeout: float = Field(30.0, gt=0.0, le=3600.0, description="blacklist a goal after this long without progress (s)")
     progress_distance: float = Field(0.25, gt=0.0, le=10.0, description="getting this much closer to the goal is progress (m)")
     blacklist_radius: float = Field(0.5, ge=0.0, le=20.0, description="frontier cells this close to a failed or reached goal are skipped (m)")
+    turn_penalty: float = Field(1.0, ge=0.0, le=100.0, description="the turn needed to set off towards a goal counts as this much extra path per radian (m/rad); 0 = closest goal only")
     goal_hysteresis: float = Field(0.75, gt=0.0, le=1.0, description="switch goal only if the new one costs less than this fraction of the current one")
     blacklist_resets: int = Field(1, ge=0, le=100, description="times the failed-goal blacklist is cleared when nothing else is left")
     initial_spin: bool = Field(True, description="turn a full circle at the start, to see behind the laser's blind sector")

@@ -17,7 +17,10 @@ looks for the cheapest goal cell by path cost in one window:
 Cells near failed goals (the blacklist) are never goals. The search can keep the current goal unless
 another is clearly cheaper (``goal_hysteresis``), and can be limited to the interior of a window (see
 :func:`slamtrials.explore.planner.dijkstra`). With ``smooth_paths``, the path found is straightened
-where that costs no more (:mod:`slamtrials.explore.smoothing`).
+where that costs no more (:mod:`slamtrials.explore.smoothing`). With ``turn_penalty``, the turn the robot
+needs to set off towards the closest goal counts as extra path length, and a goal ahead of it that is
+cheaper by that count is taken instead: the robot does not turn round for a frontier barely closer
+than the one it faces (every 0.25 rad of turning costs the SLAM algorithm an update).
 """
 
 from __future__ import annotations
@@ -41,7 +44,7 @@ from slamtrials.explore.costmap import (
 from slamtrials.explore.frontiers import Frontiers, find_frontiers
 from slamtrials.explore.goals import exclude_discs
 from slamtrials.explore.gridframe import GridFrame
-from slamtrials.explore.planner import UNREACHED, dijkstra
+from slamtrials.explore.planner import UNREACHED, PlanResult, dijkstra
 from slamtrials.explore.smoothing import resample_polyline, shortcut_path
 from slamtrials.explore.window import coarsen, crop, known_box
 
@@ -217,20 +220,74 @@ class GoalSearch:
                 self.reachable_share = float(reached.mean()) if reached.size else 0.0
             return ("edge" if inner is not None else "none"), None
         assert result.goal is not None
-        cells = result.path_to(*result.goal)
-        if cfg.smooth_paths and cells.shape[0] > 2:
-            corners = cells[shortcut_path(cells, costmap.cost)].astype(np.float64)
-            along = resample_polyline(corners, 1.0)  # (row, col), at most one cell apart
-            cells = np.clip(np.floor(along + 0.5).astype(np.int64), 0, np.array(costmap.cost.shape) - 1)
-            path = frame.to_xy(along[:, 0], along[:, 1])
-        else:
-            path = frame.to_xy(cells[:, 0], cells[:, 1])
+        cells, path = self._path(prepared, result, pose)
+        if cfg.turn_penalty > 0.0 and not views and not result.kept and result.first_cost is not None:
+            better = self._ahead(prepared, pose, (row, col), candidates, inner, result.first_cost, path)
+            if better is not None:
+                result, cells, path = better
         path[0] = pose[:2]
         target = path[-1].copy()
         if views:
             target = _nearest_cell(unreachable, frame, result.goal, cfg.view_distance)
         clearance = costmap.clearance[cells[:, 0], cells[:, 1]].astype(np.float64)
         return outcome, Found(path=path, clearance=clearance, target=target, kept=result.kept)
+
+    def _path(self, prepared: Prepared, result: PlanResult, pose: NDArray[np.float64]
+              ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+        """The cells (int64 ``[N, 2]``) and map-frame points (float64 ``[N, 2]``) of the path to the
+        goal of ``result``, straightened if ``smooth_paths``."""
+        costmap, frame = prepared.costmap, prepared.frame
+        assert result.goal is not None
+        cells = result.path_to(*result.goal)
+        if self.config.smooth_paths and cells.shape[0] > 2:
+            corners = cells[shortcut_path(cells, costmap.cost)].astype(np.float64)
+            along = resample_polyline(corners, 1.0)  # (row, col), at most one cell apart
+            cells = np.clip(np.floor(along + 0.5).astype(np.int64), 0, np.array(costmap.cost.shape) - 1)
+            return cells, frame.to_xy(along[:, 0], along[:, 1])
+        return cells, frame.to_xy(cells[:, 0], cells[:, 1])
+
+    def _turn_cost(self, path: NDArray[np.float64], pose: NDArray[np.float64], resolution: float) -> float:
+        """Path-cost equivalent (cells x cost factor) of the turn the robot needs to set off along
+        ``path``: ``turn_penalty`` m per radian between its heading and the direction to the path point
+        ``lookahead_distance`` ahead."""
+        cfg = self.config
+        ahead = np.hypot(path[:, 0] - pose[0], path[:, 1] - pose[1])
+        index = np.flatnonzero(ahead >= cfg.lookahead_distance)
+        if index.size == 0:
+            return 0.0
+        tx, ty = path[int(index[0])]
+        turn = abs(math.remainder(math.atan2(ty - pose[1], tx - pose[0]) - pose[2], 2.0 * math.pi))
+        return cfg.turn_penalty * turn / resolution
+
+    def _ahead(self, prepared: Prepared, pose: NDArray[np.float64], start: tuple[int, int],
+               candidates: NDArray[np.bool_], inner: Box | None, first_cost: float, path: NDArray[np.float64]
+               ) -> tuple[PlanResult, NDArray[np.int64], NDArray[np.float64]] | None:
+        """A goal in front of the robot that beats the closest one once turning is paid for, or ``None``.
+
+        The closest goal's cost plus its turn cost bounds a second search among the goal cells in the
+        half-plane ahead of the robot; its goal wins if its own cost plus turn cost is lower. So the
+        robot does not turn round for a frontier barely closer than one it is facing.
+        """
+        cfg = self.config
+        frame, costmap = prepared.frame, prepared.costmap
+        current = first_cost + self._turn_cost(path, pose, frame.resolution)
+        if current <= first_cost + 1e-9:
+            return None
+        rows, cols = np.nonzero(candidates)
+        xy = frame.to_xy(rows, cols)
+        front = (xy[:, 0] - pose[0]) * math.cos(pose[2]) + (xy[:, 1] - pose[1]) * math.sin(pose[2]) > 0.0
+        if not front.any():
+            return None
+        ahead = np.zeros_like(candidates)
+        ahead[rows[front], cols[front]] = True
+        result = dijkstra(costmap.cost, start, goal=ahead, escape=costmap.escape,
+                          escape_radius=cfg.escape_radius / frame.resolution, interior=inner, max_cost=current)
+        if result.goal is None or result.first_cost is None or result.boundary_cost is not None:
+            return None
+        cells, path_ahead = self._path(prepared, result, pose)
+        if result.first_cost + self._turn_cost(path_ahead, pose, frame.resolution) >= current:
+            return None
+        return result, cells, path_ahead
 
     def path_clear(self, path: NDArray[np.float64], pose: NDArray[np.float64]) -> bool:
         """Whether the robot still fits along ``path`` (map frame) in the latest full-resolution costmap:

@@ -92,23 +92,13 @@ def score_pose(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, 
             if tile >= 0 and kernel == 1:
                 # the default window, with constant bounds so that the compiler unrolls it (2x faster)
                 first = tile * tile_stride + (lr - 1) * row_stride + (lc - 1) * 2
-                ox0 = ox + res
-                ox2 = ox - res
                 for dr in range(3):
-                    uy = oy - (dr - 1) * res
+                    uy0 = oy - (dr - 1) * res
                     k = np.uint64(first + dr * row_stride)
-                    # three independent distances, then a small tree: shorter dependency chains than a
-                    # running minimum over all nine (the minimum of the same values, so the same result)
-                    ux = ox0 - mean[k]
-                    u0 = uy - mean[k + np.uint64(1)]
-                    d0 = ux * ux + u0 * u0
-                    ux = ox - mean[k + np.uint64(2)]
-                    u1 = uy - mean[k + np.uint64(3)]
-                    d1 = ux * ux + u1 * u1
-                    ux = ox2 - mean[k + np.uint64(4)]
-                    u2 = uy - mean[k + np.uint64(5)]
-                    d2 = ux * ux + u2 * u2
-                    best = min(best, min(d0, min(d1, d2)))
+                    for dc in range(3):
+                        ux = ox - (dc - 1) * res - mean[k + np.uint64(2 * dc)]
+                        uy = uy0 - mean[k + np.uint64(2 * dc + 1)]
+                        best = min(best, ux * ux + uy * uy)
             elif tile >= 0:
                 first = tile * tile_stride + (lr - kernel) * row_stride + (lc - kernel) * 2
                 for dr in range(-kernel, kernel + 1):
@@ -119,33 +109,6 @@ def score_pose(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, 
                         uy = uy0 - mean[k + np.uint64(1)]
                         best = min(best, ux * ux + uy * uy)
                         k += np.uint64(2)
-        elif not free_test and kernel == 1:
-            # the default window across a tile border: it lies in at most 2 x 2 tiles, each looked up once
-            r0 = drow - 1
-            c0 = dcol - 1
-            low_tr = r0 >> TILE_SHIFT
-            low_tc = c0 >> TILE_SHIFT
-            t00 = _directory_tile(directory, rows, cols, r0, c0)
-            t01 = _directory_tile(directory, rows, cols, r0, c0 + 2)
-            t10 = _directory_tile(directory, rows, cols, r0 + 2, c0)
-            t11 = _directory_tile(directory, rows, cols, r0 + 2, c0 + 2)
-            for dr in range(3):
-                rr = r0 + dr
-                upper = (rr >> TILE_SHIFT) != low_tr
-                uy0 = oy - (dr - 1) * res
-                row_offset = (rr & _MASK) * row_stride
-                for dc in range(3):
-                    cc = c0 + dc
-                    if (cc >> TILE_SHIFT) != low_tc:
-                        tile = t11 if upper else t01
-                    else:
-                        tile = t10 if upper else t00
-                    if tile < 0:
-                        continue
-                    k = np.uint64(tile * tile_stride + row_offset + (cc & _MASK) * 2)
-                    ux = ox - (dc - 1) * res - mean[k]
-                    uy = uy0 - mean[k + np.uint64(1)]
-                    best = min(best, ux * ux + uy * uy)
         else:
             fdcol = 0
             fdrow = 0

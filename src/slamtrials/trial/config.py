@@ -64,7 +64,8 @@ class TrialConfig(BaseModel):
     termination:
         The paper's snapshot rule and the hard time cap.
     coverage_stride:
-        Every how many frames a scan is traced at its true pose to measure what the laser observed.
+        Every how many frames a scan is traced at its true pose to measure what the laser observed (and
+        a pose is a candidate for aligning the SLAM map locally to measure what it mapped).
     """
 
     model_config = _MODEL_CONFIG
@@ -73,7 +74,7 @@ class TrialConfig(BaseModel):
     slam: SlamSettings = Field(default_factory=SlamSettings)
     explore: ExploreConfig = Field(default_factory=ExploreConfig)
     termination: TerminationConfig = Field(default_factory=TerminationConfig)
-    coverage_stride: int = Field(5, ge=1, le=1000, description="frames between scans traced for the observed area")
+    coverage_stride: int = Field(5, ge=1, le=1000, description="frames between scans traced for the observed area, and between poses aligning the mapped area")
 
     def explore_config(self) -> ExploreConfig:
         """``explore`` with the robot's footprint, limits and control period taken from ``sim``."""

@@ -7,6 +7,10 @@ was covered:
 
 * :func:`mapped_fraction`: cells whose centre falls on a known (free or occupied) cell of the SLAM
   map, after carrying the world into the map frame through the first frame (estimate vs truth);
+* :func:`local_mapped_fraction`: the same, but each cell is carried through the pose of the
+  trajectory nearest to it (truth vs estimate at that moment). A SLAM map that is slightly rotated or
+  bent as a whole (a long building, a small heading error) still knows the places the robot mapped;
+  the first-frame alignment would count the cells along far walls as unmapped;
 * :func:`observed_fraction`: cells crossed or hit by the laser, traced at the TRUE poses of every
   ``stride``-th scan; what the exploration let the robot see, whatever SLAM made of it.
 """
@@ -17,14 +21,15 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import cKDTree
 
-from slamtrials.geometry import compose1, inverse, transform_points
+from slamtrials.geometry import compose, compose1, inverse, transform_points
 from slamtrials.record import UNKNOWN, OccupancyGrid
 from slamtrials.slam import GridMap
 from slamtrials.worlds import World
 from slamtrials.worlds.world import cell_to_world
 
-__all__ = ["reachable_cell_centres", "mapped_fraction", "observed_fraction", "known_free_area"]
+__all__ = ["known_free_area", "local_mapped_fraction", "mapped_fraction", "observed_fraction", "reachable_cell_centres"]
 
 
 def reachable_cell_centres(world: World, reachable: NDArray[np.bool_] | None = None) -> NDArray[np.float64]:
@@ -58,6 +63,26 @@ def mapped_fraction(world: World, grid: OccupancyGrid, estimate0: NDArray[np.flo
         return 0.0
     map_from_world = compose1(estimate0, inverse(truth0))
     return float(np.mean(_lookup(grid, transform_points(map_from_world, centres)) != UNKNOWN))
+
+
+def local_mapped_fraction(world: World, grid: OccupancyGrid, estimate: NDArray[np.float64], truth: NDArray[np.float64],
+                          reachable: NDArray[np.bool_] | None = None, stride: int = 5) -> float:
+    """Fraction of the ``reachable`` world cells that the SLAM map ``grid`` knows, each cell carried into
+    the map frame through the trajectory pose nearest to it.
+
+    ``estimate`` and ``truth`` are float64 ``[T, 3]``: the SLAM trajectory (map frame) and the true one
+    (world frame) at the same frames; every ``stride``-th pose is a candidate. For a cell nearest to true
+    pose ``k``, the map-frame point is ``estimate[k] (+) (truth[k] (-) cell)``.
+    """
+    centres = reachable_cell_centres(world, reachable)
+    truth = np.asarray(truth, dtype=np.float64)[::max(int(stride), 1)]
+    estimate = np.asarray(estimate, dtype=np.float64)[::max(int(stride), 1)]
+    if centres.shape[0] == 0 or grid.grid.size == 0 or truth.shape[0] == 0:
+        return 0.0
+    _, nearest = cKDTree(truth[:, :2]).query(centres)
+    map_from_world = compose(estimate, inverse(truth))[nearest]  # [K, 3], one transform per cell
+    points = compose(map_from_world, np.column_stack([centres, np.zeros(centres.shape[0])]))[:, :2]
+    return float(np.mean(_lookup(grid, points) != UNKNOWN))
 
 
 def observed_fraction(world: World, truth: NDArray[np.float64], scans: NDArray[np.float32], laser: dict[str, Any],

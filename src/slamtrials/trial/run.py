@@ -27,7 +27,7 @@ from slamtrials.record import Frame, OccupancyGrid, RunRecord
 from slamtrials.sim import Simulator
 from slamtrials.slam import get_algorithm
 from slamtrials.trial.config import TrialConfig
-from slamtrials.trial.coverage import known_free_area, mapped_fraction, observed_fraction
+from slamtrials.trial.coverage import known_free_area, local_mapped_fraction, mapped_fraction, observed_fraction
 from slamtrials.worlds import World
 
 __all__ = ["run_trial", "TrialProgress", "TRIAL_FORMAT"]
@@ -89,8 +89,10 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
         Every frame (``t``, ``scans``, ``odometry``, ``truth``, ``stalled``), ``estimate`` (the SLAM
         trajectory, map frame, one pose per frame), ``map`` (the final SLAM map), and ``metadata``:
         ``trial`` (termination reason, mapped and observed fractions of the free area the robot's
-        footprint can reach (:meth:`World.reachable_by_disc`), the mapped fraction and area of all free
-        space connected to the start, distance travelled, total turning of the true heading, simulated
+        footprint can reach (:meth:`World.reachable_by_disc`; mapped with the SLAM map aligned locally,
+        :func:`~slamtrials.trial.coverage.local_mapped_fraction`, and, as ``mapped_fraction_global``,
+        through the first pose only), the mapped fraction and area of all free space connected to the
+        start, distance travelled, total turning of the true heading, simulated
         duration, wall time, SLAM updates and the wall time spent in SLAM, explorer counters, snapshot
         MSEs), ``seed``, ``world``, the drawn odometry ``bias`` and the resolved ``config``.
 
@@ -161,7 +163,9 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
         "trial": {
             "format": TRIAL_FORMAT,
             "termination_reason": reason,
-            "mapped_fraction": mapped_fraction(world, final_map, record.estimate[0], record.truth[0], reachable),
+            "mapped_fraction": local_mapped_fraction(world, final_map, record.estimate, record.truth, reachable,
+                                                     config.coverage_stride),
+            "mapped_fraction_global": mapped_fraction(world, final_map, record.estimate[0], record.truth[0], reachable),
             "observed_fraction": observed_fraction(world, record.truth, record.scans, laser, config.coverage_stride,
                                                    reachable),
             "reachable_area_m2": reachable_area,

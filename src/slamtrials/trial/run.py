@@ -118,9 +118,10 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
     slam = get_algorithm(config.slam.algorithm)(slam_config, dict(laser))
     slam.reset(np.random.default_rng(slam_seed))
     explorer = Explorer(config.explore_config())
-    termination = SnapshotTermination(config.termination)
     reachable = world.reachable_by_disc(config.sim.robot.radius)
     reachable_area = float(np.count_nonzero(reachable)) * world.resolution ** 2
+    # the paper chose the snapshot period by the building's size, known in advance
+    termination = SnapshotTermination(config.termination, area=reachable_area)
     max_time = config.termination.max_time
 
     frames: list[Frame] = []

@@ -18,7 +18,7 @@ from typing import Annotated
 
 import typer
 
-from slamtrials.cli.common import make_app, make_console
+from slamtrials.cli.common import fmt_number, make_app, make_console, table_one
 from slamtrials.errors import ConfigError
 
 __all__ = ["app", "register", "summary_table", "EXIT_INTERRUPTED"]
@@ -41,23 +41,9 @@ def _quiet_dask() -> None:
             logging.getLogger(name).setLevel(level)
 
 
-def _fmt(value: float | None, digits: int = 3) -> str:
-    return "-" if value is None or value != value else f"{value:.{digits}f}"
-
-
 def summary_table(rows, confidence: float, title: str):
     """A rich Table of summary rows (:class:`slamtrials.campaign.WorldSummary`), the paper's Table I."""
-    from rich.table import Table
-
-    pct = f"{100 * confidence:g} %"
-    table = Table(title=title, caption=f"eps_t in m, eps_r in rad: mean and sample std over the runs; "
-                                       f"+-: half width of the {pct} confidence interval of the mean")
-    table.add_column("world", no_wrap=True)
-    table.add_column("status")
-    table.add_column("runs", justify="right")
-    for column in ("eps_t", "std", "+-", "eps_r", "std", "+-"):
-        table.add_column(column, justify="right", no_wrap=True)
-    table.add_column("runs ended by")
+    table = table_one(title, confidence, "runs ended by")
     for row in rows:
         cells = []
         for stats in (row.eps_t, row.eps_r):
@@ -65,7 +51,7 @@ def summary_table(rows, confidence: float, title: str):
                 cells += ["-", "-", "-"]
             else:
                 digits = 3 if stats is row.eps_t else 4
-                cells += [_fmt(stats.mean, digits), _fmt(stats.std_sample, digits), _fmt(stats.half_width, digits)]
+                cells += [fmt_number(stats.mean, digits), fmt_number(stats.std_sample, digits), fmt_number(stats.half_width, digits)]
         needed = f"/{row.runs_needed}" if row.runs_needed is not None and row.runs_needed > row.runs else ""
         reasons = ", ".join(f"{k} {v}" for k, v in row.terminations.items())
         table.add_row(row.world, row.status, f"{row.runs}{needed}", *cells, reasons)

@@ -42,3 +42,24 @@ def make_console():
 
     console = Console()
     return console if console.is_terminal else Console(width=110)
+
+
+def fmt_number(value: float | None, digits: int = 3) -> str:
+    """``value`` with ``digits`` decimals, or ``-`` for None and NaN (a table cell)."""
+    return "-" if value is None or value != value else f"{value:.{digits}f}"
+
+
+def table_one(title: str, confidence: float, last_column: str):
+    """An empty rich Table with the paper's Table I columns (world, status, runs, eps_t and eps_r each
+    with std and confidence half width) and ``last_column``; rows are added by the caller."""
+    from rich.table import Table
+
+    table = Table(title=title, caption=f"eps_t in m, eps_r in rad: mean and sample std over the runs; +-: half width "
+                                       f"of the {100 * confidence:g} % confidence interval of the mean")
+    table.add_column("world", no_wrap=True)
+    table.add_column("status")
+    table.add_column("runs", justify="right")
+    for column in ("eps_t", "std", "+-", "eps_r", "std", "+-"):
+        table.add_column(column, justify="right", no_wrap=True)
+    table.add_column(last_column, justify="right" if last_column == "outliers" else "left")
+    return table

@@ -19,7 +19,7 @@ from typing import Annotated
 
 import typer
 
-from slamtrials.cli.common import make_console
+from slamtrials.cli.common import fmt_number, make_console, table_one
 
 __all__ = ["report", "compare", "export_table", "register", "comparison_table", "worlds_table"]
 
@@ -69,29 +69,16 @@ def report(
 def worlds_table(data):
     """A rich Table of Table I from :func:`slamtrials.report.load_campaign` data (the catalog read read-only)."""
     import pandas as pd
-    from rich.table import Table
 
-    table = Table(title=f"{data.kind.capitalize()} {data.folder}",
-                  caption=f"eps_t in m, eps_r in rad: mean and sample std over the runs; +-: half width of the "
-                          f"{100 * data.confidence:g} % confidence interval of the mean")
-    table.add_column("world", no_wrap=True)
-    table.add_column("status")
-    table.add_column("runs", justify="right")
-    for column in ("eps_t", "std", "+-", "eps_r", "std", "+-"):
-        table.add_column(column, justify="right", no_wrap=True)
-    table.add_column("outliers", justify="right")
+    table = table_one(f"{data.kind.capitalize()} {data.folder}", data.confidence, "outliers")
     done = data.done
     for _, w in data.worlds.iterrows():
         needed = w["runs_needed"]
         runs = f"{w['runs_done']}" + (f"/{needed}" if pd.notna(needed) and int(needed) > w["runs_done"] else "")
-        cells = [_cell(w[f"{m}_{s}"], d) for m, d in (("eps_t", 3), ("eps_r", 4)) for s in ("mean", "std", "half_width")]
+        cells = [fmt_number(w[f"{m}_{s}"], d) for m, d in (("eps_t", 3), ("eps_r", 4)) for s in ("mean", "std", "half_width")]
         outliers = f"{w['eps_t_outliers']}/{w['eps_r_outliers']}" if (done["world"] == w["world"]).any() else "-"
         table.add_row(str(w["world"]), str(w["status"]), runs, *cells, outliers)
     return table
-
-
-def _cell(value: float, digits: int = 3) -> str:
-    return "-" if value != value else f"{value:.{digits}f}"
 
 
 def comparison_table(comparison, metric: str):
@@ -110,9 +97,9 @@ def comparison_table(comparison, metric: str):
     short = {"A better": f"{name_a} better", "B better": f"{name_b} better", "no significant difference": "no sig. difference"}
     for _, r in comparison.for_metric(metric).iterrows():
         trap = "-" if r["trap_fraction"] != r["trap_fraction"] else f"{r['trap_fraction']:.0%}"
-        table.add_row(str(r["world"]), f"{r['n_a']}/{r['n_b']}", _cell(r["mean_a"], digits), _cell(r["mean_b"], digits),
-                      f"{_cell(r['difference'], digits)} [{_cell(r['ci_low'], digits)}, {_cell(r['ci_high'], digits)}]",
-                      _cell(r["p_adjusted"], 4), short.get(r["verdict"], r["verdict"]), trap)
+        table.add_row(str(r["world"]), f"{r['n_a']}/{r['n_b']}", fmt_number(r["mean_a"], digits), fmt_number(r["mean_b"], digits),
+                      f"{fmt_number(r['difference'], digits)} [{fmt_number(r['ci_low'], digits)}, {fmt_number(r['ci_high'], digits)}]",
+                      fmt_number(r["p_adjusted"], 4), short.get(r["verdict"], r["verdict"]), trap)
     return table
 
 

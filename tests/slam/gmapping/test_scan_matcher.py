@@ -19,7 +19,7 @@ import math
 import numpy as np
 import pytest
 
-from slamtrials.slam.gmapping.kernels import match_particles, score_pose
+from slamtrials.slam.gmapping.kernels import TILE, match_particles, score_pose
 from slamtrials.slam.gmapping.tilemap import TileMaps
 
 RES = 0.05
@@ -190,6 +190,35 @@ def test_score_and_likelihood_equal_a_naive_reference(kernel, free):
         assert got[1] == pytest.approx(want[1], rel=1e-6)
     # the test is not vacuous: some beams found cells and some did not
     assert 0 < want[0] and want[1] > -0.5 / 0.075 * len(lx)
+
+
+@pytest.mark.parametrize("kernel", [0, 1, 2])
+def test_windows_beyond_the_directory_and_on_its_edge_equal_the_naive_reference(kernel):
+    """Beams that end outside the directory, in directory cells without a tile, and in windows that
+    straddle the directory's edge: cells there hold nothing (the kernel reads the pool's empty tile or
+    skips them), so the score equals the naive formulas, and beams that reach nothing count as misses."""
+    rng = np.random.default_rng(7 + kernel)
+    points = rng.uniform(-0.8, 0.8, size=(800, 2))
+    maps = TileMaps(1, RES)
+    maps.register(points[None, :, 0], points[None, :, 1])
+    cells = _cells_from_endpoints(points[:, 0], points[:, 1])
+    col0, row0 = maps.tile_col0 * TILE * RES, maps.tile_row0 * TILE * RES  # directory corner (m)
+    _, rows, cols = maps.directories.shape
+    col1, row1 = col0 + cols * TILE * RES, row0 + rows * TILE * RES
+    # beams from the origin to just inside and just outside every edge of the directory, and far beyond
+    targets = []
+    for t in np.linspace(0.05, 0.95, 25):
+        for dx in (-0.02, -0.001, 0.001, 0.02, 3.0):
+            targets += [(col1 + dx, row0 + t * (row1 - row0)), (col0 - dx, row0 + t * (row1 - row0)),
+                        (col0 + t * (col1 - col0), row1 + dx), (col0 + t * (col1 - col0), row0 - dx)]
+    targets = np.array(targets + [tuple(p) for p in points[:100] + 0.01])
+    lx, ly = targets[:, 0].copy(), targets[:, 1].copy()
+    lfx, lfy = free_points(lx, ly)
+    got = _score(maps, np.zeros(3), lx, ly, lfx, lfy, kernel=kernel)
+    want = naive_score(cells, np.zeros(3), lx, ly, lfx, lfy, kernel=kernel, sigma=0.05, lsigma=0.075, free=False)
+    assert got[0] == pytest.approx(want[0], rel=1e-6)
+    assert got[1] == pytest.approx(want[1], rel=1e-6)
+    assert 0 < want[0] < len(targets) / 2  # the hits near the points count, the edge beams miss
 
 
 def test_free_cell_test_skips_a_cell_whose_free_counterpart_holds_endpoints():

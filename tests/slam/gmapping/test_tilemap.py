@@ -23,7 +23,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from slamtrials.slam.gmapping.kernels import TILE
+from slamtrials.slam.gmapping.kernels import EMPTY, EMPTY_TILE, TILE
 from slamtrials.slam.gmapping.tilemap import TileMaps
 
 RES = 0.05
@@ -160,13 +160,14 @@ def test_resampling_releases_unheld_tiles_for_reuse():
     maps = TileMaps(2, RES, initial_tiles=8)
     pts = np.array([[[0.1, 0.1]], [[2.0, 2.0]]])  # each particle gets its own tile
     maps.register(pts[:, :, 0], pts[:, :, 1])
+    reserved = EMPTY_TILE + 1  # tiles the pool keeps for itself
     allocated = int(maps.state[1])
-    assert allocated == 2
+    assert allocated == reserved + 2
     maps.resample(np.array([0, 0]))
     assert maps.tiles_in_use == 1 and int(maps.state[0]) == 1
     far = np.array([[[-3.0, -3.0]], [[-3.0, -3.0]]])
     maps.register(far[:, :, 0], far[:, :, 1])
-    assert int(maps.state[1]) == 3  # one reused from the free stack, one new
+    assert int(maps.state[1]) == reserved + 3  # one reused from the free stack, one new
     # the reused tile was cleared: only the new endpoint is in it
     assert maps.cell_mean(0, (-3.0, -3.0))[0] == 1 and maps.cell_mean(1, (-3.0, -3.0))[0] == 1
     assert maps.cell_mean(0, (2.0, 2.0))[0] == 0 and maps.cell_mean(1, (2.0, 2.0))[0] == 0
@@ -180,3 +181,17 @@ def test_cell_mean_reads_back_an_endpoint_registered_on_a_cell_border():
     maps = TileMaps(1, RES)
     maps.register(np.array([[0.15]]), np.array([[0.02]]))
     assert maps.cell_mean(0, (0.15, 0.02))[0] == 1
+
+
+def test_the_empty_tile_is_never_handed_out_or_written():
+    """Score windows read tile ``EMPTY_TILE`` where a particle has no tile: registrations and
+    resamplings (which release unheld tiles) must never give it out or write into it."""
+    rng = np.random.default_rng(5)
+    maps = TileMaps(3, RES, initial_tiles=4)
+    for step in range(6):
+        pts = rng.uniform(-4.0, 4.0, size=(3, 40, 2))
+        maps.register(pts[:, :, 0], pts[:, :, 1])
+        maps.resample(rng.integers(0, 3, size=3))
+        assert not (maps.directories == EMPTY_TILE).any()
+        assert (maps.count[EMPTY_TILE] == 0).all() and (maps.mean[EMPTY_TILE] == EMPTY).all()
+        assert EMPTY_TILE not in maps.free_stack[:int(maps.state[0])]

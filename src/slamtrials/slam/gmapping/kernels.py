@@ -28,6 +28,8 @@ TILE = 1 << TILE_SHIFT
 _MASK = TILE - 1
 #: Mean offset stored in cells that hold no endpoint: far enough that no distance to it can win.
 EMPTY = np.float32(1.0e18)
+#: Tile 0 of every pool is kept empty (never handed out, never written): cells without a tile read it.
+EMPTY_TILE = 0
 _EMPTY_D2 = 1.0e36
 _FOUND_D2 = 1.0e30
 
@@ -42,6 +44,17 @@ def _directory_tile(directory, rows, cols, drow, dcol):  # pragma: no cover - co
     if tr >= rows or tc >= cols:
         return -1
     return directory[np.uint64(tr), np.uint64(tc)]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _tile_or_empty(directory, rows, cols, drow, dcol):  # pragma: no cover - compiled
+    """Like :func:`_directory_tile`, but :data:`EMPTY_TILE` instead of -1."""
+    tr = drow >> TILE_SHIFT
+    tc = dcol >> TILE_SHIFT
+    if drow < 0 or dcol < 0 or tr >= rows or tc >= cols:
+        return EMPTY_TILE
+    tile = directory[np.uint64(tr), np.uint64(tc)]
+    return tile if tile >= 0 else EMPTY_TILE
 
 
 @njit(cache=True, nogil=True)
@@ -86,11 +99,11 @@ def score_pose(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, 
         lc = dcol & _MASK
         lr = drow & _MASK
         best = _EMPTY_D2
-        if not free_test and kernel <= lc < TILE - kernel and kernel <= lr < TILE - kernel:
-            # the whole window lies in one tile: one directory lookup, no branch per cell
-            tile = _directory_tile(directory, rows, cols, drow, dcol)
-            if tile >= 0 and kernel == 1:
-                # the default window, with constant bounds so that the compiler unrolls it (2x faster)
+        if not free_test and kernel == 1:
+            # the default window, with constant bounds so that the compiler unrolls it (2x faster);
+            # cells without a tile read the empty tile, so there is no branch per cell
+            if 1 <= lc < TILE - 1 and 1 <= lr < TILE - 1:  # the window lies in one tile
+                tile = _tile_or_empty(directory, rows, cols, drow, dcol)
                 first = tile * tile_stride + (lr - 1) * row_stride + (lc - 1) * 2
                 for dr in range(3):
                     uy0 = oy - (dr - 1) * res
@@ -99,7 +112,21 @@ def score_pose(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, 
                         ux = ox - (dc - 1) * res - mean[k + np.uint64(2 * dc)]
                         uy = uy0 - mean[k + np.uint64(2 * dc + 1)]
                         best = min(best, ux * ux + uy * uy)
-            elif tile >= 0:
+            else:  # the window crosses a tile border: one directory lookup per cell
+                for dr in range(3):
+                    uy0 = oy - (dr - 1) * res
+                    row = drow + dr - 1
+                    for dc in range(3):
+                        col = dcol + dc - 1
+                        tile = _tile_or_empty(directory, rows, cols, row, col)
+                        k = np.uint64(tile * tile_stride + (row & _MASK) * row_stride + (col & _MASK) * 2)
+                        ux = ox - (dc - 1) * res - mean[k]
+                        uy = uy0 - mean[k + np.uint64(1)]
+                        best = min(best, ux * ux + uy * uy)
+        elif not free_test and kernel <= lc < TILE - kernel and kernel <= lr < TILE - kernel:
+            # the whole window lies in one tile: one directory lookup, no branch per cell
+            tile = _directory_tile(directory, rows, cols, drow, dcol)
+            if tile >= 0:
                 first = tile * tile_stride + (lr - kernel) * row_stride + (lc - kernel) * 2
                 for dr in range(-kernel, kernel + 1):
                     uy0 = oy - dr * res

@@ -17,7 +17,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from slamtrials.slam.gmapping.kernels import EMPTY, TILE, TILE_SHIFT, register_endpoints
+from slamtrials.slam.gmapping.kernels import EMPTY, EMPTY_TILE, TILE, TILE_SHIFT, register_endpoints
 
 __all__ = ["TileMaps"]
 
@@ -49,6 +49,9 @@ class TileMaps:
         count is 0).
     refs:
         int32 ``[K]``: directory entries pointing at each tile.
+
+    Tile :data:`~slamtrials.slam.gmapping.kernels.EMPTY_TILE` (0) is never handed out: the scan matcher
+    reads it for cells whose particle has no tile, so its windows need no branch per cell.
     """
 
     def __init__(self, particles: int, resolution: float, *, initial_tiles: int = 1024):
@@ -60,7 +63,8 @@ class TileMaps:
         self.mean = np.full((initial_tiles, TILE, TILE, 2), EMPTY, dtype=np.float32)
         self.refs = np.zeros(initial_tiles, dtype=np.int32)
         self.free_stack = np.zeros(initial_tiles, dtype=np.int32)
-        self.state = np.zeros(2, dtype=np.int64)  # (tiles on the free stack, tiles ever allocated)
+        # (tiles on the free stack, tiles ever allocated); tile 0 stays empty for reading (EMPTY_TILE)
+        self.state = np.array([0, EMPTY_TILE + 1], dtype=np.int64)
 
     @property
     def particles(self) -> int:
@@ -128,6 +132,7 @@ class TileMaps:
         self.refs[:] = 0
         self.refs[:allocated] = np.bincount(held, minlength=allocated)[:allocated]
         released = np.flatnonzero(self.refs[:allocated] == 0).astype(np.int32)
+        released = released[released != EMPTY_TILE]
         self.free_stack[:released.size] = released
         self.state[0] = released.size
 

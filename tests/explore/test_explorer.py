@@ -145,10 +145,11 @@ def test_a_robot_not_shut_in_ignores_narrow_doors():
 def test_view_points_of_frontiers_behind_a_gap():
     grid = room_with_door(6)  # 0.30 m: the robot cannot pass, but the laser can see through
     grid[:, 51:] = -1  # unknown right behind the gap: its cells are a frontier in the lethal zone
-    explorer = Explorer(ExploreConfig(initial_spin=False, view_distance=1.0))
+    # the frontier is the gap's 6 cells: let frontiers that short count
+    explorer = Explorer(ExploreConfig(initial_spin=False, view_distance=1.0, min_frontier_length=0.3))
     drive(explorer, grid, [1.0, 2.5, 0.0], 0.5)
     goal = explorer.goal
     assert goal is not None and goal[0] < 2.5 and math.dist(goal, (2.5, 2.5)) <= 1.1
-    plain = Explorer(ExploreConfig(initial_spin=False))
+    plain = Explorer(ExploreConfig(initial_spin=False, min_frontier_length=0.3))
     drive(plain, grid, [1.0, 2.5, 0.0], 20.0)
     assert plain.done

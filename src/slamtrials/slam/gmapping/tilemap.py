@@ -85,9 +85,13 @@ class TileMaps:
         points = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
         if points.shape[0] == 0:
             return
+        self._cover(points.min(axis=0), points.max(axis=0))
+
+    def _cover(self, low: NDArray[np.float64], high: NDArray[np.float64]) -> None:
+        """Grow every directory so it covers the box from ``low`` to ``high`` (map frame, (x, y), m)."""
         scale = 1.0 / (self.resolution * TILE)
-        lo = np.floor(points.min(axis=0) * scale).astype(np.int64)
-        hi = np.floor(points.max(axis=0) * scale).astype(np.int64)
+        lo = np.floor(np.asarray(low) * scale).astype(np.int64)
+        hi = np.floor(np.asarray(high) * scale).astype(np.int64)
         _, rows, cols = self.directories.shape
         if rows and cols and lo[0] >= self.tile_col0 and lo[1] >= self.tile_row0 \
                 and hi[0] < self.tile_col0 + cols and hi[1] < self.tile_row0 + rows:
@@ -116,7 +120,7 @@ class TileMaps:
         ey = np.ascontiguousarray(endpoints_y, dtype=np.float64)
         if ex.size == 0:
             return
-        self.ensure(np.column_stack([ex.ravel(), ey.ravel()]))
+        self._cover(np.array([ex.min(), ey.min()]), np.array([ex.max(), ey.max()]))
         done = 0
         while done < self.particles:
             done = register_endpoints(self.directories, self.count, self.mean, self.refs, self.free_stack,

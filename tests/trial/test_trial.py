@@ -113,3 +113,23 @@ def test_bad_input_is_a_config_error(world):
         TrialConfig.from_dict({"termination": {"max_time": -5}})
     with pytest.raises(ConfigError, match="unknown_section|Extra inputs"):
         TrialConfig.from_dict({"unknown_section": {}})
+
+
+def test_the_termination_rule_gets_the_building_reachable_area(world, monkeypatch):
+    """The snapshot period is chosen by the building's reachable area from the start (the paper chose
+    it by the building's size), not by the area mapped so far: run_trial hands that area to the rule."""
+    import slamtrials.trial.run as trial_run
+
+    given = []
+
+    class Recording(trial_run.SnapshotTermination):
+        def __init__(self, config=None, *, area=None):
+            given.append(area)
+            super().__init__(config, area=area)
+
+    monkeypatch.setattr(trial_run, "SnapshotTermination", Recording)
+    config = TrialConfig.from_dict({"termination": {"max_time": 2.0}})
+    record = run_trial(world, config, seed=1)
+    info = record.metadata["trial"]
+    assert given == [pytest.approx(info["reachable_area_m2"])]
+    assert 25.0 < info["reachable_area_m2"] < 40.0  # two rooms of about 3.8 x 4.7 m, less the robot's margin

@@ -132,7 +132,7 @@ def run_campaign(config: CampaignConfig | dict | None, folder: str | Path | None
         if target is None:
             raise ConfigError("no campaign folder: give --out (or 'output' in the config)")
         folder = Path(target).absolute()
-        worlds = resolve_worlds(config.worlds)
+        worlds = resolve_worlds(config.worlds, robot_radius=config.sim.robot.radius)
     if config.replay_of is not None:
         raise ConfigError(f"the config is that of a replay of {config.replay_of}; continue it with 'slamtrials campaign replay'")
 

@@ -120,8 +120,13 @@ def load_world_cached(ref: str) -> World:
     return load_world(ref)
 
 
-def resolve_worlds(entries: Sequence[str], *, base: str | Path | None = None) -> list[WorldInfo]:
+def resolve_worlds(entries: Sequence[str], *, base: str | Path | None = None,
+                   robot_radius: float | None = None) -> list[WorldInfo]:
     """Expand the entries and load every world once, before any work starts.
+
+    Each world's ``reachable_area`` is what a disc robot of ``robot_radius`` (m) can cover from the start
+    (:meth:`World.reachable_by_disc`, the area the trials' mapped fraction refers to), or without a
+    radius every free cell connected to the start.
 
     Raises
     ------
@@ -133,7 +138,8 @@ def resolve_worlds(entries: Sequence[str], *, base: str | Path | None = None) ->
     for position, (name, ref, entry) in enumerate(expand_worlds(entries, base=base)):
         try:
             world = load_world_cached(ref)
-            area = float(np.count_nonzero(world.reachable_free())) * world.resolution ** 2
+            reachable = world.reachable_free() if robot_radius is None else world.reachable_by_disc(robot_radius)
+            area = float(np.count_nonzero(reachable)) * world.resolution ** 2
         except (SlamtrialsError, OSError) as exc:
             where = f"world {entry!r}" if entry == ref else f"world {ref} (from {entry!r})"
             raise ConfigError(f"worlds: {where} does not load: {exc}") from None

@@ -9,6 +9,7 @@ import typer
 
 from slamtrials.cli.common import make_app, make_console
 from slamtrials.errors import ConfigError
+from slamtrials.sim import SimConfig
 
 app = make_app(help="List, show, describe and generate floor plans.")
 
@@ -70,6 +71,8 @@ def info(world: WorldArg, resolution: ResolutionOpt = None) -> None:
     width, height = the_world.size_m
     res = the_world.resolution
     reachable = float(the_world.reachable_free().sum()) * res**2
+    radius = SimConfig().robot.radius
+    by_robot = float(the_world.reachable_by_disc(radius).sum()) * res**2
     _labels, regions = the_world.free_regions
     x, y, theta = (float(v) for v in the_world.start)
     lines = [
@@ -79,6 +82,7 @@ def info(world: WorldArg, resolution: ResolutionOpt = None) -> None:
         ("origin", "({:.3f}, {:.3f}, {:.3f})".format(*(float(v) for v in the_world.origin))),
         ("free area", f"{the_world.free_area:,.1f} m^2 in {regions} connected region{'s' if regions != 1 else ''}"),
         ("reachable free area", f"{reachable:,.1f} m^2 (from the start pose)"),
+        ("robot-reachable area", f"{by_robot:,.1f} m^2 (the paper's {radius:g} m robot; trials measure coverage on it)"),
         ("start pose", f"x {x:.3f} m, y {y:.3f} m, theta {theta:.3f} rad"),
     ]
     meta = the_world.metadata

@@ -58,7 +58,7 @@ def _tile_or_empty(directory, rows, cols, drow, dcol):  # pragma: no cover - com
 
 
 #: Taylor coefficients 1/k! of exp, k = 0 .. 13.
-_EXP_TAYLOR = (1.0, 1.0, 0.5, 0.16666666666666666, 0.041666666666666664, 0.008333333333333333, 0.001388888888888889, 0.0001984126984126984, 2.48015873015873e-05, 2.7557319223985893e-06, 2.755731922398589e-07, 2.505210838544172e-08, 2.08767569878681e-09, 1.6059043836821613e-10)
+_EXP_TAYLOR = tuple(1.0 / math.factorial(k) for k in range(14))
 #: Largest argument a for which _exp_minus(a) uses the series (error below 1e-15 relative there).
 _EXP_SERIES_MAX = 0.5
 

@@ -55,6 +55,7 @@ class TileMaps:
     """
 
     def __init__(self, particles: int, resolution: float, *, initial_tiles: int = 1024):
+        initial_tiles = max(int(initial_tiles), EMPTY_TILE + 1)
         self.resolution = float(resolution)
         self.directories = np.full((particles, 0, 0), -1, dtype=np.int32)
         self.tile_col0 = 0

@@ -11,7 +11,8 @@ trials passing.
 Worlds: the 23 real building maps in ``../shared/worlds/real`` (or ``$SLAMTRIALS_SHARED/worlds/real``)
 and the 20 bundled catalog worlds, smallest first; ``--max-area`` skips bigger ones (by the catalog's
 or SOURCES' free area, else the loaded world's). Per trial one CSV row goes to ``DIR/trials.csv`` as
-soon as it ends (so a long sweep can be watched and resumed with ``--resume``), and the picture of
+soon as it ends (so a long sweep can be watched, resumed with ``--resume`` and its table printed
+with ``--report`` before it is done), and the picture of
 every failing trial to ``DIR/failures/``. At the end a Markdown table is printed: per world, the
 reasons, mapped fractions, simulated and wall times and the simulated-to-wall ratio.
 """
@@ -95,16 +96,17 @@ def one_trial(world_ref: str, source: str, seed: int, out: str) -> dict:
 
 
 def table(rows: list[dict]) -> str:
-    lines = ["| world | m^2 | seeds | end reasons | mapped (min) | simulated s (mean) | wall s (mean) | sim/wall |",
-             "|---|---|---|---|---|---|---|---|"]
+    lines = ["| world | m^2 | seeds | passed | end reasons | mapped (min) | simulated s (mean) | updates (mean) | wall s (mean) | sim/wall |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     by_world: dict[str, list[dict]] = {}
     for row in rows:
         by_world.setdefault(row["world"], []).append(row)
     for world, group in sorted(by_world.items(), key=lambda kv: float(kv[1][0]["reachable_m2"])):
         reasons = ", ".join(sorted({r["reason"] for r in group}))
-        lines.append(f"| {world} | {float(group[0]['reachable_m2']):.0f} | {len(group)} | {reasons} | "
+        passed = sum(str(r["passed"]) == "True" for r in group)
+        lines.append(f"| {world} | {float(group[0]['reachable_m2']):.0f} | {len(group)} | {passed} | {reasons} | "
                      f"{min(float(r['mapped']) for r in group):.3f} | {np.mean([float(r['duration_s']) for r in group]):.0f} | "
-                     f"{np.mean([float(r['wall_s']) for r in group]):.0f} | "
+                     f"{np.mean([float(r['updates']) for r in group]):.0f} | {np.mean([float(r['wall_s']) for r in group]):.0f} | "
                      f"{np.mean([float(r['ratio']) for r in group]):.1f} |")
     passed = sum(str(r["passed"]) == "True" for r in rows)
     lines.append(f"\n{passed} of {len(rows)} trials passed ({100 * passed / max(len(rows), 1):.1f} %; target 95 %).")
@@ -120,7 +122,12 @@ def main() -> None:
     parser.add_argument("--first-seed", type=int, default=1, help="seeds are first-seed .. first-seed + seeds - 1")
     parser.add_argument("--out", type=Path, default=HERE.parent / "results" / "sweep")
     parser.add_argument("--resume", action="store_true", help="keep the rows already in DIR/trials.csv")
+    parser.add_argument("--report", action="store_true", help="only print the table of DIR/trials.csv (e.g. of an unfinished sweep)")
     args = parser.parse_args()
+    if args.report:
+        with (args.out / "trials.csv").open() as handle:
+            print(table(list(csv.DictReader(handle))))
+        return
     args.out.mkdir(parents=True, exist_ok=True)
     csv_path = args.out / "trials.csv"
     done: list[dict] = []

@@ -87,3 +87,16 @@ def test_small_campaign_config():
     assert odometry.slam.algorithm == "odometry" and odometry.runs.max_runs == 3
     with pytest.raises(ConfigError, match="max_runs"):
         small_campaign_config(initial=5, max_runs=3)
+
+
+def test_world_paths_in_a_config_file_are_relative_to_that_file(tmp_path, monkeypatch):
+    """A floor plan next to the config resolves from any working directory; catalog names and paths
+    that are not beside the config stay as written."""
+    folder = tmp_path / "study"
+    (folder / "maps").mkdir(parents=True)
+    (folder / "maps" / "a.yaml").write_text("placeholder: the loader is not called here\n")
+    config_file = folder / "campaign.yaml"
+    config_file.write_text("worlds: [maps/a.yaml, office_small_01, elsewhere/b.yaml]\n")
+    monkeypatch.chdir(tmp_path)
+    config = CampaignConfig.from_yaml(config_file)
+    assert config.worlds == [str((folder / "maps" / "a.yaml").resolve()), "office_small_01", "elsewhere/b.yaml"]

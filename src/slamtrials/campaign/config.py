@@ -82,6 +82,14 @@ class RunSettings(BaseModel):
         return self
 
 
+def _beside(folder: Path, entry: Any) -> Any:
+    """``entry`` as an absolute path if it is a relative path to something in ``folder``, else unchanged."""
+    if not isinstance(entry, str) or not entry.strip() or Path(entry).expanduser().is_absolute():
+        return entry
+    candidate = folder / entry
+    return str(candidate.resolve()) if candidate.exists() else entry
+
+
 class CampaignConfig(BaseModel):
     """Everything a campaign needs: worlds, trial settings, metric, run-count rule, root seed, output.
 
@@ -171,6 +179,11 @@ class CampaignConfig(BaseModel):
     def from_yaml(cls, path: str | Path) -> "CampaignConfig":
         """Read and validate a YAML campaign config.
 
+        A relative ``worlds`` entry that names a file or folder next to the config file is taken
+        relative to the config file's folder (and stored as an absolute path), so a config and its
+        floor plans can move together; other entries (catalog names, paths relative to the working
+        directory) are kept as written.
+
         Raises
         ------
         FormatError
@@ -183,4 +196,8 @@ class CampaignConfig(BaseModel):
         path = Path(path)
         if path.is_dir():
             raise FormatError(path, "is a folder; give a campaign config YAML file")
-        return cls.from_dict(read_yaml_mapping(path), source=str(path))
+        data = read_yaml_mapping(path)
+        worlds = data.get("worlds")
+        if isinstance(worlds, list):
+            data["worlds"] = [_beside(path.parent, entry) for entry in worlds]
+        return cls.from_dict(data, source=str(path))

@@ -22,7 +22,6 @@ from collections.abc import Sequence
 from functools import lru_cache
 from pathlib import Path
 
-import numpy as np
 import yaml
 
 from slamtrials.campaign.store import WorldInfo
@@ -139,7 +138,7 @@ def resolve_worlds(entries: Sequence[str], *, base: str | Path | None = None,
         try:
             world = load_world_cached(ref)
             reachable = world.reachable_free() if robot_radius is None else world.reachable_by_disc(robot_radius)
-            area = float(np.count_nonzero(reachable)) * world.resolution ** 2
+            area = world.area_of(reachable)
         except (SlamtrialsError, OSError) as exc:
             where = f"world {entry!r}" if entry == ref else f"world {ref} (from {entry!r})"
             raise ConfigError(f"worlds: {where} does not load: {exc}") from None

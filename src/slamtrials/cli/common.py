@@ -49,9 +49,10 @@ def fmt_number(value: float | None, digits: int = 3) -> str:
     return "-" if value is None or value != value else f"{value:.{digits}f}"
 
 
-def table_one(title: str, confidence: float, last_column: str):
+def table_one(title: str, confidence: float, last_column: str, last_justify: str = "left"):
     """An empty rich Table with the paper's Table I columns (world, status, runs, eps_t and eps_r each
-    with std and confidence half width) and ``last_column``; rows are added by the caller."""
+    with std and confidence half width) and ``last_column`` (aligned ``last_justify``); rows are added
+    by the caller."""
     from rich.table import Table
 
     table = Table(title=title, caption=f"eps_t in m, eps_r in rad: mean and sample std over the runs; +-: half width "
@@ -61,5 +62,5 @@ def table_one(title: str, confidence: float, last_column: str):
     table.add_column("runs", justify="right")
     for column in ("eps_t", "std", "+-", "eps_r", "std", "+-"):
         table.add_column(column, justify="right", no_wrap=True)
-    table.add_column(last_column, justify="right" if last_column == "outliers" else "left")
+    table.add_column(last_column, justify=last_justify)
     return table

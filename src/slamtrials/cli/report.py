@@ -70,7 +70,7 @@ def worlds_table(data):
     """A rich Table of Table I from :func:`slamtrials.report.load_campaign` data (the catalog read read-only)."""
     import pandas as pd
 
-    table = table_one(f"{data.kind.capitalize()} {data.folder}", data.confidence, "outliers")
+    table = table_one(f"{data.kind.capitalize()} {data.folder}", data.confidence, "outliers", "right")
     done = data.done
     for _, w in data.worlds.iterrows():
         needed = w["runs_needed"]

@@ -119,7 +119,7 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
     slam.reset(np.random.default_rng(slam_seed))
     explorer = Explorer(config.explore_config())
     reachable = world.reachable_by_disc(config.sim.robot.radius)
-    reachable_area = float(np.count_nonzero(reachable)) * world.resolution ** 2
+    reachable_area = world.area_of(reachable)
     # the paper chose the snapshot period by the building's size, known in advance
     termination = SnapshotTermination(config.termination, area=reachable_area)
     max_time = config.termination.max_time
@@ -171,7 +171,7 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
                                                    reachable),
             "reachable_area_m2": reachable_area,
             "mapped_fraction_connected": mapped_fraction(world, final_map, record.estimate[0], record.truth[0]),
-            "connected_free_area_m2": float(np.count_nonzero(world.reachable_free())) * world.resolution ** 2,
+            "connected_free_area_m2": world.area_of(world.reachable_free()),
             "mapped_free_area_m2": known_free_area(final_map),
             "distance_m": _path_length(record.truth),
             "turning_rad": _turning(record.truth),

@@ -99,7 +99,11 @@ class World:
     @property
     def free_area(self) -> float:
         """Area of all free cells in square metres."""
-        return float(np.count_nonzero(~self.occupied)) * self.resolution**2
+        return self.area_of(~self.occupied)
+
+    def area_of(self, cells: NDArray[np.bool_]) -> float:
+        """Area (m^2) of the cells set in the bool ``[H, W]`` mask ``cells``."""
+        return float(np.count_nonzero(cells)) * self.resolution**2
 
     @cached_property
     def clearance(self) -> NDArray[np.float64]:

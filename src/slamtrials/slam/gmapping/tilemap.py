@@ -81,14 +81,7 @@ class TileMaps:
         return int(self.count.nbytes + self.mean.nbytes + self.refs.nbytes
                    + self.free_stack.nbytes + self.directories.nbytes)
 
-    def ensure(self, xy: NDArray[np.float64]) -> None:
-        """Grow every directory so it covers the map-frame points ``[..., 2]`` (m)."""
-        points = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-        if points.shape[0] == 0:
-            return
-        self._cover(points.min(axis=0), points.max(axis=0))
-
-    def _cover(self, low: NDArray[np.float64], high: NDArray[np.float64]) -> None:
+    def ensure(self, low: NDArray[np.float64], high: NDArray[np.float64]) -> None:
         """Grow every directory so it covers the box from ``low`` to ``high`` (map frame, (x, y), m)."""
         scale = 1.0 / (self.resolution * TILE)
         lo = np.floor(np.asarray(low) * scale).astype(np.int64)
@@ -121,7 +114,7 @@ class TileMaps:
         ey = np.ascontiguousarray(endpoints_y, dtype=np.float64)
         if ex.size == 0:
             return
-        self._cover(np.array([ex.min(), ey.min()]), np.array([ex.max(), ey.max()]))
+        self.ensure(np.array([ex.min(), ey.min()]), np.array([ex.max(), ey.max()]))
         done = 0
         while done < self.particles:
             done = register_endpoints(self.directories, self.count, self.mean, self.refs, self.free_stack,

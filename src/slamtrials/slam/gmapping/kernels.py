@@ -35,20 +35,9 @@ _FOUND_D2 = 1.0e30
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _directory_tile(directory, rows, cols, drow, dcol):  # pragma: no cover - compiled
-    """Tile id at directory-relative cell (dcol, drow), or -1 outside the directory or without a tile."""
-    if drow < 0 or dcol < 0:
-        return -1
-    tr = drow >> TILE_SHIFT
-    tc = dcol >> TILE_SHIFT
-    if tr >= rows or tc >= cols:
-        return -1
-    return directory[np.uint64(tr), np.uint64(tc)]
-
-
-@njit(cache=True, nogil=True, inline="always")
 def _tile_or_empty(directory, rows, cols, drow, dcol):  # pragma: no cover - compiled
-    """Like :func:`_directory_tile`, but :data:`EMPTY_TILE` instead of -1."""
+    """Tile id at directory-relative cell (dcol, drow); :data:`EMPTY_TILE` outside the directory or where
+    the particle has no tile."""
     tr = drow >> TILE_SHIFT
     tc = dcol >> TILE_SHIFT
     if drow < 0 or dcol < 0 or tr >= rows or tc >= cols:
@@ -151,17 +140,16 @@ def score_pose(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, 
                         best = min(best, ux * ux + uy * uy)
         elif not free_test and kernel <= lc < TILE - kernel and kernel <= lr < TILE - kernel:
             # the whole window lies in one tile: one directory lookup, no branch per cell
-            tile = _directory_tile(directory, rows, cols, drow, dcol)
-            if tile >= 0:
-                first = tile * tile_stride + (lr - kernel) * row_stride + (lc - kernel) * 2
-                for dr in range(-kernel, kernel + 1):
-                    uy0 = oy - dr * res
-                    k = np.uint64(first + (dr + kernel) * row_stride)
-                    for dc in range(-kernel, kernel + 1):
-                        ux = ox - dc * res - mean[k]
-                        uy = uy0 - mean[k + np.uint64(1)]
-                        best = min(best, ux * ux + uy * uy)
-                        k += np.uint64(2)
+            tile = _tile_or_empty(directory, rows, cols, drow, dcol)
+            first = tile * tile_stride + (lr - kernel) * row_stride + (lc - kernel) * 2
+            for dr in range(-kernel, kernel + 1):
+                uy0 = oy - dr * res
+                k = np.uint64(first + (dr + kernel) * row_stride)
+                for dc in range(-kernel, kernel + 1):
+                    ux = ox - dc * res - mean[k]
+                    uy = uy0 - mean[k + np.uint64(1)]
+                    best = min(best, ux * ux + uy * uy)
+                    k += np.uint64(2)
         else:
             fdcol = 0
             fdrow = 0
@@ -171,20 +159,17 @@ def score_pose(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, 
             for dr in range(-kernel, kernel + 1):
                 uy0 = oy - dr * res
                 for dc in range(-kernel, kernel + 1):
-                    tile = _directory_tile(directory, rows, cols, drow + dr, dcol + dc)
-                    if tile < 0:
-                        continue
+                    tile = _tile_or_empty(directory, rows, cols, drow + dr, dcol + dc)
                     k = np.uint64(tile * tile_stride + ((drow + dr) & _MASK) * row_stride + ((dcol + dc) & _MASK) * 2)
                     mx = mean[k]
                     if mx >= EMPTY:
                         continue
                     if free_test:
-                        free_tile = _directory_tile(directory, rows, cols, fdrow + dr, fdcol + dc)
-                        if free_tile >= 0:
-                            f = np.uint64(free_tile * tile_stride + ((fdrow + dr) & _MASK) * row_stride
-                                          + ((fdcol + dc) & _MASK) * 2)
-                            if mean[f] < EMPTY:
-                                continue
+                        free_tile = _tile_or_empty(directory, rows, cols, fdrow + dr, fdcol + dc)
+                        f = np.uint64(free_tile * tile_stride + ((fdrow + dr) & _MASK) * row_stride
+                                      + ((fdcol + dc) & _MASK) * 2)
+                        if mean[f] < EMPTY:
+                            continue
                     ux = ox - dc * res - mx
                     uy = uy0 - mean[k + np.uint64(1)]
                     best = min(best, ux * ux + uy * uy)

@@ -20,7 +20,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["TILE_SHIFT", "TILE", "score_pose", "match_particles", "register_endpoints"]
+__all__ = ["TILE_SHIFT", "TILE", "score_pose", "score_3x3", "score_scratch", "match_particles", "register_endpoints"]
 
 TILE_SHIFT = 4
 #: Cells per tile side.
@@ -53,11 +53,9 @@ _EXP_SERIES_MAX = 0.5
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _exp_minus(a):  # pragma: no cover - compiled
-    """exp(-a) for a >= 0: a degree-13 Taylor series by Estrin's scheme for a <= 0.5 (where the score's
-    arguments almost all are), else libm; about twice as fast as libm's exp, within a few ulp of it."""
-    if a > _EXP_SERIES_MAX:
-        return math.exp(-a)
+def _exp_series_minus(a):  # pragma: no cover - compiled
+    """The degree-13 Taylor series of exp(-a) by Estrin's scheme: exact to 1e-15 relative for 0 <= a <= 0.5
+    (:data:`_EXP_SERIES_MAX`). Branch free, so that a loop of it vectorizes."""
     x = -a
     x2 = x * x
     x4 = x2 * x2
@@ -67,6 +65,15 @@ def _exp_minus(a):  # pragma: no cover - compiled
     q2 = (c[8] + x * c[9]) + x2 * (c[10] + x * c[11])
     q3 = c[12] + x * c[13]
     return (q0 + x4 * q1) + (x4 * x4) * (q2 + x4 * q3)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _exp_minus(a):  # pragma: no cover - compiled
+    """exp(-a) for a >= 0: the Taylor series for a <= 0.5 (where the score's arguments almost all are),
+    else libm; about twice as fast as libm's exp, within a few ulp of it."""
+    if a > _EXP_SERIES_MAX:
+        return math.exp(-a)
+    return _exp_series_minus(a)
 
 
 @njit(cache=True, nogil=True)
@@ -182,20 +189,138 @@ def score_pose(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, 
     return score, likelihood
 
 
+@njit(cache=True, nogil=True)
+def score_scratch(beams):
+    """Work arrays of :func:`score_3x3` for scans of ``beams`` used beams: float64 ``[3, beams]`` and
+    int64 ``[4, beams]``."""
+    return np.empty((3, beams)), np.empty((4, beams), dtype=np.int64)
+
+
+@njit(cache=True, nogil=True, fastmath={"nnan", "ninf", "nsz"})
+def score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats,
+              ints):  # pragma: no cover - compiled
+    """The score of :func:`score_pose` for its default window (``kernel`` 1, no free-cell test), bit for
+    bit, in stages that keep each loop short: the hill climbing's hot spot.
+
+    1. Per beam: endpoint, offset in its cell and, when the 3 x 3 window lies in one tile, the window's
+       first index in ``mean`` (else the beam goes on a list).
+    2. Per beam: the window minimum, with no branch (listed beams read the empty tile here);
+       then the listed beams again, one directory lookup per cell.
+    3. The exp series of every beam (a loop the compiler vectorizes), then the sum in beam order, with
+       libm's exp where the series does not apply.
+
+    ``floats`` and ``ints`` come from :func:`score_scratch` (at least ``len(lx)`` columns); the
+    arithmetic per beam is the same as in :func:`score_pose`, and the fast-math flags allowed here (no
+    NaN, no infinity, no signed zero; all values are finite) do not change any result.
+    """
+    inv_res = 1.0 / res
+    inv_sigma = 1.0 / sigma
+    c = math.cos(theta)
+    s = math.sin(theta)
+    n = lx.shape[0]
+    rows, cols = directory.shape
+    base_c = tile_col0 << TILE_SHIFT
+    base_r = tile_row0 << TILE_SHIFT
+    row_stride = 2 * TILE
+    tile_stride = 2 * TILE * TILE
+    offset_x = floats[0]
+    offset_y = floats[1]
+    best = floats[2]
+    first = ints[0]
+    crossing = ints[1]  # the beams whose window crosses a tile border, and their cells
+    crossing_col = ints[2]
+    crossing_row = ints[3]
+    crossings = 0
+    for b in range(n):
+        ex = x + c * lx[b] - s * ly[b]
+        ey = y + s * lx[b] + c * ly[b]
+        gc = int(math.floor(ex * inv_res))
+        gr = int(math.floor(ey * inv_res))
+        offset_x[b] = ex - gc * res
+        offset_y[b] = ey - gr * res
+        dcol = gc - base_c
+        drow = gr - base_r
+        lc = dcol & _MASK
+        lr = drow & _MASK
+        if 1 <= lc < TILE - 1 and 1 <= lr < TILE - 1:
+            tile = _tile_or_empty(directory, rows, cols, drow, dcol)
+            first[b] = tile * tile_stride + (lr - 1) * row_stride + (lc - 1) * 2
+        else:
+            first[b] = EMPTY_TILE * tile_stride
+            crossing[crossings] = b
+            crossing_col[crossings] = dcol
+            crossing_row[crossings] = drow
+            crossings += 1
+    for b in range(n):
+        ox = offset_x[b]
+        oy = offset_y[b]
+        k0 = np.uint64(first[b])
+        d2 = _EMPTY_D2
+        for dr in range(3):
+            uy0 = oy - (dr - 1) * res
+            k = k0 + np.uint64(dr * row_stride)
+            for dc in range(3):
+                ux = ox - (dc - 1) * res - mean[k + np.uint64(2 * dc)]
+                uy = uy0 - mean[k + np.uint64(2 * dc + 1)]
+                d2 = min(d2, ux * ux + uy * uy)
+        best[b] = d2
+    for i in range(crossings):
+        b = crossing[i]
+        ox = offset_x[b]
+        oy = offset_y[b]
+        dcol = crossing_col[i]
+        drow = crossing_row[i]
+        d2 = _EMPTY_D2
+        for dr in range(3):
+            uy0 = oy - (dr - 1) * res
+            row = drow + dr - 1
+            for dc in range(3):
+                col = dcol + dc - 1
+                tile = _tile_or_empty(directory, rows, cols, row, col)
+                k = np.uint64(tile * tile_stride + (row & _MASK) * row_stride + (col & _MASK) * 2)
+                ux = ox - (dc - 1) * res - mean[k]
+                uy = uy0 - mean[k + np.uint64(1)]
+                d2 = min(d2, ux * ux + uy * uy)
+        best[b] = d2
+    terms = offset_x  # the offsets are no longer needed
+    for b in range(n):
+        terms[b] = _exp_series_minus(best[b] * inv_sigma)
+    score = 0.0
+    for b in range(n):
+        d2 = best[b]
+        if d2 < _FOUND_D2:
+            a = d2 * inv_sigma
+            score += terms[b] if a <= _EXP_SERIES_MAX else math.exp(-a)
+    return score
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _match_score(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, lfx, lfy, kernel, sigma, lsigma,
+                 free_test, floats, ints):  # pragma: no cover - compiled
+    """The scan-matching score at one pose: :func:`score_3x3` for the default window, else
+    :func:`score_pose`."""
+    if kernel == 1 and not free_test:
+        return score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats, ints)
+    score, _ = score_pose(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, lfx, lfy, kernel, sigma,
+                          lsigma, free_test, False)
+    return score
+
+
 _OPPOSITE = (1, 0, 3, 2, 5, 4)
 
 
 @njit(cache=True, nogil=True)
 def _hill_climb(directory, mean, tile_col0, tile_row0, res, pose, lx, ly, lfx, lfy, kernel, sigma, lsigma, free_test,
-                lstep, astep, iterations):  # pragma: no cover - compiled
+                lstep, astep, iterations, floats, ints):  # pragma: no cover - compiled
     """GMapping's hill climbing from ``pose`` (spec/gmapping.md, section 3); returns (x, y, theta, score).
+    ``floats``, ``ints``: work arrays from :func:`score_scratch`.
 
     One saving over the original: right after a move, the move straight back (same step) is not tried;
     it returns to the pose just left, whose score is lower than the current one, so it could not win.
     """
     cx, cy, ct = pose[0], pose[1], pose[2]
-    current, _ = score_pose(directory, mean, tile_col0, tile_row0, res, cx, cy, ct, lx, ly, lfx, lfy, kernel, sigma,
-                            lsigma, free_test, False)
+    current = _match_score(directory, mean, tile_col0, tile_row0, res, cx, cy, ct, lx, ly, lfx, lfy, kernel, sigma,
+                           lsigma, free_test, floats, ints)
     ld = lstep
     ad = astep
     refinement = 0
@@ -226,8 +351,8 @@ def _hill_climb(directory, mean, tile_col0, tile_row0, res, pose, lx, ly, lfx, l
                 pt += ad
             else:
                 pt -= ad
-            local, _ = score_pose(directory, mean, tile_col0, tile_row0, res, px, py, pt, lx, ly, lfx, lfy, kernel,
-                                  sigma, lsigma, free_test, False)
+            local = _match_score(directory, mean, tile_col0, tile_row0, res, px, py, pt, lx, ly, lfx, lfy, kernel,
+                                 sigma, lsigma, free_test, floats, ints)
             if local > current:
                 current = local
                 bx, by, bt = px, py, pt
@@ -266,10 +391,11 @@ def match_particles(directories, mean, tile_col0, tile_row0, res, poses, lx, ly,
     matched = poses.copy()
     scores = np.zeros(n)
     likelihoods = np.zeros(n)
+    floats, ints = score_scratch(lx.shape[0])
     for p in range(n):
         directory = directories[p]
         x, y, t, best = _hill_climb(directory, mean, tile_col0, tile_row0, res, poses[p], lx, ly, lfx, lfy, kernel,
-                                    sigma, lsigma, free_test, lstep, astep, iterations)
+                                    sigma, lsigma, free_test, lstep, astep, iterations, floats, ints)
         scores[p] = best
         if best > minimum_score:
             matched[p, 0] = x

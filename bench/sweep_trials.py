@@ -9,7 +9,7 @@ mapped at least 90 % of the reachable free area of the true world. The target is
 trials passing.
 
 Worlds: the 23 real building maps in ``../shared/worlds/real`` (or ``$SLAMTRIALS_SHARED/worlds/real``)
-and the 20 bundled catalog worlds, smallest first; ``--max-area`` skips bigger ones (by the catalog's
+and the 20 bundled catalog worlds (trials run biggest first); ``--max-area`` skips bigger ones (by the catalog's
 or SOURCES' free area, else the loaded world's). Per trial one CSV row goes to ``DIR/trials.csv`` as
 soon as it ends (so a long sweep can be watched, resumed with ``--resume`` and its table printed
 with ``--report`` before it is done), and the picture of
@@ -139,16 +139,15 @@ def main() -> None:
             csv.DictWriter(handle, FIELDS).writeheader()
     finished = {(r["world"], int(r["seed"])) for r in done}
     jobs = [(ref, source, seed) for ref, source, _ in world_list(args.max_area, args.worlds)
-            for seed in range(args.first_seed, args.first_seed + args.seeds)]
-    print(f"CPU: {cpu_model()}; {len(jobs)} trials, {args.jobs} at a time", flush=True)
+            for seed in range(args.first_seed, args.first_seed + args.seeds)
+            if ((Path(ref).parent.name if source == "real" else ref), seed) not in finished]
+    jobs.reverse()  # the biggest worlds first, so that no worker is left alone with a long trial at the end
+    print(f"CPU: {cpu_model()}; {len(jobs)} trials to run ({len(finished)} done), {args.jobs} at a time", flush=True)
     started = time.perf_counter()
     rows = list(done)
     with ProcessPoolExecutor(max_workers=args.jobs) as pool:
         futures = {}
         for ref, source, seed in jobs:
-            name = Path(ref).parent.name if source == "real" else ref
-            if (name, seed) in finished:
-                continue
             futures[pool.submit(one_trial, ref, source, seed, str(args.out))] = (ref, seed)
         for future in as_completed(futures):
             ref, seed = futures[future]

@@ -20,6 +20,8 @@ import math
 import numpy as np
 from numba import njit
 
+from slamtrials.slam.gmapping.window import NOTHING_D2, window_min_3x3
+
 __all__ = ["TILE_SHIFT", "TILE", "score_pose", "score_3x3", "score_scratch", "match_particles", "register_endpoints"]
 
 TILE_SHIFT = 4
@@ -30,7 +32,7 @@ _MASK = TILE - 1
 EMPTY = np.float32(1.0e18)
 #: Tile 0 of every pool is kept empty (never handed out, never written): cells without a tile read it.
 EMPTY_TILE = 0
-_EMPTY_D2 = 1.0e36
+_EMPTY_D2 = NOTHING_D2
 _FOUND_D2 = 1.0e30
 
 
@@ -205,8 +207,9 @@ def score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, s
 
     1. Per beam: endpoint, offset in its cell and, when the 3 x 3 window lies in one tile, the window's
        first index in ``mean`` (else the beam goes on a list).
-    2. Per beam: the window minimum, with no branch (listed beams read the empty tile here);
-       then the listed beams again, one directory lookup per cell.
+    2. Per beam: the window minimum in vector code (:func:`~slamtrials.slam.gmapping.window.window_min_3x3`;
+       listed beams read the empty tile here); then the listed beams again, one directory lookup per
+       cell.
     3. The exp series of every beam (a loop the compiler vectorizes), then the sum in beam order, with
        libm's exp where the series does not apply.
 
@@ -253,18 +256,7 @@ def score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, s
             crossing_row[crossings] = drow
             crossings += 1
     for b in range(n):
-        ox = offset_x[b]
-        oy = offset_y[b]
-        k0 = np.uint64(first[b])
-        d2 = _EMPTY_D2
-        for dr in range(3):
-            uy0 = oy - (dr - 1) * res
-            k = k0 + np.uint64(dr * row_stride)
-            for dc in range(3):
-                ux = ox - (dc - 1) * res - mean[k + np.uint64(2 * dc)]
-                uy = uy0 - mean[k + np.uint64(2 * dc + 1)]
-                d2 = min(d2, ux * ux + uy * uy)
-        best[b] = d2
+        best[b] = window_min_3x3(mean, first[b], row_stride, offset_x[b], offset_y[b], res)
     for i in range(crossings):
         b = crossing[i]
         ox = offset_x[b]

@@ -15,7 +15,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pytest
 
 from slamtrials.geometry import compose, compose1, ominus
 from slamtrials.record import Frame

@@ -48,6 +48,25 @@ def _tile_or_empty(directory, rows, cols, drow, dcol):  # pragma: no cover - com
     return tile if tile >= 0 else EMPTY_TILE
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _window_min_across_tiles(directory, mean, rows, cols, drow, dcol, ox, oy, res):  # pragma: no cover - compiled
+    """The default 3 x 3 window's smallest squared distance (or :data:`_EMPTY_D2`) around directory-relative
+    cell (``dcol``, ``drow``), endpoint offset (``ox``, ``oy``) in it, for windows that cross a tile
+    border: one directory lookup per cell."""
+    d2 = _EMPTY_D2
+    for dr in range(3):
+        uy0 = oy - (dr - 1) * res
+        row = drow + dr - 1
+        for dc in range(3):
+            col = dcol + dc - 1
+            tile = _tile_or_empty(directory, rows, cols, row, col)
+            k = np.uint64(tile * (2 * TILE * TILE) + (row & _MASK) * (2 * TILE) + (col & _MASK) * 2)
+            ux = ox - (dc - 1) * res - mean[k]
+            uy = uy0 - mean[k + np.uint64(1)]
+            d2 = min(d2, ux * ux + uy * uy)
+    return d2
+
+
 #: Taylor coefficients 1/k! of exp, k = 0 .. 13.
 _EXP_TAYLOR = tuple(1.0 / math.factorial(k) for k in range(14))
 #: Largest argument a for which _exp_minus(a) uses the series (error below 1e-15 relative there).
@@ -137,17 +156,8 @@ def score_pose(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, 
                         ux = ox - (dc - 1) * res - mean[k + np.uint64(2 * dc)]
                         uy = uy0 - mean[k + np.uint64(2 * dc + 1)]
                         best = min(best, ux * ux + uy * uy)
-            else:  # the window crosses a tile border: one directory lookup per cell
-                for dr in range(3):
-                    uy0 = oy - (dr - 1) * res
-                    row = drow + dr - 1
-                    for dc in range(3):
-                        col = dcol + dc - 1
-                        tile = _tile_or_empty(directory, rows, cols, row, col)
-                        k = np.uint64(tile * tile_stride + (row & _MASK) * row_stride + (col & _MASK) * 2)
-                        ux = ox - (dc - 1) * res - mean[k]
-                        uy = uy0 - mean[k + np.uint64(1)]
-                        best = min(best, ux * ux + uy * uy)
+            else:
+                best = _window_min_across_tiles(directory, mean, rows, cols, drow, dcol, ox, oy, res)
         elif not free_test and kernel <= lc < TILE - kernel and kernel <= lr < TILE - kernel:
             # the whole window lies in one tile: one directory lookup, no branch per cell
             tile = _tile_or_empty(directory, rows, cols, drow, dcol)
@@ -259,22 +269,8 @@ def score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, s
         best[b] = window_min_3x3(mean, first[b], row_stride, offset_x[b], offset_y[b], res)
     for i in range(crossings):
         b = crossing[i]
-        ox = offset_x[b]
-        oy = offset_y[b]
-        dcol = crossing_col[i]
-        drow = crossing_row[i]
-        d2 = _EMPTY_D2
-        for dr in range(3):
-            uy0 = oy - (dr - 1) * res
-            row = drow + dr - 1
-            for dc in range(3):
-                col = dcol + dc - 1
-                tile = _tile_or_empty(directory, rows, cols, row, col)
-                k = np.uint64(tile * tile_stride + (row & _MASK) * row_stride + (col & _MASK) * 2)
-                ux = ox - (dc - 1) * res - mean[k]
-                uy = uy0 - mean[k + np.uint64(1)]
-                d2 = min(d2, ux * ux + uy * uy)
-        best[b] = d2
+        best[b] = _window_min_across_tiles(directory, mean, rows, cols, crossing_row[i], crossing_col[i],
+                                           offset_x[b], offset_y[b], res)
     terms = offset_x  # the offsets are no longer needed
     for b in range(n):
         terms[b] = _exp_series_minus(best[b] * inv_sigma)

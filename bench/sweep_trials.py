@@ -9,8 +9,8 @@ mapped at least 90 % of the reachable free area of the true world. The target is
 trials passing.
 
 Worlds: the 23 real building maps in ``../shared/worlds/real`` (or ``$SLAMTRIALS_SHARED/worlds/real``)
-and the 20 bundled catalog worlds (trials run biggest first); ``--max-area`` skips bigger ones (by the catalog's
-or SOURCES' free area, else the loaded world's). Per trial one CSV row goes to ``DIR/trials.csv`` as
+and the 20 bundled catalog worlds (trials run biggest first); ``--max-area`` skips bigger ones (by the
+catalog's or SOURCES' free area, else the loaded world's). Per trial one CSV row goes to ``DIR/trials.csv`` as
 soon as it ends (so a long sweep can be watched, resumed with ``--resume`` and its table printed
 with ``--report`` before it is done), and the picture of
 every failing trial to ``DIR/failures/``. At the end a Markdown table is printed: per world, the

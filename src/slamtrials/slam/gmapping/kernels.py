@@ -116,8 +116,9 @@ def score_pose(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, 
     Returns ``(score, log_likelihood)``; the likelihood is 0 unless ``with_likelihood``. Indexes are
     unsigned so that numba does no negative-index wrap-around per access. The hill climbing scores the
     default window with :func:`score_3x3` (same results, faster); this function gives the likelihood,
-    the other windows and the free-cell test. Each beam's term ``exp(-d^2 / sigma)`` is computed as ``_exp_minus(d^2 * (1 / sigma))``: a quarter
-    faster than libm's exp of a quotient, and within a few ulp of it.
+    the other windows and the free-cell test. Each beam's term ``exp(-d^2 / sigma)`` is computed as
+    ``_exp_minus(d^2 * (1 / sigma))``: a quarter faster than libm's exp of a quotient, and within a few
+    ulp of it.
     """
     inv_res = 1.0 / res
     inv_sigma = 1.0 / sigma

@@ -32,7 +32,6 @@ _MASK = TILE - 1
 EMPTY = np.float32(1.0e18)
 #: Tile 0 of every pool is kept empty (never handed out, never written): cells without a tile read it.
 EMPTY_TILE = 0
-_EMPTY_D2 = NOTHING_D2
 _FOUND_D2 = 1.0e30
 
 
@@ -50,10 +49,10 @@ def _tile_or_empty(directory, rows, cols, drow, dcol):  # pragma: no cover - com
 
 @njit(cache=True, nogil=True, inline="always")
 def _window_min_across_tiles(directory, mean, rows, cols, drow, dcol, ox, oy, res):  # pragma: no cover - compiled
-    """The default 3 x 3 window's smallest squared distance (or :data:`_EMPTY_D2`) around directory-relative
+    """The default 3 x 3 window's smallest squared distance (or :data:`NOTHING_D2`) around directory-relative
     cell (``dcol``, ``drow``), endpoint offset (``ox``, ``oy``) in it, for windows that cross a tile
     border: one directory lookup per cell."""
-    d2 = _EMPTY_D2
+    d2 = NOTHING_D2
     for dr in range(3):
         uy0 = oy - (dr - 1) * res
         row = drow + dr - 1
@@ -143,7 +142,7 @@ def score_pose(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, 
         drow = gr - base_r
         lc = dcol & _MASK
         lr = drow & _MASK
-        best = _EMPTY_D2
+        best = NOTHING_D2
         if not free_test and kernel == 1:
             # the default window, with constant bounds so that the compiler unrolls it (2x faster);
             # cells without a tile read the empty tile, so there is no branch per cell

@@ -70,11 +70,80 @@ def test_follows_a_straight_path_within_the_limits():
     assert math.isclose(v_prev, cfg.max_linear_speed)
 
 
-def test_turns_in_place_towards_a_path_behind():
-    follower = PathFollower(ExploreConfig())
+def test_turns_in_place_towards_a_path_behind_when_not_backing_out():
+    follower = PathFollower(ExploreConfig(max_reverse_distance=0.0))
     follower.set_path(np.column_stack([np.linspace(0, -3, 61), np.zeros(61)]))
     out = follower.command([0.0, 0.0, 0.0], empty_scan(), LASER)
     assert out.v == 0.0 and out.w != 0.0
+
+
+def drive(follower, pose, steps, dt=0.1):
+    """Unicycle robot obeying the follower's commands exactly; returns the poses [steps + 1, 3] and the
+    commands [steps, 2]."""
+    poses, commands = [np.array(pose, dtype=float)], []
+    for _ in range(steps):
+        x, y, theta = poses[-1]
+        out = follower.command(poses[-1], empty_scan(), LASER)
+        follower.remember(out.v, out.w)
+        commands.append((out.v, out.w))
+        poses.append(np.array([x + out.v * dt * math.cos(theta), y + out.v * dt * math.sin(theta), theta + out.w * dt]))
+        if out.finished:
+            break
+    return np.array(poses), np.array(commands)
+
+
+def l_path_behind():
+    """Back 2 m the way the robot came (it faces +x at the origin), then 3 m to the left of that way."""
+    back = np.column_stack([np.linspace(0, -2, 41), np.zeros(41)])
+    up = np.column_stack([np.full(60, -2.0), np.linspace(0.05, 3, 60)])
+    return np.vstack([back, up])
+
+
+def test_backs_out_of_a_dead_end_instead_of_turning_round():
+    cfg = ExploreConfig()
+    follower = PathFollower(cfg)
+    follower.set_path(l_path_behind())
+    poses, commands = drive(follower, [0.0, 0.0, 0.0], 400)
+    assert np.hypot(poses[-1, 0] + 2.0, poses[-1, 1] - 3.0) < cfg.goal_tolerance  # got there
+    v = commands[:, 0]
+    assert v.min() >= -cfg.reverse_speed - 1e-12 and v.min() < -0.5 * cfg.reverse_speed
+    speed = np.abs(np.concatenate([[0.0], v]))
+    assert np.all(np.diff(speed) <= cfg.max_linear_accel * cfg.control_period + 1e-12)  # braking is the robot's
+    assert not np.any((v[1:] < 0.0) & (v[:-1] > 0.0))  # never from forward straight to backward
+    backed = poses[1:][v < 0.0]
+    assert backed[:, 0].min() > -2.5 and np.all(np.abs(backed[:, 1]) < 0.6)  # only along the first leg
+    turning = np.abs(np.diff(poses[:, 2])).sum()
+    assert turning < math.radians(135.0)  # one quarter turn (and some steering), not a half turn first
+
+    turning_round = PathFollower(ExploreConfig(max_reverse_distance=0.0))
+    turning_round.set_path(l_path_behind())
+    poses_fwd, commands_fwd = drive(turning_round, [0.0, 0.0, 0.0], 400)
+    assert commands_fwd[:, 0].min() >= 0.0
+    assert np.abs(np.diff(poses_fwd[:, 2])).sum() > math.radians(200.0)
+
+
+def test_backing_out_stops_after_max_reverse_distance():
+    cfg = ExploreConfig(max_reverse_distance=1.0)
+    follower = PathFollower(cfg)
+    follower.set_path(np.column_stack([np.linspace(0, -4, 81), np.zeros(81)]))
+    poses, commands = drive(follower, [0.0, 0.0, 0.0], 600)
+    backing = np.flatnonzero(commands[:, 0] < 0.0)
+    assert backing.size and np.all(np.diff(backing) == 1)  # one stretch, then forward
+    assert -poses[backing[-1] + 1, 0] <= 1.0 + 0.1
+    assert np.hypot(poses[-1, 0] + 4.0, poses[-1, 1]) < cfg.goal_tolerance
+
+
+def test_a_moving_robot_stops_before_backing_out():
+    cfg = ExploreConfig()
+    follower = PathFollower(cfg)
+    follower.set_path(np.column_stack([np.linspace(0.2, -3, 65), np.zeros(65)]))
+    follower.remember(0.5, 0.0)
+    follower.command([0.15, 0.0, 0.0], empty_scan(), LASER)
+    out = follower.command([0.2, 0.0, 0.0], empty_scan(), LASER)  # 0.05 m in 0.1 s: still rolling forward
+    assert out.v == 0.0 and out.w == 0.0 and not follower.backing
+    follower.remember(out.v, out.w)
+    out = follower.command([0.2, 0.0, 0.0], empty_scan(), LASER)  # stopped
+    assert out.v < 0.0 and follower.backing
 
 
 def test_curves_towards_a_path_to_the_left():

@@ -29,6 +29,18 @@ def test_moving_as_commanded_or_standing_still_is_not_stuck():
     assert not any(idle.update(0.1 * k, [0.0, 0.0, 0.0], 0.0, 0.1, False) for k in range(100))
 
 
+def test_backing_out_counts_and_a_change_of_direction_starts_the_window_afresh():
+    cfg = ExploreConfig()
+    backing = StuckMonitor(cfg)
+    stuck = [backing.update(0.1 * k, [0.0, 0.0, 0.0], -0.3, 0.1) for k in range(40)]
+    assert stuck[-1]  # commanded backwards while following, but not moving
+    shuttle = StuckMonitor(cfg)
+    # 2 s forward, then 2 s back to where it started: the 3 s window must not see "no net motion"
+    xs = [0.03 * k for k in range(20)] + [0.6 - 0.03 * k for k in range(20)]
+    vs = [0.3] * 20 + [-0.3] * 20
+    assert not any(shuttle.update(0.1 * k, [x, 0.0, 0.0], v, 0.1) for k, (x, v) in enumerate(zip(xs, vs)))
+
+
 def free_map():
     return SimpleNamespace(grid=np.zeros((100, 100), np.int8), resolution=0.05, origin=np.array([-2.5, -2.5, 0.0]))
 

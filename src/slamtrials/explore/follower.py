@@ -27,6 +27,19 @@ costmap's lethal distance). If even that is impossible it reports itself *blocke
 starts a recovery if this lasts). Once the short look-ahead or creeping was needed, it is kept (also
 across new paths) until the robot has moved 0.4 m: switching back and forth between look-aheads would
 make it turn back and forth on the spot.
+
+Backing out: when the path first leads back the way the robot came (typically from a goal at a dead
+end), the robot backs along it instead of turning round. The *leg* is the longest start of the path,
+at most ``max_reverse_distance`` long, that runs straight from the robot (every point within
+``_LEG_TOLERANCE`` of the line to its end); if it is at least ``_MIN_LEG`` long and its end lies at
+least ``reverse_angle`` off the heading, the robot stops (without turning; its speed is measured from
+its last two positions), then follows the leg backwards: steps 2 to 5 with the heading ``theta + pi``,
+the target no further than the leg's end, the scan points mirrored (the laser's blind sector is behind
+the robot; the path keeps off the mapped walls) and ``reverse_speed`` as the speed limit. At the leg's
+end (a corner, or the way out of the dead end) it drives forward again, turning in place there if
+needed; it also does when backing would need a turn in place or the scan blocks it. It backs out again
+only after moving ``_REVERSE_REARM`` away from where it stopped backing. A new path while backing gets
+a new leg from where the robot is (for the distance still allowed).
 """
 
 from __future__ import annotations
@@ -54,6 +67,11 @@ _CREEP_MARGIN = 0.0  # m: clearance kept beyond the radius while creeping
 _NARROW_AHEAD = 1.0  # m of path ahead whose clearance limits the speed
 _TARGET_WINDOW = 3.0  # m of path ahead searched for the look-ahead target
 _TIGHT_RELEASE = 0.4  # m: after a short look-ahead or creeping was needed, keep it up for this distance
+_LEG_TOLERANCE = 0.05  # m: how far from a straight line the path may stray and still be backed along
+_MIN_LEG = 0.3  # m: shorter legs are not worth backing along
+_LEG_ARRIVED = 0.1  # m: the leg's end is reached within this distance
+_STANDSTILL = 0.05  # m/s: below this speed the robot may start backing out
+_REVERSE_REARM = 1.0  # m: after backing out, move this far before backing out again
 
 
 def turn_rate(error: float, max_rate: float, max_accel: float) -> float:
@@ -196,6 +214,10 @@ class PathFollower:
         self._narrow_end = np.zeros(0, dtype=np.intp)
         self._window_end = np.zeros(0, dtype=np.intp)
         self._index = 0
+        self._reverse_from: tuple[float, float] | None = None  # where backing out began, while backing
+        self._leg_end = 0  # path index of the end of the leg being backed along
+        self._reverse_ended: tuple[float, float] | None = None  # where the last backing out ended
+        self._previous: tuple[float, float] | None = None  # the position at the previous call
         self._tight: tuple[int, float, float] | None = None  # (level, x, y) where tight following began
         self._v = 0.0
         self._w = 0.0
@@ -226,15 +248,27 @@ class PathFollower:
         self._narrow_end = np.searchsorted(along, along + _NARROW_AHEAD, side="right") - 1
         self._window_end = np.searchsorted(along, along + _TARGET_WINDOW, side="right") - 1
         self._index = 0
+        if self._reverse_from is not None and not len(points):
+            self._stop_backing(*(self._previous or self._reverse_from))
+        elif self._reverse_from is not None:  # backing out: go on along the new path's leg, if it has one
+            leg = self._leg(self.config.max_reverse_distance - math.hypot(
+                points[0, 0] - self._reverse_from[0], points[0, 1] - self._reverse_from[1]))
+            if leg is None:
+                self._stop_backing(float(points[0, 0]), float(points[0, 1]))
+            else:
+                self._leg_end = leg
 
     def clear(self) -> None:
         """Forget the path."""
         self.set_path(np.zeros((0, 2)))
 
     def reset(self) -> None:
-        """Forget the path, the remembered velocity and the tight-following state."""
+        """Forget the path, the remembered velocity, the tight-following and the backing-out state."""
         self.clear()
         self._tight = None
+        self._reverse_from = None
+        self._reverse_ended = None
+        self._previous = None
         self._v = 0.0
         self._w = 0.0
 
@@ -268,6 +302,17 @@ class PathFollower:
         if end_dist < cfg.goal_tolerance:
             return self._limited(0.0, 0.0, finished=True)
         points = scan_points(ranges, laser)
+        speed = math.inf if self._previous is None else math.hypot(x - self._previous[0],
+                                                                  y - self._previous[1]) / cfg.control_period
+        self._previous = (x, y)
+        backing_out = self._backing_out(x, y, theta, speed)
+        if backing_out is None:
+            return self._limited(0.0, 0.0)  # come to a stop first, without turning
+        if backing_out:
+            backing = self._reverse(x, y, theta, points, to_end)
+            if backing is not None:
+                return backing
+            self._stop_backing(x, y)
         if self._tight is not None and math.hypot(x - self._tight[1], y - self._tight[2]) >= _TIGHT_RELEASE:
             self._tight = None  # got through the tight spot: back to normal following
         level = 0 if self._tight is None else self._tight[0]
@@ -292,6 +337,89 @@ class PathFollower:
             v = min(v, cfg.max_angular_speed / abs(curvature))
         return self._limited(v, curvature * v, pure_pursuit=True, curvature=curvature)
 
+    @property
+    def backing(self) -> bool:
+        """Whether the robot is backing out along the path."""
+        return self._reverse_from is not None
+
+    def _backing_out(self, x: float, y: float, theta: float, speed: float) -> bool | None:
+        """Whether to drive backwards now (module docstring, "Backing out"), or ``None`` to stop first;
+        starts and stops backing. ``speed`` (m/s) is the robot's, from its last two positions."""
+        cfg = self.config
+        if self._reverse_from is not None:
+            ex, ey = self._path[self._leg_end]
+            backed = math.hypot(x - self._reverse_from[0], y - self._reverse_from[1])
+            if (self._index >= self._leg_end or math.hypot(ex - x, ey - y) < _LEG_ARRIVED
+                    or backed >= cfg.max_reverse_distance):
+                self._stop_backing(x, y)
+                return False
+            return True
+        if cfg.max_reverse_distance <= 0.0:
+            return False
+        if self._reverse_ended is not None and math.hypot(x - self._reverse_ended[0],
+                                                          y - self._reverse_ended[1]) < _REVERSE_REARM:
+            return False
+        # cheap test first: most paths lead ahead
+        soon = int(np.searchsorted(self._remaining[self._index] - self._remaining[self._index:], _MIN_LEG))
+        sx, sy = self._path[min(self._index + soon, len(self._path) - 1)]
+        if abs(math.remainder(math.atan2(sy - y, sx - x) - theta, 2.0 * math.pi)) < 0.5 * math.pi:
+            return False
+        leg = self._leg(cfg.max_reverse_distance, x, y)
+        if leg is None:
+            return False
+        ex, ey = self._path[leg]
+        if abs(math.remainder(math.atan2(ey - y, ex - x) - theta, 2.0 * math.pi)) < cfg.reverse_angle:
+            return False
+        if speed >= _STANDSTILL or self._v > 0.0:
+            return None
+        self._reverse_from = (x, y)
+        self._leg_end = leg
+        return True
+
+    def _leg(self, limit: float, x: float | None = None, y: float | None = None) -> int | None:
+        """Index of the end of the longest straight start of the path from (x, y) (default: the path's
+        current point), at most ``limit`` m along the path; ``None`` if shorter than ``_MIN_LEG``."""
+        path, i0 = self._path, self._index
+        if x is None or y is None:
+            x, y = (float(v) for v in path[i0])
+        along = self._remaining[i0] - self._remaining[i0:]
+        last = int(np.searchsorted(along, limit, side="right")) - 1
+        for j in range(last, 0, -1):
+            dx, dy = path[i0 + j, 0] - x, path[i0 + j, 1] - y
+            length = math.hypot(dx, dy)
+            if length < _MIN_LEG:
+                return None
+            stray = np.abs((path[i0:i0 + j, 0] - x) * dy - (path[i0:i0 + j, 1] - y) * dx) / length
+            if stray.max() <= _LEG_TOLERANCE:
+                return i0 + j
+        return None
+
+    def _stop_backing(self, x: float, y: float) -> None:
+        if self._reverse_from is not None:
+            self._reverse_from = None
+            self._reverse_ended = (x, y)
+
+    def _reverse(self, x: float, y: float, theta: float, points: NDArray[np.float64],
+                 to_end: float) -> FollowCommand | None:
+        """Pure pursuit backwards (heading ``theta + pi``), or ``None`` when that needs a turn in place
+        or the scan blocks it."""
+        cfg = self.config
+        tx, ty = self._target(x, y, cfg.lookahead_distance, self._leg_end)
+        error = math.remainder(math.atan2(ty - y, tx - x) - theta - math.pi, 2.0 * math.pi)
+        if abs(error) > cfg.rotate_in_place_angle:
+            return None
+        dist = max(math.hypot(tx - x, ty - y), 1e-6)
+        curvature = 2.0 * math.sin(error) / dist  # in the backward frame: positive turns the tail left
+        free = free_travel(-points, curvature, cfg.robot_radius + cfg.obstacle_margin)
+        speed = math.sqrt(2.0 * cfg.max_linear_accel * max(free - cfg.stop_distance, 0.0))
+        if speed < _BLOCKED_SPEED:
+            return None
+        speed = min(speed, cfg.reverse_speed, math.sqrt(2.0 * cfg.max_linear_accel * to_end), self._narrow_limit())
+        if abs(curvature) > 1e-9:
+            speed = min(speed, cfg.max_angular_speed / abs(curvature))
+        # the tail turning left at rate curvature * speed is the base turning left at that rate
+        return self._limited(-speed, curvature * speed, pure_pursuit=True, curvature=-curvature)
+
     def _creep(self, x: float, y: float, theta: float, points: NDArray[np.float64], to_end: float) -> FollowCommand:
         """Tight manoeuvring: face the path a few centimetres ahead, then inch straight along it."""
         cfg = self.config
@@ -315,10 +443,12 @@ class PathFollower:
         share = min(max((least - cfg.lethal_distance) / cfg.narrow_clearance, 0.0), 1.0)
         return cfg.narrow_speed + share * (cfg.max_linear_speed - cfg.narrow_speed)
 
-    def _target(self, x: float, y: float, lookahead: float) -> tuple[float, float]:
+    def _target(self, x: float, y: float, lookahead: float, last: int | None = None) -> tuple[float, float]:
         """The first path point from the current one at least ``lookahead`` from (x, y), else the last
-        within ``_TARGET_WINDOW`` along the path."""
+        within ``_TARGET_WINDOW`` along the path (and not beyond index ``last``)."""
         end = int(self._window_end[self._index]) + 1
+        if last is not None:
+            end = min(end, last + 1)
         path = self._path[self._index:end]
         ahead = np.hypot(path[:, 0] - x, path[:, 1] - y)
         beyond = np.flatnonzero(ahead >= lookahead)
@@ -331,8 +461,10 @@ class PathFollower:
         dt = cfg.control_period
         if v > 0.0:
             v = min(v, max(self._v, 0.0) + cfg.max_linear_accel * dt)
-            if pure_pursuit:
-                w = curvature * v  # stay on the arc while speeding up
+        elif v < 0.0:
+            v = max(v, min(self._v, 0.0) - cfg.max_linear_accel * dt)
+        if pure_pursuit:
+            w = curvature * v  # stay on the arc while speeding up
         dw = cfg.max_angular_accel * dt
         w = min(max(w, self._w - dw), self._w + dw)
         self._v, self._w = v, w

@@ -1,6 +1,7 @@
 """Getting unstuck: notice that the robot does not move as commanded, then back off and turn.
 
-:class:`StuckMonitor` keeps the last ``stuck_time`` seconds of commanded forward speed and estimated
+:class:`StuckMonitor` keeps the last ``stuck_time`` seconds of commanded speed (forward, or backward
+while backing out along a path; a change of direction starts the window afresh) and estimated
 position. The robot is stuck when it was commanded to move at least ``stuck_min_command`` metres over
 that window but moved (net) less than ``stuck_ratio`` of it: the simulator stops a robot that bumps
 into a wall, and a robot wedged against an obstacle that the map does not show (or shows elsewhere,
@@ -43,12 +44,14 @@ class StuckMonitor:
         self._samples: deque[tuple[float, float, float, float]] = deque()  # (t, x, y, commanded distance)
         self._commanded = 0.0
         self._anchor: tuple[float, float, float] | None = None  # (t, x, y) where idling began
+        self._direction = 1.0  # sign of the last non-zero speed commanded
 
     def reset(self) -> None:
         """Forget the history."""
         self._samples.clear()
         self._commanded = 0.0
         self._anchor = None
+        self._direction = 1.0
 
     def update(self, t: float, pose: ArrayLike, v_command: float, dt: float, following: bool = True) -> bool:
         """Record that at time ``t`` (s) the robot was at ``pose`` and was then commanded ``v_command``
@@ -60,7 +63,15 @@ class StuckMonitor:
             self._anchor = (t, x, y)
         elif t - self._anchor[0] >= self.config.idle_time:
             return True
-        moved = max(float(v_command), 0.0) * dt
+        # backing out along a path counts; a recovery's backing off (not following) does not
+        moved = (abs(float(v_command)) if following else max(float(v_command), 0.0)) * dt
+        direction = math.copysign(1.0, v_command) if following and v_command != 0.0 else 0.0
+        if direction != 0.0:
+            if direction != self._direction:
+                # the net displacement of a window in which the robot changed direction means nothing
+                self._samples.clear()
+                self._commanded = 0.0
+            self._direction = direction
         self._samples.append((t, x, y, moved))
         self._commanded += moved
         window = self.config.stuck_time

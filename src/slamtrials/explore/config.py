@@ -87,7 +87,7 @@ class ExploreConfig(BaseModel):
     # --- frontiers -----------------------------------------------------------------------------------
     min_frontier_length: float = Field(0.5, ge=0.0, le=100.0, description="smallest frontier kept: cells x resolution (m)")
     view_distance: float = Field(0.0, ge=0.0, le=30.0, description="last resort: look at frontiers the robot cannot reach from reachable cells this close (m); 0 = never")
-    min_unknown_area: float = Field(1.0, ge=0.0, le=1000.0, description="enclosed unknown pockets smaller than this make no frontier (m^2)")
+    min_unknown_area: float = Field(3.0, ge=0.0, le=1000.0, description="enclosed unknown pockets smaller than this make no frontier (m^2)")
     # --- motion limits and follower ------------------------------------------------------------------
     max_linear_speed: float = Field(0.7, gt=0.0, le=10.0, description="largest forward speed (m/s)")
     max_angular_speed: float = Field(math.radians(70.0), gt=0.0, le=4.0 * math.pi, description="largest turn rate (rad/s)")

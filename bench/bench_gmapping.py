@@ -35,6 +35,7 @@ from slamtrials.sim import SimConfig  # noqa: E402
 from slamtrials.sim.tour import tour_waypoints  # noqa: E402
 from slamtrials.sim.waypoints import simulate_waypoints  # noqa: E402
 from slamtrials.slam import make_algorithm  # noqa: E402
+from slamtrials.slam.gmapping.kernels import TILE  # noqa: E402
 from slamtrials.worlds import load_world  # noqa: E402
 
 from benchutil import cpu_model
@@ -127,7 +128,7 @@ def memory(quick: bool) -> None:
     print(f"### Memory: 40 particles (paper preset) over a {record.t[-1]:.0f} s tour of {LARGEST}\n")
     print("| measure | value |\n|---|---|")
     print(f"| updates | {slam.updates} ({slam.resamplings} resamplings) |")
-    print(f"| peak tiles held (16 x 16 cells, 3 KiB each) | {peak_tiles:,} |")
+    print(f"| peak tiles held ({TILE} x {TILE} cells, {TILE * TILE * 12 // 1024} KiB each) | {peak_tiles:,} |")
     print(f"| peak bytes of the particle maps (pool + directories) | {peak_maps / 2**20:.0f} MiB |")
     print(f"| peak resident size of the whole process | {rss / 2**20:.0f} MiB |")
     print(f"| wall time of the run | {elapsed:.0f} s ({record.t[-1] / elapsed:.1f}x real time) |\n")

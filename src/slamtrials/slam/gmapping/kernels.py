@@ -24,7 +24,9 @@ from slamtrials.slam.gmapping.window import NOTHING_D2, window_min_3x3
 
 __all__ = ["TILE_SHIFT", "TILE", "score_pose", "score_3x3", "score_scratch", "match_particles", "register_endpoints"]
 
-TILE_SHIFT = 4
+# 32-cell tiles: a 3 x 3 window crosses a tile border for 12 % of beams (23 % with 16-cell tiles),
+# which takes the slower scalar path; the price is about twice the particle-map memory (bench/RESULTS.md)
+TILE_SHIFT = 5
 #: Cells per tile side.
 TILE = 1 << TILE_SHIFT
 _MASK = TILE - 1

@@ -1,7 +1,7 @@
 """The particles' maps: endpoint-mean grids stored as shared, copy-on-write tiles.
 
 Every particle sees its own map, but the maps live in one pool of ``TILE x TILE``-cell tiles
-(:data:`~slamtrials.slam.gmapping.kernels.TILE` = 16, 0.8 m at 5 cm). A particle's map is a directory
+(:data:`~slamtrials.slam.gmapping.kernels.TILE` = 32, 1.6 m at 5 cm). A particle's map is a directory
 of tile ids; particles descended from the same parent point at the same tiles until one of them writes,
 and only then is that one tile copied. Resampling therefore copies directories (4 bytes per tile),
 never cells, and 40 particles cost little more than one map plus what each saw since their paths split.

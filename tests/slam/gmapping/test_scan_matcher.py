@@ -6,8 +6,9 @@
   (nearest cell mean in the (2k+1)^2 window, ``exp(-|mu|^2 / sigma)``, ``-|mu|^2 / lsigma`` or
   ``-0.5 / lsigma``) computed from the endpoints themselves, for several window sizes, with and
   without the free-cell test, at poses whose windows straddle tile borders;
-* ``score_3x3``, the staged kernel the hill climbing uses for the default window, gives the very score
-  of ``score_pose``, bit for bit, also for beams beyond the map and windows across tile borders;
+* ``score_3x3`` and ``likelihood_3x3``, the staged kernels used for the default window, give the very
+  score and log-likelihood of ``score_pose``, bit for bit, also for beams beyond the map and windows
+  across tile borders;
 * the free-cell test (``free_cell_test=True``) skips a window cell whose counterpart next to the free
   point holds endpoints, lowering the score in the predicted way.
 
@@ -21,7 +22,8 @@ import math
 import numpy as np
 import pytest
 
-from slamtrials.slam.gmapping.kernels import TILE, match_particles, score_3x3, score_pose, score_scratch
+from slamtrials.slam.gmapping.kernels import (TILE, likelihood_3x3, match_particles, score_3x3, score_pose,
+                                              score_scratch)
 from slamtrials.slam.gmapping.tilemap import TileMaps
 
 RES = 0.05
@@ -226,7 +228,8 @@ def test_windows_beyond_the_directory_and_on_its_edge_equal_the_naive_reference(
 def test_the_staged_default_window_score_is_score_pose_bit_for_bit():
     """Random endpoints over several tiles (some cells with several), beams ending on them, near them, in
     cells without a tile, across tile borders and far outside the directory, at random poses: the score
-    of ``score_3x3`` is exactly ``score_pose``'s (the hill climbing must not depend on which one runs)."""
+    of ``score_3x3`` and the log-likelihood of ``likelihood_3x3`` are exactly ``score_pose``'s (the
+    filter must not depend on which one runs)."""
     rng = np.random.default_rng(33)
     points = rng.uniform(-1.5, 1.5, size=(2000, 2))
     points = np.vstack([points, points[:400] + rng.normal(0.0, 0.01, size=(400, 2))])
@@ -240,10 +243,13 @@ def test_the_staged_default_window_score_is_score_pose_bit_for_bit():
     found = 0
     for _ in range(40):
         x, y, theta = rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), rng.uniform(-0.5, 0.5)
-        want, _ = score_pose(directory, mean, maps.tile_col0, maps.tile_row0, RES, x, y, theta, lx, ly, lx, ly,
-                             1, 0.05, 0.075, False, False)
+        want, want_likelihood = score_pose(directory, mean, maps.tile_col0, maps.tile_row0, RES, x, y, theta, lx,
+                                           ly, lx, ly, 1, 0.05, 0.075, False, True)
         got = score_3x3(directory, mean, maps.tile_col0, maps.tile_row0, RES, x, y, theta, lx, ly, 0.05, floats, ints)
         assert got == want
+        got_likelihood = likelihood_3x3(directory, mean, maps.tile_col0, maps.tile_row0, RES, x, y, theta, lx, ly,
+                                        0.075, floats, ints)
+        assert got_likelihood == want_likelihood and got_likelihood < 0.0
         found += want > 1.0
     assert found == 40  # beams found cells at every pose: the comparison is not between two zeros
 

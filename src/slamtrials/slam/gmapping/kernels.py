@@ -22,7 +22,7 @@ from numba import njit
 
 from slamtrials.slam.gmapping.window import NOTHING_D2, window_min_3x3
 
-__all__ = ["TILE_SHIFT", "TILE", "score_pose", "score_3x3", "score_scratch", "match_particles", "register_endpoints"]
+__all__ = ["TILE_SHIFT", "TILE", "score_pose", "score_3x3", "likelihood_3x3", "score_scratch", "match_particles", "register_endpoints"]
 
 # 32-cell tiles: a 3 x 3 window crosses a tile border for 12 % of beams (23 % with 16-cell tiles),
 # which takes the slower scalar path; the price is about twice the particle-map memory (bench/RESULTS.md)
@@ -211,26 +211,12 @@ def score_scratch(beams):
     return np.empty((3, beams)), np.empty((4, beams), dtype=np.int64)
 
 
-@njit(cache=True, nogil=True, fastmath={"nnan", "ninf", "nsz"})
-def score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats,
-              ints):  # pragma: no cover - compiled
-    """The score of :func:`score_pose` for its default window (``kernel`` 1, no free-cell test), bit for
-    bit, in stages that keep each loop short: the hill climbing's hot spot.
-
-    1. Per beam: endpoint, offset in its cell and, when the 3 x 3 window lies in one tile, the window's
-       first index in ``mean`` (else the beam goes on a list).
-    2. Per beam: the window minimum in vector code (:func:`~slamtrials.slam.gmapping.window.window_min_3x3`;
-       listed beams read the empty tile here); then the listed beams again, one directory lookup per
-       cell.
-    3. The exp series of every beam (a loop the compiler vectorizes), then the sum in beam order, with
-       libm's exp where the series does not apply.
-
-    ``floats`` and ``ints`` come from :func:`score_scratch` (at least ``len(lx)`` columns); the
-    arithmetic per beam is the same as in :func:`score_pose`, and the fast-math flags allowed here (no
-    NaN, no infinity, no signed zero; all values are finite) do not change any result.
-    """
+@njit(cache=True, nogil=True, inline="always")
+def _window_minima_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, floats,
+                       ints):  # pragma: no cover - compiled
+    """Stages 1 and 2 of :func:`score_3x3`: each beam's smallest squared distance to a mean in its 3 x 3
+    window goes to ``floats[2]`` (:data:`NOTHING_D2` if none); ``floats[0]`` is left free for reuse."""
     inv_res = 1.0 / res
-    inv_sigma = 1.0 / sigma
     c = math.cos(theta)
     s = math.sin(theta)
     n = lx.shape[0]
@@ -273,7 +259,31 @@ def score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, s
         b = crossing[i]
         best[b] = _window_min_across_tiles(directory, mean, rows, cols, crossing_row[i], crossing_col[i],
                                            offset_x[b], offset_y[b], res)
-    terms = offset_x  # the offsets are no longer needed
+
+
+@njit(cache=True, nogil=True, fastmath={"nnan", "ninf", "nsz"})
+def score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats,
+              ints):  # pragma: no cover - compiled
+    """The score of :func:`score_pose` for its default window (``kernel`` 1, no free-cell test), bit for
+    bit, in stages that keep each loop short: the hill climbing's hot spot.
+
+    1. Per beam: endpoint, offset in its cell and, when the 3 x 3 window lies in one tile, the window's
+       first index in ``mean`` (else the beam goes on a list).
+    2. Per beam: the window minimum in vector code (:func:`~slamtrials.slam.gmapping.window.window_min_3x3`;
+       listed beams read the empty tile here); then the listed beams again, one directory lookup per
+       cell.
+    3. The exp series of every beam (a loop the compiler vectorizes), then the sum in beam order, with
+       libm's exp where the series does not apply.
+
+    ``floats`` and ``ints`` come from :func:`score_scratch` (at least ``len(lx)`` columns); the
+    arithmetic per beam is the same as in :func:`score_pose`, and the fast-math flags allowed here (no
+    NaN, no infinity, no signed zero; all values are finite) do not change any result.
+    """
+    _window_minima_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, floats, ints)
+    inv_sigma = 1.0 / sigma
+    n = lx.shape[0]
+    best = floats[2]
+    terms = floats[0]  # the offsets are no longer needed
     for b in range(n):
         terms[b] = _exp_series_minus(best[b] * inv_sigma)
     score = 0.0
@@ -283,6 +293,23 @@ def score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, s
             a = d2 * inv_sigma
             score += terms[b] if a <= _EXP_SERIES_MAX else math.exp(-a)
     return score
+
+
+@njit(cache=True, nogil=True, fastmath={"nnan", "ninf", "nsz"})
+def likelihood_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, lsigma, floats,
+                   ints):  # pragma: no cover - compiled
+    """The log-likelihood of :func:`score_pose` for its default window (``kernel`` 1, no free-cell
+    test), bit for bit: the window minima of :func:`score_3x3`, then the sum in beam order."""
+    _window_minima_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, floats, ints)
+    best = floats[2]
+    no_hit = -0.5 / lsigma
+    likelihood = 0.0
+    for b in range(lx.shape[0]):
+        if best[b] < _FOUND_D2:
+            likelihood -= best[b] / lsigma
+        else:
+            likelihood += no_hit
+    return likelihood
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -392,8 +419,13 @@ def match_particles(directories, mean, tile_col0, tile_row0, res, poses, lx, ly,
             matched[p, 0] = x
             matched[p, 1] = y
             matched[p, 2] = math.atan2(math.sin(t), math.cos(t))
-        _, likelihoods[p] = score_pose(directory, mean, tile_col0, tile_row0, res, matched[p, 0], matched[p, 1],
-                                       matched[p, 2], lx, ly, lfx, lfy, kernel, sigma, lsigma, free_test, True)
+        if kernel == 1 and not free_test:
+            likelihoods[p] = likelihood_3x3(directory, mean, tile_col0, tile_row0, res, matched[p, 0], matched[p, 1],
+                                            matched[p, 2], lx, ly, lsigma, floats, ints)
+        else:
+            _, likelihoods[p] = score_pose(directory, mean, tile_col0, tile_row0, res, matched[p, 0],
+                                           matched[p, 1], matched[p, 2], lx, ly, lfx, lfy, kernel, sigma, lsigma,
+                                           free_test, True)
     return matched, scores, likelihoods
 
 

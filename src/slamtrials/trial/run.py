@@ -5,7 +5,8 @@ its pose estimate; the termination rule looks at the SLAM map; the explorer turn
 and the map into a velocity command; the simulator steps. The trial ends when
 
 * ``map_converged``: two consecutive map snapshots differ by less than the MSE threshold (the paper's
-  rule), or ``max_snapshots`` were taken;
+  rule);
+* ``max_snapshots``: ``termination.max_snapshots`` snapshots were taken (the paper's limit, about 19);
 * ``no_frontiers``: the explorer has no reachable frontier left;
 * ``time_cap``: the hard cap on simulated time was reached.
 

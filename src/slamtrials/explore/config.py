@@ -57,11 +57,12 @@ class ExploreConfig(BaseModel):
     ``view_distance`` of frontiers the robot cannot reach (off by default: in our trials they cost a
     lot of time for little map).
 
-    Backing out: a robot standing still whose path leads back the way it came (the path point 1.5 m
-    ahead at least ``reverse_angle`` off its heading, e.g. after reaching a goal at a dead end) drives
-    backwards along it, at ``reverse_speed`` at most, until that point comes within 90 degrees of its
-    heading or it has backed ``max_reverse_distance``. Every turn counts towards GMapping's
-    ``angularUpdate``, so turning round at each dead end costs the SLAM about 13 updates.
+    Backing out: when the path leads back the way the robot came (the end of its first straight
+    stretch, at most ``max_reverse_distance`` along it, lies at least ``reverse_angle`` off the
+    heading; e.g. after reaching a goal at a dead end), the robot stops and backs along that stretch at
+    ``reverse_speed`` at most, then turns where the path turns
+    (:mod:`slamtrials.explore.follower`). Every turn counts towards GMapping's ``angularUpdate``, so
+    turning round at each dead end would cost the SLAM about 13 updates.
 
     Recovery: the robot is stuck when, over ``stuck_time``, it moved less than ``stuck_ratio`` of what
     it was commanded to move (the simulator stops the robot on a collision), when it has followed a
@@ -99,7 +100,7 @@ class ExploreConfig(BaseModel):
     rotate_in_place_angle: float = Field(math.radians(50.0), gt=0.0, le=math.pi, description="heading error above which the robot turns in place (rad)")
     max_reverse_distance: float = Field(2.5, ge=0.0, le=100.0, description="back out along the path for at most this far instead of turning round (m); 0 = never")
     reverse_speed: float = Field(0.35, gt=0.0, le=10.0, description="largest backing speed when backing out along the path (m/s)")
-    reverse_angle: float = Field(math.radians(120.0), ge=math.radians(90.0), le=math.pi, description="a robot standing still backs out when the path 1.5 m ahead lies at least this far from its heading (rad)")
+    reverse_angle: float = Field(math.radians(120.0), ge=math.radians(90.0), le=math.pi, description="back out when the end of the path's first straight stretch lies at least this far from the heading (rad)")
     narrow_speed: float = Field(0.25, gt=0.0, le=10.0, description="speed limit where the path's clearance is down to the lethal distance (m/s)")
     narrow_clearance: float = Field(0.25, ge=0.0, le=10.0, description="clearance beyond the lethal distance from which full speed is allowed (m)")
     obstacle_margin: float = Field(0.03, ge=0.0, le=1.0, description="clearance added to the radius when checking the scan ahead (m)")

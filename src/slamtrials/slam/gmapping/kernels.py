@@ -22,7 +22,8 @@ from numba import njit
 
 from slamtrials.slam.gmapping.window import NOTHING_D2, window_min_3x3
 
-__all__ = ["TILE_SHIFT", "TILE", "score_pose", "score_3x3", "likelihood_3x3", "score_scratch", "match_particles", "register_endpoints"]
+__all__ = ["TILE_SHIFT", "TILE", "score_pose", "score_3x3", "likelihood_3x3", "score_scratch", "match_particles",
+           "register_endpoints"]
 
 # 32-cell tiles: a 3 x 3 window crosses a tile border for 12 % of beams (23 % with 16-cell tiles),
 # which takes the slower scalar path; the price is about twice the particle-map memory (bench/RESULTS.md)

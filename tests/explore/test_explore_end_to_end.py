@@ -40,6 +40,7 @@ def test_explores_a_small_building(make):
     assert result.sim_time < 900.0
     assert result.coverage >= 0.90, result.line()
     assert result.collisions <= 5, result.line()
+    assert result.stats["backing_outs"] >= 1, result.stats  # rooms are left by backing out, not turning round
 
 
 def test_runs_are_reproducible():

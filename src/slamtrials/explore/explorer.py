@@ -73,6 +73,9 @@ class ExploreStats:
         Times the blacklist was cleared because nothing else was left.
     look_arounds:
         Full turns made (the initial one included).
+    backing_outs:
+        Times the robot backed out along its path instead of turning round
+        (:mod:`slamtrials.explore.follower`).
     plan_seconds:
         Wall-clock seconds spent planning (costmaps, frontiers, Dijkstra).
     """
@@ -83,6 +86,7 @@ class ExploreStats:
     recoveries: int = 0
     blacklist_resets: int = 0
     look_arounds: int = 0
+    backing_outs: int = 0
     plan_seconds: float = 0.0
 
 
@@ -261,7 +265,9 @@ class Explorer:
         if not self._follower.has_path:
             self._blocked_since = None
             return 0.0, 0.0
+        backing = self._follower.backing
         out = self._follower.command(pose, ranges, laser)
+        self.stats.backing_outs += int(self._follower.backing and not backing)
         self._following = True
         if out.blocked:
             if self._blocked_since is None:

@@ -318,24 +318,39 @@ class PathFollower:
         level = 0 if self._tight is None else self._tight[0]
         lookaheads = (cfg.lookahead_distance, _SHORT_LOOKAHEAD)
         while level < len(lookaheads):
-            tx, ty = self._target(x, y, lookaheads[level])
-            error = math.remainder(math.atan2(ty - y, tx - x) - theta, 2.0 * math.pi)
+            error, curvature, v_scan = self._arc(x, y, theta, 0.0, self._target(x, y, lookaheads[level]), points)
             if abs(error) > cfg.rotate_in_place_angle:
                 return self._limited(0.0, turn_rate(error, cfg.max_angular_speed, cfg.max_angular_accel))
-            dist = max(math.hypot(tx - x, ty - y), 1e-6)
-            curvature = 2.0 * math.sin(error) / dist
-            free = free_travel(points, curvature, cfg.robot_radius + cfg.obstacle_margin)
-            v_scan = math.sqrt(2.0 * cfg.max_linear_accel * max(free - cfg.stop_distance, 0.0))
             if v_scan >= _BLOCKED_SPEED:
                 break
             level += 1
             self._tight = (level, x, y)
         if level >= len(lookaheads):
             return self._creep(x, y, theta, points, to_end)
-        v = min(cfg.max_linear_speed, math.sqrt(2.0 * cfg.max_linear_accel * to_end), v_scan, self._narrow_limit())
+        v = self._arc_speed(cfg.max_linear_speed, v_scan, to_end, curvature)
+        return self._limited(v, curvature * v, pure_pursuit=True, curvature=curvature)
+
+    def _arc(self, x: float, y: float, theta: float, offset: float, target: tuple[float, float],
+             points: NDArray[np.float64]) -> tuple[float, float, float]:
+        """Pure pursuit towards ``target`` with the heading ``theta + offset`` (``offset`` pi: backwards,
+        ``points`` then mirrored): heading error (rad), curvature (1/m) and the largest speed (m/s) at which
+        the robot can still stop before the scan's points on that arc."""
+        cfg = self.config
+        tx, ty = target
+        error = math.remainder(math.atan2(ty - y, tx - x) - theta - offset, 2.0 * math.pi)
+        dist = max(math.hypot(tx - x, ty - y), 1e-6)
+        curvature = 2.0 * math.sin(error) / dist
+        free = free_travel(points, curvature, cfg.robot_radius + cfg.obstacle_margin)
+        return error, curvature, math.sqrt(2.0 * cfg.max_linear_accel * max(free - cfg.stop_distance, 0.0))
+
+    def _arc_speed(self, limit: float, v_scan: float, to_end: float, curvature: float) -> float:
+        """Speed (m/s) on the arc: ``limit``, the scan's ``v_scan``, stopping at the path's end, the
+        narrow-path limit and the turn-rate limit."""
+        cfg = self.config
+        v = min(limit, math.sqrt(2.0 * cfg.max_linear_accel * to_end), v_scan, self._narrow_limit())
         if abs(curvature) > 1e-9:
             v = min(v, cfg.max_angular_speed / abs(curvature))
-        return self._limited(v, curvature * v, pure_pursuit=True, curvature=curvature)
+        return v
 
     @property
     def backing(self) -> bool:
@@ -404,19 +419,12 @@ class PathFollower:
         """Pure pursuit backwards (heading ``theta + pi``), or ``None`` when that needs a turn in place
         or the scan blocks it."""
         cfg = self.config
-        tx, ty = self._target(x, y, cfg.lookahead_distance, self._leg_end)
-        error = math.remainder(math.atan2(ty - y, tx - x) - theta - math.pi, 2.0 * math.pi)
-        if abs(error) > cfg.rotate_in_place_angle:
+        target = self._target(x, y, cfg.lookahead_distance, self._leg_end)
+        # in the backward frame: positive curvature turns the tail left
+        error, curvature, v_scan = self._arc(x, y, theta, math.pi, target, -points)
+        if abs(error) > cfg.rotate_in_place_angle or v_scan < _BLOCKED_SPEED:
             return None
-        dist = max(math.hypot(tx - x, ty - y), 1e-6)
-        curvature = 2.0 * math.sin(error) / dist  # in the backward frame: positive turns the tail left
-        free = free_travel(-points, curvature, cfg.robot_radius + cfg.obstacle_margin)
-        speed = math.sqrt(2.0 * cfg.max_linear_accel * max(free - cfg.stop_distance, 0.0))
-        if speed < _BLOCKED_SPEED:
-            return None
-        speed = min(speed, cfg.reverse_speed, math.sqrt(2.0 * cfg.max_linear_accel * to_end), self._narrow_limit())
-        if abs(curvature) > 1e-9:
-            speed = min(speed, cfg.max_angular_speed / abs(curvature))
+        speed = self._arc_speed(cfg.reverse_speed, v_scan, to_end, curvature)
         # the tail turning left at rate curvature * speed is the base turning left at that rate
         return self._limited(-speed, curvature * speed, pure_pursuit=True, curvature=-curvature)
 

@@ -41,60 +41,83 @@ from numpy.typing import ArrayLike, NDArray
 from slamtrials.geometry import compose1
 from slamtrials.slam.base import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 
-__all__ = ["GridMap", "beam_endpoints", "beam_angles", "classify", "DEFAULT_CHUNK"]
+__all__ = ["GridMap", "scan_endpoints", "beam_endpoints", "beam_angles", "classify", "DEFAULT_CHUNK"]
 
 #: Cells added on a side when a map grows (plus what the scan needs).
 DEFAULT_CHUNK = 64
 
 
 @njit(cache=True, nogil=True)
-def _integrate_scan(hits, visits, col0, row0, ou, ov, eu, ev, hit, weight):  # pragma: no cover - compiled
-    """Add one scan's visits and hits, each counted ``weight`` times (-1 takes a scan back out).
+def _integrate_scans(hits, visits, col0, row0, ou, ov, eu, ev, usable, hit, weights):  # pragma: no cover - compiled
+    """Add the visits and hits of ``M`` scans, scan ``m`` counted ``weights[m]`` times (-1 takes a scan back out).
 
-    ``(ou, ov)`` is the laser in continuous GLOBAL cell coordinates (cells: u right, v up, from the map
-    frame's origin); ``eu, ev`` float64 ``[B]`` the beam endpoints (already cut); ``hit`` bool ``[B]``
-    whether the endpoint's cell is an obstacle. The traversal is done in global cells and only the
-    indexing subtracts the window's corner (``col0``, ``row0``), so a scan is traced the same way however
-    the window grew in between (which is what makes taking it back out exact). Cells outside the window
-    are skipped.
+    ``(ou[m], ov[m])`` is scan ``m``'s laser in continuous GLOBAL cell coordinates (cells: u right, v up,
+    from the map frame's origin); ``eu, ev`` float64 ``[M, B]`` the beam endpoints (already cut) in the same
+    coordinates; ``usable`` bool ``[M, B]`` the beams that carry information (the others are skipped);
+    ``hit`` bool ``[M, B]`` whether the endpoint's cell is an obstacle. The traversal is done in global
+    cells and only the indexing subtracts the window's corner (``col0``, ``row0``), so a scan is traced
+    the same way however the window grew in between (which is what makes taking it back out exact).
+    Cells outside the window are skipped.
     """
     height, width = visits.shape
-    x0 = int(math.floor(ou))
-    y0 = int(math.floor(ov))
-    for b in range(eu.shape[0]):
-        dx = eu[b] - ou
-        dy = ev[b] - ov
-        jx = int(math.floor(eu[b]))
-        jy = int(math.floor(ev[b]))
-        ix = x0
-        iy = y0
-        step_x = 1 if dx > 0.0 else -1
-        step_y = 1 if dy > 0.0 else -1
-        if dx != 0.0:
-            delta_x = abs(1.0 / dx)
-            t_x = ((ix + 1.0 - ou) if dx > 0.0 else (ou - ix)) * delta_x
-        else:
-            delta_x = math.inf
-            t_x = math.inf
-        if dy != 0.0:
-            delta_y = abs(1.0 / dy)
-            t_y = ((iy + 1.0 - ov) if dy > 0.0 else (ov - iy)) * delta_y
-        else:
-            delta_y = math.inf
-            t_y = math.inf
-        steps = abs(jx - ix) + abs(jy - iy)
-        for _ in range(steps):
-            if 0 <= iy - row0 < height and 0 <= ix - col0 < width:
-                visits[iy - row0, ix - col0] += weight
-            if ix == jx or (iy != jy and t_y <= t_x):
-                iy += step_y
-                t_y += delta_y
+    for m in range(eu.shape[0]):
+        weight = weights[m]
+        x0 = int(math.floor(ou[m]))
+        y0 = int(math.floor(ov[m]))
+        for b in range(eu.shape[1]):
+            if not usable[m, b]:
+                continue
+            dx = eu[m, b] - ou[m]
+            dy = ev[m, b] - ov[m]
+            jx = int(math.floor(eu[m, b]))
+            jy = int(math.floor(ev[m, b]))
+            ix = x0
+            iy = y0
+            step_x = 1 if dx > 0.0 else -1
+            step_y = 1 if dy > 0.0 else -1
+            if dx != 0.0:
+                delta_x = abs(1.0 / dx)
+                t_x = ((ix + 1.0 - ou[m]) if dx > 0.0 else (ou[m] - ix)) * delta_x
             else:
-                ix += step_x
-                t_x += delta_x
-        if hit[b] and 0 <= jy - row0 < height and 0 <= jx - col0 < width:
-            visits[jy - row0, jx - col0] += weight
-            hits[jy - row0, jx - col0] += weight
+                delta_x = math.inf
+                t_x = math.inf
+            if dy != 0.0:
+                delta_y = abs(1.0 / dy)
+                t_y = ((iy + 1.0 - ov[m]) if dy > 0.0 else (ov[m] - iy)) * delta_y
+            else:
+                delta_y = math.inf
+                t_y = math.inf
+            steps = abs(jx - ix) + abs(jy - iy)
+            for _ in range(steps):
+                if 0 <= iy - row0 < height and 0 <= ix - col0 < width:
+                    visits[iy - row0, ix - col0] += weight
+                if ix == jx or (iy != jy and t_y <= t_x):
+                    iy += step_y
+                    t_y += delta_y
+                else:
+                    ix += step_x
+                    t_x += delta_x
+            if hit[m, b] and 0 <= jy - row0 < height and 0 <= jx - col0 < width:
+                visits[jy - row0, jx - col0] += weight
+                hits[jy - row0, jx - col0] += weight
+
+
+@njit(cache=True, nogil=True)
+def _classify(hits, visits, occ_thresh, flip):  # pragma: no cover - compiled
+    """int8 cells of :func:`classify`; with ``flip`` in the ROS orientation (row 0 at the top)."""
+    height, width = visits.shape
+    grid = np.empty((height, width), dtype=np.int8)
+    for r in range(height):
+        out = height - 1 - r if flip else r
+        for c in range(width):
+            v = visits[r, c]
+            if v <= 0:
+                grid[out, c] = UNKNOWN
+            elif hits[r, c] > occ_thresh * v:
+                grid[out, c] = OCCUPIED
+            else:
+                grid[out, c] = FREE
+    return grid
 
 
 def beam_angles(laser: dict[str, Any], beams: int) -> NDArray[np.float64]:
@@ -102,16 +125,17 @@ def beam_angles(laser: dict[str, Any], beams: int) -> NDArray[np.float64]:
     return float(laser["angle_min"]) + float(laser["angle_increment"]) * np.arange(beams, dtype=np.float64)
 
 
-def beam_endpoints(laser_pose: ArrayLike, ranges: ArrayLike, angles: ArrayLike, *, range_min: float,
-                   range_max: float, max_urange: float) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-    """Where each beam's traced segment ends, and whether that end is an obstacle (module docstring).
+def scan_endpoints(laser_poses: ArrayLike, ranges: ArrayLike, angles: ArrayLike, *, range_min: float,
+                   range_max: float, max_urange: float) -> tuple[NDArray[np.float64], NDArray[np.float64],
+                                                                 NDArray[np.bool_], NDArray[np.bool_]]:
+    """Where the traced segment of every beam of ``M`` scans ends, and what it marks (module docstring).
 
     Parameters
     ----------
-    laser_pose:
-        ``[3]`` pose of the laser in the map frame (m, rad).
+    laser_poses:
+        ``[M, 3]`` poses of the laser in the map frame (m, rad).
     ranges:
-        ``[B]`` ranges (m).
+        ``[M, B]`` ranges (m).
     angles:
         ``[B]`` beam angles in the laser frame (rad).
     range_min, range_max, max_urange:
@@ -119,30 +143,40 @@ def beam_endpoints(laser_pose: ArrayLike, ranges: ArrayLike, angles: ArrayLike, 
 
     Returns
     -------
-    endpoints:
-        float64 ``[K, 2]`` map-frame end points (m) of the ``K`` beams that carry information.
+    x, y:
+        float64 ``[M, B]`` map-frame end points (m); meaningful where ``usable``.
+    usable:
+        bool ``[M, B]``: the beam carries information.
     hit:
-        bool ``[K]``: the end point is a return (marks a hit), not a cut.
+        bool ``[M, B]``: the end point is a return (marks a hit), not a cut; False where not usable.
     """
     r = np.asarray(ranges, dtype=np.float64)
     a = np.asarray(angles, dtype=np.float64)
+    pose = np.asarray(laser_poses, dtype=np.float64)
     no_return = (r >= range_max) | np.isposinf(r)
     usable = (~np.isnan(r) & (r > range_min)) | no_return
-    length = np.minimum(np.where(no_return, range_max, r), max_urange)[usable]
-    hit = (~no_return & (r <= max_urange))[usable]
-    x, y, theta = (float(v) for v in laser_pose)  # type: ignore[union-attr]
-    heading = theta + a[usable]
-    endpoints = np.column_stack([x + length * np.cos(heading), y + length * np.sin(heading)])
-    return endpoints, hit
+    length = np.where(usable, np.minimum(np.where(no_return, range_max, r), max_urange), 0.0)
+    hit = usable & ~no_return & (r <= max_urange)
+    heading = pose[:, 2:3] + a
+    return pose[:, 0:1] + length * np.cos(heading), pose[:, 1:2] + length * np.sin(heading), usable, hit
+
+
+def beam_endpoints(laser_pose: ArrayLike, ranges: ArrayLike, angles: ArrayLike, *, range_min: float,
+                   range_max: float, max_urange: float) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+    """:func:`scan_endpoints` of one scan, only the beams that carry information.
+
+    Returns float64 ``[K, 2]`` map-frame end points (m) of the ``K`` usable beams and bool ``[K]`` whether
+    each is a return (marks a hit), not a cut.
+    """
+    x, y, usable, hit = scan_endpoints(np.asarray(laser_pose, dtype=np.float64).reshape(1, 3),
+                                       np.asarray(ranges, dtype=np.float64).reshape(1, -1), angles,
+                                       range_min=range_min, range_max=range_max, max_urange=max_urange)
+    return np.column_stack([x[usable], y[usable]]), hit[usable]
 
 
 def classify(hits: NDArray[np.int32], visits: NDArray[np.int32], occ_thresh: float) -> NDArray[np.int8]:
     """Trinary cells from counts: 100 where ``hits / visits > occ_thresh``, 0 where visited, else -1."""
-    grid = np.full(visits.shape, UNKNOWN, dtype=np.int8)
-    visited = visits > 0
-    grid[visited] = FREE
-    grid[visited & (hits > occ_thresh * visits)] = OCCUPIED
-    return grid
+    return _classify(hits, visits, float(occ_thresh), False)
 
 
 class GridMap:
@@ -186,22 +220,30 @@ class GridMap:
     def ensure(self, xy: ArrayLike) -> None:
         """Grow the window (keeping every cell's world position) so it holds every point ``[N, 2]`` (m)."""
         cols, rows = self.cell_of(np.asarray(xy, dtype=np.float64).reshape(-1, 2))
-        if cols.size == 0:
-            return
+        if cols.size:
+            self._grow_for([(int(cols.min()), int(cols.max()), int(rows.min()), int(rows.max()))])
+
+    def _grow_for(self, boxes: list[tuple[int, int, int, int]]) -> None:
+        """Grow the window as :meth:`ensure` would for each box ``(col min, col max, row min, row max)``
+        (global cells) in turn, copying the counts once."""
+        col0, row0 = self.col0, self.row0
         height, width = self.visits.shape
-        lo_c, hi_c, lo_r, hi_r = int(cols.min()), int(cols.max()), int(rows.min()), int(rows.max())
-        if height and width and lo_c >= self.col0 and hi_c < self.col0 + width and lo_r >= self.row0 and hi_r < self.row0 + height:
+        for lo_c, hi_c, lo_r, hi_r in boxes:
+            if height and width and lo_c >= col0 and hi_c < col0 + width and lo_r >= row0 and hi_r < row0 + height:
+                continue
+            if height and width:
+                lo_c, hi_c = min(lo_c, col0), max(hi_c, col0 + width - 1)
+                lo_r, hi_r = min(lo_r, row0), max(hi_r, row0 + height - 1)
+            col0, row0 = lo_c - self.chunk, lo_r - self.chunk
+            height, width = hi_r + self.chunk + 1 - row0, hi_c + self.chunk + 1 - col0
+        if (col0, row0, height, width) == (self.col0, self.row0, *self.visits.shape):
             return
-        if height and width:
-            lo_c, hi_c = min(lo_c, self.col0), max(hi_c, self.col0 + width - 1)
-            lo_r, hi_r = min(lo_r, self.row0), max(hi_r, self.row0 + height - 1)
-        new_c0, new_r0 = lo_c - self.chunk, lo_r - self.chunk
-        shape = (hi_r + self.chunk + 1 - new_r0, hi_c + self.chunk + 1 - new_c0)
-        hits, visits = np.zeros(shape, np.int32), np.zeros(shape, np.int32)
-        r, c = self.row0 - new_r0, self.col0 - new_c0
-        hits[r:r + height, c:c + width] = self.hits
-        visits[r:r + height, c:c + width] = self.visits
-        self.hits, self.visits, self.col0, self.row0 = hits, visits, new_c0, new_r0
+        hits, visits = np.zeros((height, width), np.int32), np.zeros((height, width), np.int32)
+        r, c = self.row0 - row0, self.col0 - col0
+        old_height, old_width = self.visits.shape
+        hits[r:r + old_height, c:c + old_width] = self.hits
+        visits[r:r + old_height, c:c + old_width] = self.visits
+        self.hits, self.visits, self.col0, self.row0 = hits, visits, col0, row0
 
     def integrate(self, laser_pose: ArrayLike, ranges: ArrayLike, angles: ArrayLike, *, range_min: float,
                   range_max: float, max_urange: float, weight: int = 1) -> None:
@@ -209,15 +251,32 @@ class GridMap:
 
         ``weight`` -1 removes a scan integrated before from the same pose (counts are exact integers).
         """
-        endpoints, hit = beam_endpoints(laser_pose, ranges, angles, range_min=range_min, range_max=range_max,
-                                        max_urange=max_urange)
-        origin = np.asarray(laser_pose, dtype=np.float64)[:2]
-        self.ensure(np.vstack([origin[None, :], endpoints]))
+        self.integrate_many(np.asarray(laser_pose, dtype=np.float64).reshape(1, 3),
+                            np.asarray(ranges, dtype=np.float64).reshape(1, -1), angles, np.array([int(weight)]),
+                            range_min=range_min, range_max=range_max, max_urange=max_urange)
+
+    def integrate_many(self, laser_poses: ArrayLike, ranges: ArrayLike, angles: ArrayLike, weights: ArrayLike, *,
+                       range_min: float, range_max: float, max_urange: float) -> None:
+        """Trace ``M`` scans, scan ``m`` from ``laser_poses[m]`` (map frame, ``[M, 3]``) with ranges
+        ``ranges[m]`` (``[M, B]``, m) counted ``weights[m]`` times (int ``[M]``; -1 removes it): the same
+        counts and window as :meth:`integrate` called for each scan in turn, in one compiled call."""
+        poses = np.asarray(laser_poses, dtype=np.float64).reshape(-1, 3)
+        if poses.shape[0] == 0:
+            return
+        x, y, usable, hit = scan_endpoints(poses, ranges, angles, range_min=range_min, range_max=range_max,
+                                           max_urange=max_urange)
         scale = 1.0 / self.resolution
-        eu = np.ascontiguousarray(endpoints[:, 0] * scale)
-        ev = np.ascontiguousarray(endpoints[:, 1] * scale)
-        _integrate_scan(self.hits, self.visits, self.col0, self.row0, float(origin[0] * scale), float(origin[1] * scale),
-                        eu, ev, np.ascontiguousarray(hit), int(weight))
+        eu, ev = x * scale, y * scale
+        ou, ov = poses[:, 0] * scale, poses[:, 1] * scale
+        # each scan's box of cells (its laser and its usable end points), as ensure() computes it
+        origin_c, origin_r = np.floor(ou)[:, None], np.floor(ov)[:, None]
+        cols = np.where(usable, np.floor(eu), origin_c)
+        rows = np.where(usable, np.floor(ev), origin_r)
+        boxes = np.column_stack([np.minimum(cols.min(axis=1), origin_c[:, 0]), np.maximum(cols.max(axis=1), origin_c[:, 0]),
+                                 np.minimum(rows.min(axis=1), origin_r[:, 0]), np.maximum(rows.max(axis=1), origin_r[:, 0])])
+        self._grow_for([tuple(int(v) for v in box) for box in boxes])
+        _integrate_scans(self.hits, self.visits, self.col0, self.row0, ou, ov, eu, ev, usable, hit,
+                         np.asarray(weights, dtype=np.int64).reshape(-1))
 
     def integrate_frame(self, base_pose: ArrayLike, ranges: ArrayLike, laser: dict[str, Any], *,
                         max_urange: float | None = None) -> None:
@@ -233,5 +292,5 @@ class GridMap:
 
     def occupancy(self, occ_thresh: float = 0.25) -> OccupancyGrid:
         """The trinary map (:func:`classify`), flipped to row 0 at the top, with the window's origin."""
-        grid = classify(self.hits, self.visits, occ_thresh)[::-1]
-        return OccupancyGrid(grid=np.ascontiguousarray(grid), resolution=self.resolution, origin=self.origin)
+        grid = _classify(self.hits, self.visits, float(occ_thresh), True)
+        return OccupancyGrid(grid=grid, resolution=self.resolution, origin=self.origin)

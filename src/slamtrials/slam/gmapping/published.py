@@ -44,10 +44,19 @@ class PublishedMap:
         self._scans: list[NDArray[np.float32]] = []
         self._occupancy: OccupancyGrid | None = None
 
-    def _trace(self, pose: NDArray[np.float64], ranges: NDArray[np.float32], weight: int) -> None:
-        self.grid.integrate(pose, ranges, beam_angles(self.laser, ranges.shape[0]),
-                            range_min=float(self.laser.get("range_min", 0.0)), range_max=float(self.laser["range_max"]),
-                            max_urange=self.max_urange, weight=weight)
+    def _trace(self, poses: list[NDArray[np.float64]], scans: list[NDArray[np.float32]], weights: list[int]) -> None:
+        """Trace scans ``scans[k]`` from laser poses ``poses[k]`` with weights ``weights[k]``, in runs of
+        equal beam count (one compiled call per run)."""
+        start = 0
+        while start < len(scans):
+            end = start + 1
+            while end < len(scans) and scans[end].shape == scans[start].shape:
+                end += 1
+            self.grid.integrate_many(np.array(poses[start:end]), np.stack(scans[start:end]),
+                                     beam_angles(self.laser, scans[start].shape[0]), np.array(weights[start:end]),
+                                     range_min=float(self.laser.get("range_min", 0.0)),
+                                     range_max=float(self.laser["range_max"]), max_urange=self.max_urange)
+            start = end
 
     def rebuild(self, path: NDArray[np.float64], scans: list[NDArray[np.float32]]) -> int:
         """Make the grid that of laser poses ``path`` ``[U, 3]`` with ``scans[u]`` taken at ``path[u]``.
@@ -59,17 +68,15 @@ class PublishedMap:
         common = min(len(old), len(path))
         differs = np.flatnonzero(np.any(old[:common] != path[:common], axis=1))
         keep = int(differs[0]) if differs.size else common
-        work = 0
-        for u in range(len(old) - 1, keep - 1, -1):
-            self._trace(old[u], self._scans[u], -1)
-            work += 1
-        for u in range(keep, len(path)):
-            self._trace(path[u], scans[u], 1)
-            work += 1
+        removed = range(len(old) - 1, keep - 1, -1)
+        added = range(keep, len(path))
+        self._trace([old[u] for u in removed] + [path[u] for u in added],
+                    [self._scans[u] for u in removed] + [scans[u] for u in added],
+                    [-1] * len(removed) + [1] * len(added))
         self._path = np.array(path, dtype=np.float64)
         self._scans = scans
         self._occupancy = self.grid.occupancy(self.occ_thresh)
-        return work
+        return len(removed) + len(added)
 
     def occupancy(self) -> OccupancyGrid:
         """The grid as of the last :meth:`rebuild` (an empty 0 x 0 grid before the first)."""

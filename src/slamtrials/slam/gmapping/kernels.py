@@ -207,16 +207,17 @@ def score_pose(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, 
 
 @njit(cache=True, nogil=True)
 def score_scratch(beams):
-    """Work arrays of :func:`score_3x3` for scans of ``beams`` used beams: float64 ``[3, beams]`` and
-    int64 ``[4, beams]``."""
-    return np.empty((3, beams)), np.empty((4, beams), dtype=np.int64)
+    """Work arrays of :func:`score_3x3` for scans of ``beams`` used beams: float64 ``[5, beams]`` (rows 0
+    and 1 for the stages, rows 2 to 4 for window minima) and int64 ``[4, beams]``."""
+    return np.empty((5, beams)), np.empty((4, beams), dtype=np.int64)
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _window_minima_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, floats,
-                       ints):  # pragma: no cover - compiled
+def _window_minima_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, floats, ints,
+                       row):  # pragma: no cover - compiled
     """Stages 1 and 2 of :func:`score_3x3`: each beam's smallest squared distance to a mean in its 3 x 3
-    window goes to ``floats[2]`` (:data:`NOTHING_D2` if none); ``floats[0]`` is left free for reuse."""
+    window goes to ``floats[row]`` (:data:`NOTHING_D2` if none; ``row`` >= 2); ``floats[0]`` is left
+    free for reuse."""
     inv_res = 1.0 / res
     c = math.cos(theta)
     s = math.sin(theta)
@@ -228,7 +229,7 @@ def _window_minima_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, 
     tile_stride = 2 * TILE * TILE
     offset_x = floats[0]
     offset_y = floats[1]
-    best = floats[2]
+    best = floats[row]
     first = ints[0]
     crossing = ints[1]  # the beams whose window crosses a tile border, and their cells
     crossing_col = ints[2]
@@ -263,8 +264,8 @@ def _window_minima_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, 
 
 
 @njit(cache=True, nogil=True, fastmath={"nnan", "ninf", "nsz"})
-def score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats,
-              ints):  # pragma: no cover - compiled
+def score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats, ints,
+              row=2):  # pragma: no cover - compiled
     """The score of :func:`score_pose` for its default window (``kernel`` 1, no free-cell test), bit for
     bit, in stages that keep each loop short: the hill climbing's hot spot.
 
@@ -276,14 +277,15 @@ def score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, s
     3. The exp series of every beam (a loop the compiler vectorizes), then the sum in beam order, with
        libm's exp where the series does not apply.
 
-    ``floats`` and ``ints`` come from :func:`score_scratch` (at least ``len(lx)`` columns); the
-    arithmetic per beam is the same as in :func:`score_pose`, and the fast-math flags allowed here (no
-    NaN, no infinity, no signed zero; all values are finite) do not change any result.
+    ``floats`` and ``ints`` come from :func:`score_scratch` (at least ``len(lx)`` columns); the window
+    minima are left in ``floats[row]`` (``row`` 2, 3 or 4) for :func:`_likelihood_of`. The arithmetic per
+    beam is the same as in :func:`score_pose`, and the fast-math flags allowed here (no NaN, no
+    infinity, no signed zero; all values are finite) do not change any result.
     """
-    _window_minima_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, floats, ints)
+    _window_minima_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, floats, ints, row)
     inv_sigma = 1.0 / sigma
     n = lx.shape[0]
-    best = floats[2]
+    best = floats[row]
     terms = floats[0]  # the offsets are no longer needed
     for b in range(n):
         terms[b] = _exp_series_minus(best[b] * inv_sigma)
@@ -301,11 +303,16 @@ def likelihood_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, 
                    ints):  # pragma: no cover - compiled
     """The log-likelihood of :func:`score_pose` for its default window (``kernel`` 1, no free-cell
     test), bit for bit: the window minima of :func:`score_3x3`, then the sum in beam order."""
-    _window_minima_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, floats, ints)
-    best = floats[2]
+    _window_minima_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, floats, ints, 2)
+    return _likelihood_of(floats[2], lsigma)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _likelihood_of(best, lsigma):  # pragma: no cover - compiled
+    """The log-likelihood from the beams' window minima ``best`` ``[B]``, summed in beam order."""
     no_hit = -0.5 / lsigma
     likelihood = 0.0
-    for b in range(lx.shape[0]):
+    for b in range(best.shape[0]):
         if best[b] < _FOUND_D2:
             likelihood -= best[b] / lsigma
         else:
@@ -315,11 +322,11 @@ def likelihood_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, 
 
 @njit(cache=True, nogil=True, inline="always")
 def _match_score(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, lfx, lfy, kernel, sigma, lsigma,
-                 free_test, floats, ints):  # pragma: no cover - compiled
-    """The scan-matching score at one pose: :func:`score_3x3` for the default window, else
-    :func:`score_pose`."""
+                 free_test, floats, ints, row):  # pragma: no cover - compiled
+    """The scan-matching score at one pose: :func:`score_3x3` for the default window (window minima left
+    in ``floats[row]``), else :func:`score_pose`."""
     if kernel == 1 and not free_test:
-        return score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats, ints)
+        return score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats, ints, row)
     score, _ = score_pose(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, lfx, lfy, kernel, sigma,
                           lsigma, free_test, False)
     return score
@@ -342,8 +349,10 @@ def _seen_before(seen, count, x, y, theta):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True)
 def _hill_climb(directory, mean, tile_col0, tile_row0, res, pose, lx, ly, lfx, lfy, kernel, sigma, lsigma, free_test,
                 lstep, astep, iterations, floats, ints, seen):  # pragma: no cover - compiled
-    """GMapping's hill climbing from ``pose`` (spec/gmapping.md, section 3); returns (x, y, theta, score).
-    ``floats``, ``ints``: work arrays from :func:`score_scratch`; ``seen``: float64 ``[S, 3]`` work array.
+    """GMapping's hill climbing from ``pose`` (spec/gmapping.md, section 3); returns (x, y, theta, score,
+    row): with the default window, ``floats[row]`` holds the window minima at the returned pose (for its
+    likelihood). ``floats``, ``ints``: work arrays from :func:`score_scratch`; ``seen``: float64
+    ``[S, 3]`` work array.
 
     Two savings over the original, neither of which changes the result:
 
@@ -358,8 +367,10 @@ def _hill_climb(directory, mean, tile_col0, tile_row0, res, pose, lx, ly, lfx, l
     cx, cy, ct = pose[0], pose[1], pose[2]
     seen[0, 0], seen[0, 1], seen[0, 2] = cx, cy, ct
     n_seen = 1
+    # rows of floats: the current pose's window minima, the best candidate's so far, the next candidate's
+    at, kept, scratch = 2, 3, 4
     current = _match_score(directory, mean, tile_col0, tile_row0, res, cx, cy, ct, lx, ly, lfx, lfy, kernel, sigma,
-                           lsigma, free_test, floats, ints)
+                           lsigma, free_test, floats, ints, at)
     ld = lstep
     ad = astep
     refinement = 0
@@ -396,16 +407,19 @@ def _hill_climb(directory, mean, tile_col0, tile_row0, res, pose, lx, ly, lfx, l
                 seen[n_seen, 0], seen[n_seen, 1], seen[n_seen, 2] = px, py, pt
                 n_seen += 1
             local = _match_score(directory, mean, tile_col0, tile_row0, res, px, py, pt, lx, ly, lfx, lfy, kernel,
-                                 sigma, lsigma, free_test, floats, ints)
+                                 sigma, lsigma, free_test, floats, ints, scratch)
             if local > current:
                 current = local
                 bx, by, bt = px, py, pt
                 accepted = move
+                kept, scratch = scratch, kept
         cx, cy, ct = bx, by, bt
         came_by = accepted
+        if accepted >= 0:
+            at, kept = kept, at
         if not (current > best or refinement < iterations):
             break
-    return cx, cy, ct, best
+    return cx, cy, ct, best, at
 
 
 @njit(cache=True, nogil=True)
@@ -439,14 +453,16 @@ def match_particles(directories, mean, tile_col0, tile_row0, res, poses, lx, ly,
     seen = np.empty((_SEEN_CAPACITY, 3))
     for p in range(n):
         directory = directories[p]
-        x, y, t, best = _hill_climb(directory, mean, tile_col0, tile_row0, res, poses[p], lx, ly, lfx, lfy, kernel,
-                                    sigma, lsigma, free_test, lstep, astep, iterations, floats, ints, seen)
+        x, y, t, best, row = _hill_climb(directory, mean, tile_col0, tile_row0, res, poses[p], lx, ly, lfx, lfy,
+                                         kernel, sigma, lsigma, free_test, lstep, astep, iterations, floats, ints, seen)
         scores[p] = best
         if best > minimum_score:
             matched[p, 0] = x
             matched[p, 1] = y
             matched[p, 2] = math.atan2(math.sin(t), math.cos(t))
-        if kernel == 1 and not free_test:
+        if kernel == 1 and not free_test and best > minimum_score and matched[p, 2] == t:
+            likelihoods[p] = _likelihood_of(floats[row], lsigma)  # the climb scored this very pose last
+        elif kernel == 1 and not free_test:
             likelihoods[p] = likelihood_3x3(directory, mean, tile_col0, tile_row0, res, matched[p, 0], matched[p, 1],
                                             matched[p, 2], lx, ly, lsigma, floats, ints)
         else:

@@ -46,7 +46,7 @@ class TileMaps:
     count, mean:
         The pool: int32 ``[K, TILE, TILE]`` endpoint counts and float32 ``[K, TILE, TILE, 2]`` mean offsets
         (m) from each cell's lower-left corner (:data:`~slamtrials.slam.gmapping.kernels.EMPTY` where the
-        count is 0).
+        count is 0). Tiles never handed out (from ``state[1]`` on) may hold anything once the pool grew.
     refs:
         int32 ``[K]``: directory entries pointing at each tile.
 
@@ -101,12 +101,21 @@ class TileMaps:
         self.directories, self.tile_col0, self.tile_row0 = grown, col0, row0
 
     def _grow_pool(self, needed: int) -> None:
+        """Make room for at least ``needed`` more tiles (the capacity at least doubles).
+
+        Only the tiles handed out so far are copied, and the new ones are left uninitialised (no page of
+        them is touched here): ``register_endpoints`` fills a tile when it hands it out.
+        """
         capacity = self.count.shape[0]
-        extra = max(capacity, needed)
-        self.count = np.concatenate([self.count, np.zeros((extra, TILE, TILE), np.int32)])
-        self.mean = np.concatenate([self.mean, np.full((extra, TILE, TILE, 2), EMPTY, np.float32)])
-        self.refs = np.concatenate([self.refs, np.zeros(extra, np.int32)])
-        self.free_stack = np.concatenate([self.free_stack, np.zeros(extra, np.int32)])
+        grown = capacity + max(capacity, needed)
+        allocated = int(self.state[1])
+        count = np.empty((grown, TILE, TILE), np.int32)
+        count[:allocated] = self.count[:allocated]
+        mean = np.empty((grown, TILE, TILE, 2), np.float32)
+        mean[:allocated] = self.mean[:allocated]
+        self.count, self.mean = count, mean
+        self.refs = np.concatenate([self.refs, np.zeros(grown - capacity, np.int32)])
+        self.free_stack = np.concatenate([self.free_stack, np.zeros(grown - capacity, np.int32)])
 
     def register(self, endpoints_x: NDArray[np.float64], endpoints_y: NDArray[np.float64]) -> None:
         """Add particle ``p``'s endpoints (row ``p`` of float64 ``[N, B]`` arrays, map frame, m) to its map."""

@@ -270,11 +270,10 @@ class GridMap:
         ou, ov = poses[:, 0] * scale, poses[:, 1] * scale
         # each scan's box of cells (its laser and its usable end points), as ensure() computes it
         origin_c, origin_r = np.floor(ou)[:, None], np.floor(ov)[:, None]
-        cols = np.where(usable, np.floor(eu), origin_c)
-        rows = np.where(usable, np.floor(ev), origin_r)
-        boxes = np.column_stack([np.minimum(cols.min(axis=1), origin_c[:, 0]), np.maximum(cols.max(axis=1), origin_c[:, 0]),
-                                 np.minimum(rows.min(axis=1), origin_r[:, 0]), np.maximum(rows.max(axis=1), origin_r[:, 0])])
-        self._grow_for([tuple(int(v) for v in box) for box in boxes])
+        cols = np.hstack([origin_c, np.where(usable, np.floor(eu), origin_c)])
+        rows = np.hstack([origin_r, np.where(usable, np.floor(ev), origin_r)])
+        boxes = np.column_stack([cols.min(axis=1), cols.max(axis=1), rows.min(axis=1), rows.max(axis=1)])
+        self._grow_for(boxes.astype(np.int64).tolist())
         _integrate_scans(self.hits, self.visits, self.col0, self.row0, ou, ov, eu, ev, usable, hit,
                          np.asarray(weights, dtype=np.int64).reshape(-1))
 

@@ -106,6 +106,7 @@ def test_samples_are_the_array_composition_bit_for_bit():
     old, new = np.array([1.0, -2.0, 3.0]), np.array([1.3, -1.7, -2.9])
     moved = sample_motion(starts, old, new, SRR, SRT, STR, STT, np.random.default_rng(8))
     increment = ominus1(old, new)
-    noisy = increment + np.random.default_rng(8).standard_normal((len(starts), 3)) * motion_sigmas(increment, SRR, SRT, STR, STT)
+    sigmas = motion_sigmas(increment, SRR, SRT, STR, STT)
+    noisy = increment + np.random.default_rng(8).standard_normal((len(starts), 3)) * sigmas
     noisy[:, 2] = wrap_angle(noisy[:, 2])
     np.testing.assert_array_equal(moved, compose(starts, noisy))

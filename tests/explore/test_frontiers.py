@@ -11,13 +11,13 @@ from scipy import ndimage
 from slamtrials.explore import find_frontiers
 from slamtrials.explore.frontiers import effective_unknown, frontier_mask
 
-F, O, U = 0, 100, -1
+F, OCC, U = 0, 100, -1
 
 
 def test_half_known_room_has_one_straight_frontier():
     grid = np.full((10, 12), U, dtype=np.int8)
     grid[:, :6] = F
-    grid[0, :6] = grid[-1, :6] = grid[:, 0] = O
+    grid[0, :6] = grid[-1, :6] = grid[:, 0] = OCC
     fr = find_frontiers(grid)
     assert fr.count == 1
     assert fr.mask[:, 5].sum() == 8 and fr.mask.sum() == 8  # rows 1..8 of the last free column
@@ -28,7 +28,7 @@ def test_half_known_room_has_one_straight_frontier():
 def test_occupied_cells_are_never_frontiers_and_walls_close_frontiers():
     grid = np.full((6, 6), U, dtype=np.int8)
     grid[1:5, 1:5] = F
-    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = O
+    grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = OCC
     assert find_frontiers(grid).count == 0
     grid[2, -1] = U  # a gap in the wall
     fr = find_frontiers(grid)
@@ -67,7 +67,7 @@ def reference_mask(grid, min_cells, min_unknown_cells):
 
 
 @settings(max_examples=80, deadline=None)
-@given(arrays(np.int8, st.tuples(st.integers(1, 25), st.integers(1, 25)), elements=st.sampled_from([U, F, F, O])),
+@given(arrays(np.int8, st.tuples(st.integers(1, 25), st.integers(1, 25)), elements=st.sampled_from([U, F, F, OCC])),
        st.integers(1, 6), st.integers(0, 15))
 def test_kernel_matches_the_reference(grid, min_cells, min_unknown_cells):
     fr = find_frontiers(grid, min_cells=min_cells, min_unknown_cells=min_unknown_cells)

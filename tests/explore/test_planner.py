@@ -59,7 +59,8 @@ MAZE = """
 def parse(text):
     rows = [line for line in text.strip().splitlines()]
     grid = np.array([[ch != "#" for ch in row] for row in rows])
-    find = lambda ch: next((r, c) for r, row in enumerate(rows) for c, x in enumerate(row) if x == ch)
+    def find(ch):
+        return next((r, c) for r, row in enumerate(rows) for c, x in enumerate(row) if x == ch)
     return grid, find("S"), find("G")
 
 

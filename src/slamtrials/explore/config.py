@@ -96,7 +96,7 @@ class ExploreConfig(BaseModel):
     max_angular_accel: float = Field(math.radians(100.0), gt=0.0, le=100.0, description="largest angular acceleration (rad/s^2)")
     control_period: float = Field(0.1, gt=0.0, le=1.0, description="time between commands (s)")
     smooth_paths: bool = Field(True, description="straighten the planner's 8-connected paths where that costs no more")
-    lookahead_distance: float = Field(0.6, gt=0.0, le=10.0, description="pure-pursuit look-ahead (m)")
+    lookahead_distance: float = Field(1.0, gt=0.0, le=10.0, description="pure-pursuit look-ahead (m)")
     rotate_in_place_angle: float = Field(math.radians(50.0), gt=0.0, le=math.pi, description="heading error above which the robot turns in place (rad)")
     max_reverse_distance: float = Field(2.5, ge=0.0, le=100.0, description="back out along the path for at most this far instead of turning round (m); 0 = never")
     reverse_speed: float = Field(0.35, gt=0.0, le=10.0, description="largest backing speed when backing out along the path (m/s)")

@@ -32,6 +32,7 @@ not import ``worlds``).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -223,7 +224,7 @@ class GridMap:
         if cols.size:
             self._grow_for([(int(cols.min()), int(cols.max()), int(rows.min()), int(rows.max()))])
 
-    def _grow_for(self, boxes: list[tuple[int, int, int, int]]) -> None:
+    def _grow_for(self, boxes: Sequence[Sequence[int]]) -> None:
         """Grow the window as :meth:`ensure` would for each box ``(col min, col max, row min, row max)``
         (global cells) in turn, copying the counts once."""
         col0, row0 = self.col0, self.row0

@@ -10,7 +10,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "src" / "slamtrials"
 
 #: Modules every layer may import: they hold no behaviour of any layer.
-UTILITIES = {"errors", "atomicfile", "__about__"}
+UTILITIES = {"errors", "atomicfile", "__about__", "stablemath"}
 
 #: Layer -> the slamtrials layers it may import (DESIGN.md, "Layers").
 ALLOWED = {
@@ -31,6 +31,14 @@ COMPOSERS = {"demo", "evaluation", "slamrun", "cli", "__init__"}
 
 #: Layers that must not do I/O, print or plot (DESIGN.md).
 COMPUTING = {"geometry", "record", "sim", "slam", "explore", "trial", "metric"}
+
+#: numpy functions whose float64 results depend on the machine: numpy's own SIMD code for these on
+#: AVX-512 CPUs differs from the C library's by a few ulp, and BLAS picks its kernels by CPU.
+MACHINE_DEPENDENT = {"sin", "cos", "tan", "arcsin", "arccos", "arctan", "arctan2", "hypot", "sinh", "cosh", "tanh",
+                     "arcsinh", "arccosh", "arctanh", "exp", "exp2", "expm1", "log", "log2", "log10", "log1p",
+                     "power", "float_power", "cbrt", "dot", "vdot", "inner", "matmul", "tensordot", "einsum", "linalg"}
+#: Layers whose numbers end up in runs, maps and files, and must be the same on every machine.
+REPRODUCIBLE = COMPUTING | {"worlds", "io", "campaign"}
 
 
 def _layer_of(path: Path) -> str:
@@ -95,3 +103,33 @@ def test_computing_layers_do_no_file_io_or_plotting(path: Path) -> None:
         if isinstance(node, (ast.Import, ast.ImportFrom)):
             module = node.module if isinstance(node, ast.ImportFrom) else node.names[0].name
             assert not (module or "").startswith(("matplotlib", "PIL")), f"{path}:{node.lineno}: imports {module}"
+
+
+@pytest.mark.parametrize("path", [p for p in SOURCES if _layer_of(p) in REPRODUCIBLE],
+                         ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_reproducible_layers_take_transcendental_functions_from_stablemath(path: Path) -> None:
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id in {"np", "numpy"}:
+            assert node.attr not in MACHINE_DEPENDENT, (
+                f"{path}:{node.lineno}: np.{node.attr} differs between machines; use slamtrials.stablemath "
+                "(or write the products out instead of BLAS)")
+        if isinstance(node, ast.BinOp):
+            assert not isinstance(node.op, ast.MatMult), f"{path}:{node.lineno}: '@' runs BLAS, whose kernels differ by CPU"
+
+
+#: fast-math flags that let LLVM change results by the CPU it compiles for (vector width, FMA, approximations).
+_RESULT_CHANGING_FASTMATH = {"fast", "reassoc", "contract", "afn", "arcp"}
+
+
+@pytest.mark.parametrize("path", SOURCES, ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_numba_kernels_use_no_result_changing_fast_math(path: Path) -> None:
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.keyword) and node.arg == "fastmath":
+            flags = ast.literal_eval(node.value)
+            assert flags is not True, f"{path}:{node.value.lineno}: fastmath=True reassociates and contracts"
+            if isinstance(flags, (set, frozenset, list, tuple)):
+                assert not set(flags) & _RESULT_CHANGING_FASTMATH, (
+                    f"{path}:{node.value.lineno}: fastmath {sorted(set(flags) & _RESULT_CHANGING_FASTMATH)} "
+                    "changes results with the CPU")

@@ -9,10 +9,16 @@ The public API is imported lazily so that ``import slamtrials`` stays fast.
 
 from __future__ import annotations
 
+import os
 from importlib import import_module
 from typing import Any
 
 from slamtrials.__about__ import __version__
+
+# Before numba is first imported: with Intel's SVML library installed, numba would let LLVM turn its
+# loops over math.sin, exp, ... into SVML calls, whose results differ from the C library's; every run
+# must compute the same bits on every machine (slamtrials.stablemath).
+os.environ.setdefault("NUMBA_DISABLE_INTEL_SVML", "1")
 
 _PUBLIC = {
     "load_world": "slamtrials.worlds",

@@ -11,6 +11,8 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from slamtrials import stablemath
+
 __all__ = ["wrap_angle", "compose", "inverse", "ominus", "transform_points", "as_poses", "wrap_angle1", "compose1", "ominus1", "interpolate"]
 
 
@@ -35,7 +37,7 @@ def compose(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
     """
     a = as_poses(a)
     b = as_poses(b)
-    c, s = np.cos(a[..., 2]), np.sin(a[..., 2])
+    c, s = stablemath.cos(a[..., 2]), stablemath.sin(a[..., 2])
     out = np.empty(np.broadcast_shapes(a.shape, b.shape))
     out[..., 0] = a[..., 0] + c * b[..., 0] - s * b[..., 1]
     out[..., 1] = a[..., 1] + s * b[..., 0] + c * b[..., 1]
@@ -46,7 +48,7 @@ def compose(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
 def inverse(a: ArrayLike) -> NDArray[np.float64]:
     """Inverse pose ``(-) a`` such that ``compose(a, inverse(a))`` is the identity."""
     a = as_poses(a)
-    c, s = np.cos(a[..., 2]), np.sin(a[..., 2])
+    c, s = stablemath.cos(a[..., 2]), stablemath.sin(a[..., 2])
     out = np.empty(a.shape)
     out[..., 0] = -c * a[..., 0] - s * a[..., 1]
     out[..., 1] = s * a[..., 0] - c * a[..., 1]
@@ -63,7 +65,7 @@ def transform_points(pose: ArrayLike, points: ArrayLike) -> NDArray[np.float64]:
     """Map points ``[..., 2]`` given in the frame of ``pose`` (shape ``[3]``) into the parent frame."""
     pose = as_poses(pose)
     pts = np.asarray(points, dtype=np.float64)
-    c, s = np.cos(pose[2]), np.sin(pose[2])
+    c, s = stablemath.cos(pose[2]), stablemath.sin(pose[2])
     out = np.empty(pts.shape)
     out[..., 0] = pose[0] + c * pts[..., 0] - s * pts[..., 1]
     out[..., 1] = pose[1] + s * pts[..., 0] + c * pts[..., 1]

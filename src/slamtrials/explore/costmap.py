@@ -26,6 +26,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
+from slamtrials import stablemath
 from slamtrials.explore.config import ExploreConfig
 from slamtrials.explore.gridframe import FREE_BELOW
 
@@ -137,7 +138,7 @@ def _cost_table(resolution: float, lethal: float, wall_cost: float, decay: float
     n = math.ceil(reach / resolution + 1.0) ** 2 + 1
     d = np.sqrt(np.arange(n, dtype=np.float64)) * resolution - 0.5 * resolution
     d = np.maximum(d, 0.0)
-    cost = 1.0 + wall_cost * np.exp(-(d - lethal) / decay)
+    cost = 1.0 + wall_cost * stablemath.exp(-(d - lethal) / decay)
     cost[d < lethal] = np.inf
     cost[-1] = 1.0
     return d.astype(np.float32), cost.astype(np.float32)

@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from slamtrials import stablemath
 from slamtrials.explore.config import ExploreConfig
 from slamtrials.explore.costmap import influence_distance
 from slamtrials.explore.follower import PathFollower
@@ -394,7 +395,7 @@ class Explorer:
     def _take(self, t: float, found: Found) -> None:
         """Make ``found`` the goal and follow its path."""
         path = found.path
-        length = float(np.hypot(*np.diff(path, axis=0).T).sum()) if len(path) > 1 else 0.0
+        length = float(stablemath.hypot(*np.diff(path, axis=0).T).sum()) if len(path) > 1 else 0.0
         goal_xy = found.goal.copy()
         if self._goal is not None and (found.kept or math.dist(goal_xy, self._goal.xy) <= self.config.blacklist_radius):
             self._goal.xy = goal_xy

@@ -52,6 +52,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
+from slamtrials import stablemath
 from slamtrials.explore.config import ExploreConfig
 
 __all__ = ["FollowCommand", "PathFollower", "free_travel", "scan_points", "turn_rate"]
@@ -90,7 +91,7 @@ def _beam_directions(beams: int, laser: dict[str, Any]) -> tuple[NDArray[np.floa
     found = _ANGLE_CACHE.get(key)
     if found is None:
         angles = key[1] + key[2] * np.arange(beams) + mth
-        found = (np.cos(angles), np.sin(angles))
+        found = (stablemath.cos(angles), stablemath.sin(angles))
         if len(_ANGLE_CACHE) > 64:
             _ANGLE_CACHE.clear()
         _ANGLE_CACHE[key] = found
@@ -241,7 +242,7 @@ class PathFollower:
         points = np.asarray(path, dtype=np.float64).reshape(-1, 2)
         self._path = points
         self._clearance = None if clearance is None else np.asarray(clearance, dtype=np.float64).reshape(-1)
-        seg = np.hypot(*np.diff(points, axis=0).T) if len(points) > 1 else np.zeros(0)
+        seg = stablemath.hypot(*np.diff(points, axis=0).T) if len(points) > 1 else np.zeros(0)
         self._remaining = np.concatenate([np.cumsum(seg[::-1])[::-1], [0.0]]) if len(points) else np.zeros(0)
         # for each point, the index of the last point within _NARROW_AHEAD and _TARGET_WINDOW along the path
         along = self._remaining[0] - self._remaining if len(points) else np.zeros(0)
@@ -279,7 +280,7 @@ class PathFollower:
             return math.inf
         x, y = float(pose[0]), float(pose[1])  # type: ignore[index]
         stop = min(self._index + _SEARCH_AHEAD, len(self._path))
-        d = np.hypot(self._path[self._index:stop, 0] - x, self._path[self._index:stop, 1] - y)
+        d = stablemath.hypot(self._path[self._index:stop, 0] - x, self._path[self._index:stop, 1] - y)
         k = int(np.argmin(d))
         return float(d[k] + self._remaining[self._index + k])
 
@@ -295,7 +296,7 @@ class PathFollower:
             return self._limited(0.0, 0.0, finished=True)
         path = self._path
         stop = min(self._index + _SEARCH_AHEAD, len(path))
-        d = np.hypot(path[self._index:stop, 0] - x, path[self._index:stop, 1] - y)
+        d = stablemath.hypot(path[self._index:stop, 0] - x, path[self._index:stop, 1] - y)
         self._index += int(np.argmin(d))
         to_end = float(self._remaining[self._index]) + float(d.min())
         end_dist = math.hypot(path[-1, 0] - x, path[-1, 1] - y)
@@ -458,7 +459,7 @@ class PathFollower:
         if last is not None:
             end = min(end, last + 1)
         path = self._path[self._index:end]
-        ahead = np.hypot(path[:, 0] - x, path[:, 1] - y)
+        ahead = stablemath.hypot(path[:, 0] - x, path[:, 1] - y)
         beyond = np.flatnonzero(ahead >= lookahead)
         tx, ty = path[int(beyond[0])] if beyond.size else path[-1]
         return float(tx), float(ty)

@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from slamtrials import stablemath
 from slamtrials.explore.config import ExploreConfig
 from slamtrials.explore.costmap import (
     OCCUPIED,
@@ -251,7 +252,7 @@ class GoalSearch:
         ``path``: ``turn_penalty`` m per radian between its heading and the direction to the path point
         ``lookahead_distance`` ahead."""
         cfg = self.config
-        ahead = np.hypot(path[:, 0] - pose[0], path[:, 1] - pose[1])
+        ahead = stablemath.hypot(path[:, 0] - pose[0], path[:, 1] - pose[1])
         index = np.flatnonzero(ahead >= cfg.lookahead_distance)
         if index.size == 0:
             return 0.0
@@ -300,7 +301,7 @@ class GoalSearch:
         frame = prepared.frame
         rows, cols = frame.to_cell(path)
         inside = (rows >= 0) & (rows < frame.height) & (cols >= 0) & (cols < frame.width)
-        far = np.hypot(path[:, 0] - pose[0], path[:, 1] - pose[1]) > self.config.escape_radius
+        far = stablemath.hypot(path[:, 0] - pose[0], path[:, 1] - pose[1]) > self.config.escape_radius
         check = inside & far
         kind = prepared.costmap.kind[rows[check], cols[check]]
         clearance = prepared.costmap.clearance[rows[check], cols[check]]

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from slamtrials import stablemath
 from slamtrials.explore.config import ExploreConfig
 from slamtrials.explore.follower import scan_points
 from slamtrials.explore.gridframe import FREE_BELOW, GridFrame, map_arrays
@@ -118,9 +119,11 @@ def segment_clear(occupancy: Any, a: ArrayLike, b: ArrayLike, radius: float) -> 
         return True
     centres = frame.to_xy(rr + r0, cc + c0)
     seg = pb - pa
-    length2 = float(seg @ seg)
-    s = np.zeros(len(centres)) if length2 == 0.0 else np.clip((centres - pa) @ seg / length2, 0.0, 1.0)
-    gap = np.hypot(*(centres - (pa + s[:, None] * seg)).T)
+    # written out rather than with `@`: BLAS picks its kernels by CPU, and their rounding differs
+    length2 = float(seg[0] * seg[0] + seg[1] * seg[1])
+    along = (centres[:, 0] - pa[0]) * seg[0] + (centres[:, 1] - pa[1]) * seg[1]
+    s = np.zeros(len(centres)) if length2 == 0.0 else np.clip(along / length2, 0.0, 1.0)
+    gap = stablemath.hypot(*(centres - (pa + s[:, None] * seg)).T)
     return bool(gap.min() >= radius + 0.5 * resolution)
 
 
@@ -156,7 +159,7 @@ class Recovery:
         points = scan_points(ranges, laser)
         push = None
         if points.shape[0] and cfg.backoff_distance > 0.0:
-            dist = np.hypot(points[:, 0], points[:, 1])
+            dist = stablemath.hypot(points[:, 0], points[:, 1])
             k = int(np.argmin(dist))
             if dist[k] < cfg.robot_radius + _CONTACT:
                 away = math.atan2(-points[k, 1], -points[k, 0])  # robot frame

@@ -28,6 +28,8 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
+from slamtrials import stablemath
+
 __all__ = ["resample_polyline", "shortcut_path"]
 
 
@@ -141,7 +143,7 @@ def resample_polyline(points: NDArray[np.floating], spacing: float) -> NDArray[n
         return pts.copy()
     if spacing <= 0.0:
         raise ValueError(f"spacing must be positive, got {spacing}")
-    seg = np.hypot(*np.diff(pts, axis=0).T)
+    seg = stablemath.hypot(*np.diff(pts, axis=0).T)
     parts = np.maximum(np.ceil(seg / spacing).astype(np.int64), 1)
     starts = np.repeat(pts[:-1], parts, axis=0)
     deltas = np.repeat(np.diff(pts, axis=0) / parts[:, None], parts, axis=0)

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from slamtrials import stablemath
 from slamtrials.atomicfile import atomic_write_text
 from slamtrials.errors import FormatError
 from slamtrials.io.textfile import read_number_table
@@ -56,13 +57,14 @@ def read_relations(path: str | Path) -> Relations:
     path = Path(path)
     values, numbers = read_number_table(path, RELATION_FIELDS, "relations")
     roll, pitch, yaw = values[:, 5], values[:, 6], values[:, 7]
-    cos_pitch = np.cos(pitch)
+    cos_pitch = stablemath.cos(pitch)
     vertical = np.flatnonzero(np.abs(cos_pitch) < 1e-9)
     if vertical.size:
         i = int(vertical[0])
         raise FormatError(path, f"pitch {pitch[i]!r} points the x axis vertically: the relation has no 2-D heading", line=numbers[i])
     planar = (roll == 0.0) & (pitch == 0.0)
-    heading = np.where(planar, yaw, np.arctan2(np.sin(yaw) * cos_pitch, np.cos(yaw) * cos_pitch))
+    tilted = stablemath.arctan2(stablemath.sin(yaw) * cos_pitch, stablemath.cos(yaw) * cos_pitch)
+    heading = np.where(planar, yaw, tilted)
     delta = np.column_stack([values[:, 2], values[:, 3], heading])
     return Relations(t1=values[:, 0].copy(), t2=values[:, 1].copy(), delta=delta)
 

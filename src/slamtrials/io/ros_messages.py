@@ -45,6 +45,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from slamtrials import stablemath
 from slamtrials.geometry import ominus
 from slamtrials.io.runfolder import json_default
 
@@ -138,8 +139,8 @@ def yaw_quaternions(theta: ArrayLike) -> NDArray[np.float64]:
     """float64 ``[N, 4]`` unit quaternions ``(x, y, z, w)`` of rotations by ``theta`` (rad) about z."""
     half = 0.5 * np.asarray(theta, dtype=np.float64)
     out = np.zeros(half.shape + (4,))
-    out[..., 2] = np.sin(half)
-    out[..., 3] = np.cos(half)
+    out[..., 2] = stablemath.sin(half)
+    out[..., 3] = stablemath.cos(half)
     return out
 
 
@@ -151,7 +152,7 @@ def quaternion_yaw(q: ArrayLike) -> NDArray[np.float64]:
     q = np.asarray(q, dtype=np.float64)
     x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
     with np.errstate(over="ignore", invalid="ignore"):  # damaged input gives inf/NaN, not warnings
-        return np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+        return stablemath.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
 def body_twists(t: ArrayLike, poses: ArrayLike) -> NDArray[np.float64]:

@@ -21,6 +21,7 @@ import zlib
 from pathlib import Path
 from typing import Any
 
+import numba
 import numpy as np
 
 from slamtrials.__about__ import __version__, source_revision
@@ -91,7 +92,8 @@ def write_run(folder: str | Path, record: RunRecord) -> Path:
     doc = {
         "format": RUN_FORMAT,
         "versions": {"slamtrials": __version__, **_revision(), "python": platform.python_version(),
-                     "numpy": np.__version__},
+                     "numpy": np.__version__, "numba": numba.__version__, "libc": " ".join(platform.libc_ver()),
+                     "machine": platform.machine()},
         "frames": len(record),
         "beams": int(record.scans.shape[1]) if record.scans.ndim == 2 else 0,
         "laser": record.laser,

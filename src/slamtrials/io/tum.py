@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from slamtrials import stablemath
 from slamtrials.atomicfile import atomic_write_text
 from slamtrials.errors import FormatError
 from slamtrials.io.textfile import read_number_table
@@ -72,12 +73,12 @@ def read_tum(path: str | Path) -> Trajectory:
     # First column of the rotation matrix, times |q|^2: R[0, 0] and R[1, 0] up to a positive factor.
     r00 = qw * qw + qx * qx - qy * qy - qz * qz
     r10 = 2.0 * (qx * qy + qw * qz)
-    vertical = np.flatnonzero(np.hypot(r00, r10) <= 1e-9 * norm2)
+    vertical = np.flatnonzero(stablemath.hypot(r00, r10) <= 1e-9 * norm2)
     if vertical.size:
         i = int(vertical[0])
         raise FormatError(path, f"rotation points the x axis vertically, it has no heading (qx qy qz qw = {values[i, 4:].tolist()})",
                           line=numbers[i])
-    poses = np.column_stack([values[:, 1], values[:, 2], np.arctan2(r10, r00)])
+    poses = np.column_stack([values[:, 1], values[:, 2], stablemath.arctan2(r10, r00)])
     return Trajectory(t=t.copy(), poses=poses)
 
 
@@ -106,7 +107,7 @@ def write_tum(path: str | Path, trajectory: Trajectory, *, header: bool = True) 
     if np.any(np.diff(t) <= 0):
         raise ValueError("write_tum: timestamps must be strictly increasing")
     half = poses[:, 2] / 2.0
-    columns = [t, poses[:, 0], poses[:, 1], np.sin(half), np.cos(half)]
+    columns = [t, poses[:, 0], poses[:, 1], stablemath.sin(half), stablemath.cos(half)]
     lines = ["# " + " ".join(TUM_FIELDS) + "\n"] if header else []
     lines += [f"{ti!r} {x!r} {y!r} 0.0 0.0 0.0 {qz!r} {qw!r}\n" for ti, x, y, qz, qw in zip(*(c.tolist() for c in columns))]
     return atomic_write_text(path, "".join(lines))

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from slamtrials import stablemath
 from slamtrials.geometry import as_poses, wrap_angle
 from slamtrials.metric.matching import DEFAULT_TOLERANCE, match_relations
 from slamtrials.record import Relations, Trajectory
@@ -56,7 +57,7 @@ def relative_pose_errors(delta: ArrayLike, delta_true: ArrayLike, *, squared: bo
     dtheta = wrap_angle(delta[..., 2] - delta_true[..., 2])
     if squared:
         return dx * dx + dy * dy, dtheta * dtheta
-    return np.hypot(dx, dy), np.abs(dtheta)
+    return stablemath.hypot(dx, dy), np.abs(dtheta)
 
 
 @dataclass(frozen=True, eq=False)

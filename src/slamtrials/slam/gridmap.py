@@ -39,6 +39,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
+from slamtrials import stablemath
 from slamtrials.geometry import compose1
 from slamtrials.slam.base import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 
@@ -159,7 +160,7 @@ def scan_endpoints(laser_poses: ArrayLike, ranges: ArrayLike, angles: ArrayLike,
     length = np.where(usable, np.minimum(np.where(no_return, range_max, r), max_urange), 0.0)
     hit = usable & ~no_return & (r <= max_urange)
     heading = pose[:, 2:3] + a
-    return pose[:, 0:1] + length * np.cos(heading), pose[:, 1:2] + length * np.sin(heading), usable, hit
+    return pose[:, 0:1] + length * stablemath.cos(heading), pose[:, 1:2] + length * stablemath.sin(heading), usable, hit
 
 
 def beam_endpoints(laser_pose: ArrayLike, ranges: ArrayLike, angles: ArrayLike, *, range_min: float,

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from slamtrials import stablemath
 from slamtrials.explore import Explorer, SnapshotTermination
 from slamtrials.record import Frame, OccupancyGrid, RunRecord
 from slamtrials.sim import Simulator
@@ -60,7 +61,7 @@ class TrialProgress:
 
 
 def _path_length(truth: np.ndarray) -> float:
-    return float(np.sum(np.hypot(np.diff(truth[:, 0]), np.diff(truth[:, 1]))))
+    return float(np.sum(stablemath.hypot(np.diff(truth[:, 0]), np.diff(truth[:, 1]))))
 
 
 def _turning(truth: np.ndarray) -> float:

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import ndimage
 
+from slamtrials import stablemath
 from slamtrials.errors import WorldError
 
 __all__ = ["World", "world_to_map", "world_to_cell", "cell_to_world", "DEFAULT_START_CLEARANCE"]
@@ -163,7 +164,7 @@ class World:
             candidates = np.argwhere(window)
             if candidates.size == 0:
                 return np.zeros_like(self.occupied)
-            nearest = candidates[np.argmin(np.hypot(candidates[:, 0] + r0 - row, candidates[:, 1] + c0 - col))]
+            nearest = candidates[np.argmin(stablemath.hypot(candidates[:, 0] + r0 - row, candidates[:, 1] + c0 - col))]
             row, col = int(nearest[0] + r0), int(nearest[1] + c0)
         labels, _ = ndimage.label(fits, structure=np.ones((3, 3), dtype=bool))
         centres = labels == labels[row, col]
@@ -200,7 +201,7 @@ def world_to_map(world: World, xy: ArrayLike) -> NDArray[np.float64]:
     pts = np.asarray(xy, dtype=np.float64)
     ox, oy, oth = world.origin
     dx, dy = pts[..., 0] - ox, pts[..., 1] - oy
-    c, s = np.cos(oth), np.sin(oth)
+    c, s = stablemath.cos(oth), stablemath.sin(oth)
     out = np.empty(pts.shape)
     out[..., 0] = (c * dx + s * dy) / world.resolution
     out[..., 1] = (-s * dx + c * dy) / world.resolution
@@ -222,7 +223,7 @@ def cell_to_world(world: World, rows: ArrayLike, cols: ArrayLike) -> NDArray[np.
     u = (cols + 0.5) * world.resolution
     v = (world.height - rows - 0.5) * world.resolution
     ox, oy, oth = world.origin
-    c, s = np.cos(oth), np.sin(oth)
+    c, s = stablemath.cos(oth), stablemath.sin(oth)
     return np.stack([ox + c * u - s * v, oy + s * u + c * v], axis=-1)
 
 

@@ -48,6 +48,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
+from slamtrials import stablemath
 from slamtrials.geometry import compose, compose1, inverse, ominus, wrap_angle1
 from slamtrials.record import Frame, Trajectory
 from slamtrials.slam.base import OccupancyGrid, register_algorithm
@@ -147,15 +148,15 @@ class GMapping:
             & (ranges <= self.max_urange) & (ranges <= self.max_range)
         matched = usable & (np.arange(ranges.shape[0]) % (c.lskip + 1) == c.lskip)
         r, a = ranges[usable], angles[usable]
-        lx, ly = r * np.cos(a), r * np.sin(a)
+        lx, ly = r * stablemath.cos(a), r * stablemath.sin(a)
         keep = matched[usable]
         back = (r - math.sqrt(2.0) * c.delta)[keep]
-        return lx, ly, lx[keep], ly[keep], back * np.cos(a[keep]), back * np.sin(a[keep])
+        return lx, ly, lx[keep], ly[keep], back * stablemath.cos(a[keep]), back * stablemath.sin(a[keep])
 
     def _register(self, lx: NDArray[np.float64], ly: NDArray[np.float64]) -> None:
         """Add the scan seen from every particle's pose to its map."""
         x, y, t = self.poses[:, 0:1], self.poses[:, 1:2], self.poses[:, 2:3]
-        cos_t, sin_t = np.cos(t), np.sin(t)
+        cos_t, sin_t = stablemath.cos(t), stablemath.sin(t)
         self.maps.register(x + cos_t * lx - sin_t * ly, y + sin_t * lx + cos_t * ly)
 
     def _due(self, t: float, laser_odometry: NDArray[np.float64]) -> bool:

@@ -5,13 +5,15 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from slamtrials import stablemath
+
 __all__ = ["normalized_weights", "effective_sample_size", "systematic_resample"]
 
 
 def normalized_weights(log_weights: NDArray[np.float64], ogain: float) -> NDArray[np.float64]:
     """``w_i = exp((l_i - max l) / (ogain * N))`` normalised to sum 1; float64 ``[N]``."""
     n = log_weights.shape[0]
-    w = np.exp((log_weights - log_weights.max()) / (ogain * n))
+    w = stablemath.exp((log_weights - log_weights.max()) / (ogain * n))
     return w / w.sum()
 
 

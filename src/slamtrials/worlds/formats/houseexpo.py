@@ -64,7 +64,7 @@ def _vertices(path: Path, doc: Any, text: str) -> np.ndarray:
     if len(verts) < 3:
         raise FormatError(path, f"verts: a polygon needs at least 3 distinct vertices, got {len(verts)}", line=line)
     x, y = verts[:, 0], verts[:, 1]
-    area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+    area = 0.5 * abs(float(np.sum(x * np.roll(y, -1)) - np.sum(y * np.roll(x, -1))))
     if area <= 0.0 or not math.isfinite(area):
         raise FormatError(path, "verts: the polygon has no area (collinear or repeated points)", line=line)
     return verts

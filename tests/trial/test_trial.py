@@ -93,10 +93,17 @@ def test_mapped_fraction_counts_known_cells_of_the_true_free_space(record, world
 
 
 def test_same_seed_same_trial_bit_for_bit(record, world, config):
-    again = run_trial(world, config, seed=4)
+    progress = []
+    again = run_trial(world, config, seed=4, on_progress=progress.append, progress_period=5.0)
     for name in ("t", "scans", "odometry", "truth", "stalled", "estimate"):
         assert np.array_equal(getattr(again, name), getattr(record, name)), name
     assert np.array_equal(again.map.grid, record.map.grid)
+    # the progress reports follow the trial: time and SLAM updates only grow, the known area grows overall
+    times = [p.t for p in progress]
+    updates = [p.slam_updates for p in progress]
+    assert len(progress) >= 3 and times == sorted(times) and updates == sorted(updates)
+    assert 0 < updates[-1] <= record.metadata["trial"]["slam_updates"]
+    assert progress[-1].known_free_area > progress[0].known_free_area
     other = run_trial(world, config.model_copy(update={"termination": config.termination.model_copy(update={"max_time": 30.0})}), seed=5)
     assert other.metadata["bias"] != record.metadata["bias"]
 

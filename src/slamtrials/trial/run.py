@@ -52,12 +52,15 @@ class TrialProgress:
         Free area of the current SLAM map (m^2).
     reachable_area:
         Reachable free area of the true world (m^2).
+    slam_updates:
+        Map (filter) updates the SLAM algorithm has done so far.
     """
 
     t: float
     max_time: float
     known_free_area: float
     reachable_area: float
+    slam_updates: int = 0
 
 
 def _path_length(truth: np.ndarray) -> float:
@@ -145,7 +148,7 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
             reason = explorer.reason or "no_frontiers"
             break
         if on_progress is not None and frame.t >= next_report:
-            on_progress(TrialProgress(frame.t, max_time, known_free_area(grid), reachable_area))
+            on_progress(TrialProgress(frame.t, max_time, known_free_area(grid), reachable_area, int(slam.updates)))
             next_report = frame.t + progress_period
         frame = sim.step(command)
 

@@ -148,10 +148,11 @@ class GMapping:
             & (ranges <= self.max_urange) & (ranges <= self.max_range)
         matched = usable & (np.arange(ranges.shape[0]) % (c.lskip + 1) == c.lskip)
         r, a = ranges[usable], angles[usable]
-        lx, ly = r * stablemath.cos(a), r * stablemath.sin(a)
+        cos_a, sin_a = stablemath.cos(a), stablemath.sin(a)
+        lx, ly = r * cos_a, r * sin_a
         keep = matched[usable]
         back = (r - math.sqrt(2.0) * c.delta)[keep]
-        return lx, ly, lx[keep], ly[keep], back * stablemath.cos(a[keep]), back * stablemath.sin(a[keep])
+        return lx, ly, lx[keep], ly[keep], back * cos_a[keep], back * sin_a[keep]
 
     def _register(self, lx: NDArray[np.float64], ly: NDArray[np.float64]) -> None:
         """Add the scan seen from every particle's pose to its map."""

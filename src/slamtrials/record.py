@@ -8,13 +8,15 @@ radians; ground truth is in the world frame, odometry in the odometry frame (whi
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Frame", "RunRecord", "Trajectory", "Relations", "OccupancyGrid", "OCCUPIED", "FREE", "UNKNOWN"]
+__all__ = ["Frame", "LaserGeometry", "RunRecord", "Trajectory", "Relations", "OccupancyGrid", "OCCUPIED", "FREE", "UNKNOWN"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -41,6 +43,63 @@ class Frame:
     odometry: NDArray[np.float64]
     truth: NDArray[np.float64]
     stalled: bool = False
+
+
+@dataclass(frozen=True)
+class LaserGeometry:
+    """Where a planar laser looks and how far: everything needed to turn a scan into points.
+
+    Attributes
+    ----------
+    angle_min:
+        Bearing (rad) of beam 0 in the laser frame; beam ``i`` points at ``angle_min + i * angle_increment``
+        (counter-clockwise).
+    angle_increment:
+        Angle (rad) between neighbouring beams, > 0.
+    range_min, range_max:
+        Shortest and longest valid reading (m); a reading of ``range_max`` or more is "no return".
+    mount:
+        Pose (x, y, theta) of the laser in the robot base frame, metres and radians.
+    """
+
+    angle_min: float
+    angle_increment: float
+    range_min: float
+    range_max: float
+    mount: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        for name in ("angle_min", "angle_increment", "range_min", "range_max"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
+                raise ValueError(f"LaserGeometry.{name} must be a finite number, got {value!r}")
+            object.__setattr__(self, name, float(value))
+        mount = tuple(float(v) for v in self.mount)
+        if len(mount) != 3 or not all(math.isfinite(v) for v in mount):
+            raise ValueError(f"LaserGeometry.mount must be three finite numbers (x, y, theta), got {self.mount!r}")
+        object.__setattr__(self, "mount", mount)
+        if self.angle_increment <= 0:
+            raise ValueError(f"LaserGeometry.angle_increment must be > 0 rad, got {self.angle_increment!r}")
+        if not 0 <= self.range_min < self.range_max:
+            raise ValueError(f"LaserGeometry needs 0 <= range_min < range_max, got {self.range_min!r} and {self.range_max!r}")
+
+    def beam_angles(self, beams: int) -> NDArray[np.float64]:
+        """float64 ``[beams]`` bearings (rad) of the beams in the laser frame."""
+        return self.angle_min + self.angle_increment * np.arange(beams, dtype=np.float64)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form stored in run.json: the four numbers and ``mount`` as a list."""
+        return {"angle_min": self.angle_min, "angle_increment": self.angle_increment,
+                "range_min": self.range_min, "range_max": self.range_max, "mount": list(self.mount)}
+
+    @classmethod
+    def from_dict(cls, doc: Mapping[str, Any]) -> "LaserGeometry":
+        """Read the JSON form (``mount`` optional, default at the base origin). Raises ValueError naming the field."""
+        fields = ("angle_min", "angle_increment", "range_min", "range_max")
+        missing = [k for k in fields if k not in doc]
+        if missing:
+            raise ValueError(f"laser geometry lacks {', '.join(missing)}")
+        return cls(**{k: doc[k] for k in fields}, mount=tuple(doc.get("mount", (0.0, 0.0, 0.0))))
 
 
 @dataclass(eq=False)

@@ -1,5 +1,5 @@
 """SLAM algorithms behind one protocol: the registry, the occupancy-grid builder, the odometry
-baseline and ``gmapping``.
+baseline, ``gmapping`` and ``karto``.
 
 ``make_algorithm("odometry", record.laser)`` builds an algorithm; feed it frames with ``process`` and read
 ``trajectory()`` and ``occupancy()``. Third-party algorithms register with :func:`register_algorithm` or
@@ -24,6 +24,7 @@ from slamtrials.slam.base import (
 )
 from slamtrials.slam.gridmap import GridMap
 from slamtrials.slam.gmapping import GMapping, GMappingConfig
+from slamtrials.slam.karto import Karto, KartoConfig
 from slamtrials.slam.odometry import OdometryConfig, OdometrySlam
 
 __all__ = [
@@ -42,6 +43,8 @@ __all__ = [
     "GridMap",
     "GMapping",
     "GMappingConfig",
+    "Karto",
+    "KartoConfig",
     "OdometryConfig",
     "OdometrySlam",
 ]

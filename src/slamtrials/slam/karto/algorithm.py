@@ -1,0 +1,384 @@
+"""``karto``: graph-based SLAM as open_karto behaves when slam_toolbox runs it (online, asynchronous mode).
+
+Per frame (:meth:`Karto.process`):
+
+1. the frame's base pose is predicted from the last node: its corrected pose composed with the
+   odometry motion since it (Karto's "corrected pose" of a new scan);
+2. the frame becomes a node when it is the first, or at least ``minimum_time_interval`` seconds passed
+   since the last node and the laser moved ``minimum_travel_distance`` or turned
+   ``minimum_travel_heading`` by odometry since it (slam_toolbox's throttle and Karto's
+   HasMovedEnough);
+3. a node's laser pose is corrected by matching its scan against the running buffer of recent nodes
+   (:mod:`.scanmatch`); it is linked to the previous node and to the buffer's node nearest to it,
+   matched against the near chains of earlier passes that the graph already connects to it (linked
+   when the response is high enough), and set to the covariance-weighted mean of those matches
+   (Karto's AddEdges);
+4. loop closure: every chain of earlier nodes near it that the graph does not link to it is matched
+   coarsely with the loop matcher, then finely; on success the node is linked to the chain's nearest
+   node and the whole graph is optimized (:mod:`.optimize`), which moves every node (TryCloseLoop);
+5. every ``map_update_interval`` seconds the published map is rebuilt from the nodes' poses
+   (:mod:`.mapbuild`).
+
+Frames. Nodes hold base poses (slam_toolbox links corrected base poses); matching works on laser poses
+(base composed with the laser's mount). The map frame starts on the first frame's odometry pose, or
+``initial_pose``.
+
+Estimates. :meth:`Karto.process` returns the online estimate: a node's corrected pose once it is
+processed, else the prediction of step 1. :meth:`Karto.trajectory` returns the final estimate: every
+frame placed by odometry from the last node at or before it, with that node's pose as optimized at the
+end.
+
+Randomness: none; the ``rng`` given to :meth:`Karto.reset` is not drawn from. Results depend only on the
+inputs and the C library's sin and cos (no BLAS: see :mod:`.sparsechol`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from slamtrials import stablemath
+from slamtrials.errors import ConfigError
+from slamtrials.geometry import compose, compose1, inverse, ominus, ominus1, wrap_angle1
+from slamtrials.record import Frame, LaserGeometry, Trajectory
+from slamtrials.slam.base import OccupancyGrid, register_algorithm
+from slamtrials.slam.karto.config import KartoConfig
+from slamtrials.slam.karto.graph import PoseGraph, ScanNode
+from slamtrials.slam.karto.loopclosure import find_loop_closure_chain, find_near_chains
+from slamtrials.slam.karto.mapbuild import NodeMap
+from slamtrials.slam.karto.optimize import information, optimize_pose_graph
+from slamtrials.slam.karto.scanmatch import MatcherSettings, MatchResult, ScanMatcher, points_in_map
+
+__all__ = ["Karto"]
+
+_TOLERANCE = 1e-9
+
+
+def _mat3(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+    """3 x 3 product written out (no BLAS)."""
+    out = np.zeros((3, 3))
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = a[i, 0] * b[0, j] + a[i, 1] * b[1, j] + a[i, 2] * b[2, j]
+    return out
+
+
+def weighted_mean(means: list[NDArray[np.float64]], covariances: list[NDArray[np.float64]]) -> NDArray[np.float64]:
+    """Karto's ComputeWeightedMean: poses weighted by their information matrices, headings averaged
+    through their cosines and sines."""
+    infos = [information(c) for c in covariances]
+    total = np.zeros((3, 3))
+    for info in infos:
+        total = total + info
+    spread = information(total)
+    out = np.zeros(3)
+    sum_c = sum_s = 0.0
+    for pose, info in zip(means, infos):
+        weight = _mat3(spread, info)
+        for i in range(3):
+            out[i] += weight[i, 0] * pose[0] + weight[i, 1] * pose[1] + weight[i, 2] * pose[2]
+        sum_c += math.cos(float(pose[2]))
+        sum_s += math.sin(float(pose[2]))
+    out[2] = math.atan2(sum_s / len(means), sum_c / len(means))
+    return out
+
+
+@register_algorithm
+class Karto:
+    """Karto graph SLAM (registry name ``karto``; see the module docstring).
+
+    Parameters
+    ----------
+    config:
+        Validated :class:`~slamtrials.slam.karto.config.KartoConfig`.
+    laser:
+        The laser's geometry (:class:`~slamtrials.record.LaserGeometry` or its dict form).
+
+    Attributes
+    ----------
+    updates:
+        Nodes added since :meth:`reset`.
+    loop_closures:
+        Loop closures accepted since :meth:`reset`.
+    timings:
+        ``[(node index, seconds)]``: wall time of every node's processing (matching, linking, loop
+        closing and optimizing).
+    optimizations:
+        ``[(nodes, edges, seconds, iterations)]`` of every optimizer run.
+    """
+
+    name: ClassVar[str] = "karto"
+    Config: ClassVar[type[KartoConfig]] = KartoConfig
+    PRESETS: ClassVar[dict[str, dict[str, Any]]] = {
+        # slam_toolbox's defaults; named so trial configs, whose preset defaults to "paper", can say
+        # just `algorithm: karto` (the seed paper ran GMapping only)
+        "paper": {},
+        "slam_toolbox": {},
+    }
+
+    def __init__(self, config: KartoConfig, laser: LaserGeometry | dict[str, Any]):
+        laser = laser if isinstance(laser, LaserGeometry) else LaserGeometry.from_dict(laser)
+        self.config = config
+        self.laser = laser
+        self.mount = np.asarray(laser.mount, dtype=np.float64)
+        self.unmount = inverse(self.mount)
+        self.range_threshold = min(float(config.max_laser_range), laser.range_max)
+        c = config
+        settings = MatcherSettings(
+            coarse_search_angle_offset=c.coarse_search_angle_offset, coarse_angle_resolution=c.coarse_angle_resolution,
+            fine_search_angle_offset=c.fine_search_angle_offset, distance_variance=c.distance_variance_penalty ** 2,
+            angle_variance=c.angle_variance_penalty ** 2, minimum_distance_penalty=c.minimum_distance_penalty,
+            minimum_angle_penalty=c.minimum_angle_penalty, use_response_expansion=c.use_response_expansion)
+        self.sequential = ScanMatcher(c.correlation_search_space_dimension, c.correlation_search_space_resolution,
+                                      c.correlation_search_space_smear_deviation, self.range_threshold, settings)
+        self.loop_matcher = ScanMatcher(c.loop_search_space_dimension, c.loop_search_space_resolution,
+                                        c.loop_search_space_smear_deviation, self.range_threshold, settings)
+        self.reset(np.random.default_rng(0))
+
+    # ------------------------------------------------------------------ state
+
+    def reset(self, rng: np.random.Generator) -> None:
+        """Forget every frame (Karto draws no random numbers; ``rng`` is not used)."""
+        c = self.config
+        self.updates = 0
+        self.loop_closures = 0
+        self.timings: list[tuple[int, float]] = []
+        self.optimizations: list[tuple[int, int, float, int]] = []
+        self.graph = PoseGraph()
+        self.running: list[int] = []
+        self.map = NodeMap(c.resolution, self.laser, max_urange=self.range_threshold,
+                           min_pass_through=c.min_pass_through, occupancy_threshold=c.occupancy_threshold)
+        self._last_map_t = -math.inf
+        self._t: list[float] = []
+        self._odometry: list[NDArray[np.float64]] = []
+        self._anchor: list[int] = []
+        self._estimates: list[NDArray[np.float64]] = []
+        self._angles: NDArray[np.float64] | None = None
+
+    # ------------------------------------------------------------------ helpers
+
+    def _laser_pose(self, index: int) -> NDArray[np.float64]:
+        return compose1(self.graph.nodes[index].pose, self.mount)
+
+    def _base_pose(self, laser_pose: NDArray[np.float64]) -> NDArray[np.float64]:
+        return compose1(laser_pose, self.unmount)
+
+    def _references(self) -> NDArray[np.float64]:
+        """``[N, 2]`` every node's reference position: its points' barycentre or its laser position."""
+        nodes = self.graph.nodes
+        laser = compose(np.array([n.pose for n in nodes]).reshape(-1, 3), self.mount)
+        offsets = np.zeros((len(nodes), 2))
+        if self.config.use_scan_barycenter:
+            for k, node in enumerate(nodes):
+                if node.barycenter is not None:
+                    offsets[k] = node.barycenter
+        c, s = stablemath.cos(laser[:, 2]), stablemath.sin(laser[:, 2])
+        return np.column_stack([laser[:, 0] + c * offsets[:, 0] - s * offsets[:, 1],
+                                laser[:, 1] + s * offsets[:, 0] + c * offsets[:, 1]])
+
+    def _points(self, indexes: list[int]) -> list[tuple[NDArray[np.float64], NDArray[np.float64]]]:
+        nodes = self.graph.nodes
+        return [points_in_map(self._laser_pose(i), nodes[i].lx, nodes[i].ly) for i in indexes]
+
+    def _match(self, matcher: ScanMatcher, laser_pose: NDArray[np.float64], index: int, base: list[int], *,
+               penalize: bool, refine: bool = True) -> MatchResult:
+        node = self.graph.nodes[index]
+        return matcher.match(laser_pose, node.lx, node.ly, self._points(base), penalize=penalize, refine=refine)
+
+    def _scan_node(self, frame_index: int, t: float, odometry: NDArray[np.float64], pose: NDArray[np.float64],
+                   ranges: NDArray[np.float64]) -> ScanNode:
+        if self._angles is None or self._angles.shape[0] != ranges.shape[0]:
+            self._angles = self.laser.beam_angles(ranges.shape[0])
+        has_point = np.isfinite(ranges) & (ranges > self.laser.range_min)
+        r = np.where(has_point, ranges, np.nan)
+        lx, ly = r * stablemath.cos(self._angles), r * stablemath.sin(self._angles)
+        near = has_point & (ranges <= self.range_threshold)
+        barycenter = np.array([lx[near].mean(), ly[near].mean()]) if near.any() else None
+        return ScanNode(frame=frame_index, t=t, odometry=odometry, pose=pose, lx=lx, ly=ly, barycenter=barycenter,
+                        ranges=np.asarray(ranges, dtype=np.float32))
+
+    def _is_node(self, t: float, odometry: NDArray[np.float64]) -> bool:
+        c = self.config
+        if not self.graph.nodes:
+            return True
+        last = self.graph.nodes[-1]
+        if t - last.t < c.minimum_time_interval:
+            return False
+        before = compose1(last.odometry, self.mount)
+        now = compose1(odometry, self.mount)
+        if abs(wrap_angle1(now[2] - before[2])) >= c.minimum_travel_heading:
+            return True
+        dx, dy = now[0] - before[0], now[1] - before[1]
+        return dx * dx + dy * dy >= c.minimum_travel_distance ** 2 - _TOLERANCE
+
+    # ------------------------------------------------------------------ graph building (Karto's MapperGraph)
+
+    def _link_chain(self, chain: list[int], index: int, laser_mean: NDArray[np.float64],
+                    covariance: NDArray[np.float64]) -> None:
+        """LinkChainToScan: link the chain's node nearest to node ``index`` if near enough."""
+        reference = self._references()
+        here = reference[index]
+        closest, best = -1, math.inf
+        for k in chain:
+            dx, dy = reference[k, 0] - here[0], reference[k, 1] - here[1]
+            if dx * dx + dy * dy < best:
+                closest, best = k, dx * dx + dy * dy
+        if closest >= 0 and best < self.config.link_scan_maximum_distance ** 2 + _TOLERANCE:
+            self.graph.link(closest, index, self._base_pose(laser_mean), covariance)
+
+    def _add_edges(self, index: int, covariance: NDArray[np.float64]) -> None:
+        """AddEdges: link to the previous node, the running buffer and near chains; then the weighted mean."""
+        c = self.config
+        node = self.graph.nodes[index]
+        means: list[NDArray[np.float64]] = []
+        covariances: list[NDArray[np.float64]] = []
+        if index > 0:
+            laser_pose = self._laser_pose(index)
+            self.graph.link(index - 1, index, node.pose, covariance)
+            means.append(laser_pose)
+            covariances.append(covariance)
+            self._link_chain(self.running, index, laser_pose, covariance)
+        reference = self._references()
+        for chain in find_near_chains(self.graph, index, reference, c.link_scan_maximum_distance):
+            if len(chain) < c.loop_match_minimum_chain_size:
+                continue
+            result = self._match(self.sequential, self._laser_pose(index), index, chain, penalize=False)
+            if result.response > c.link_match_minimum_response_fine - _TOLERANCE:
+                means.append(result.pose)
+                covariances.append(result.covariance)
+                self._link_chain(chain, index, result.pose, result.covariance)
+        if means:
+            node.pose = self._base_pose(weighted_mean(means, covariances))
+
+    def _add_running(self, index: int) -> None:
+        c = self.config
+        self.running.append(index)
+        limit = c.scan_buffer_maximum_scan_distance ** 2 - _TOLERANCE
+        while True:
+            front, back = self._laser_pose(self.running[0]), self._laser_pose(self.running[-1])
+            dx, dy = back[0] - front[0], back[1] - front[1]
+            if len(self.running) > c.scan_buffer_size or dx * dx + dy * dy > limit:
+                self.running.pop(0)
+            else:
+                break
+
+    def _optimize(self) -> None:
+        """CorrectPoses: optimize the whole graph and move every node."""
+        edges = self.graph.edges
+        started = time.perf_counter()
+        result = optimize_pose_graph(self.graph.poses(), np.array([e.source for e in edges]),
+                                     np.array([e.target for e in edges]), np.array([e.mean for e in edges]),
+                                     np.array([information(e.covariance) for e in edges]))
+        self.optimizations.append((len(self.graph.nodes), len(edges), time.perf_counter() - started, result.iterations))
+        self.graph.set_poses(result.poses)
+
+    def _close_loops(self, index: int) -> None:
+        """TryCloseLoop: try every candidate chain in turn; optimize after each accepted closure."""
+        c = self.config
+        node = self.graph.nodes[index]
+        start = 0
+        chain, start = find_loop_closure_chain(self.graph, index, self._references(), c.loop_search_maximum_distance,
+                                               c.loop_match_minimum_chain_size, start)
+        while chain:
+            coarse = self._match(self.loop_matcher, self._laser_pose(index), index, chain, penalize=False,
+                                 refine=False)
+            bound = c.loop_match_maximum_variance_coarse ** 2
+            if (coarse.response > c.loop_match_minimum_response_coarse and coarse.covariance[0, 0] < bound
+                    and coarse.covariance[1, 1] < bound):
+                fine = self._match(self.sequential, coarse.pose, index, chain, penalize=False)
+                if fine.response >= c.loop_match_minimum_response_fine:
+                    node.pose = self._base_pose(fine.pose)
+                    self._link_chain(chain, index, fine.pose, fine.covariance)
+                    self._optimize()
+                    self.loop_closures += 1
+            chain, start = find_loop_closure_chain(self.graph, index, self._references(),
+                                                   c.loop_search_maximum_distance, c.loop_match_minimum_chain_size, start)
+
+    def _add_node(self, frame_index: int, t: float, odometry: NDArray[np.float64], predicted: NDArray[np.float64],
+                  ranges: NDArray[np.float64]) -> ScanNode:
+        c = self.config
+        started = time.perf_counter()
+        node = self._scan_node(frame_index, t, odometry, predicted, ranges)
+        covariance = np.eye(3)
+        if c.use_scan_matching and self.graph.nodes:
+            result = self.sequential.match(compose1(predicted, self.mount), node.lx, node.ly,
+                                           self._points(self.running), penalize=True, refine=True)
+            node.pose = self._base_pose(result.pose)
+            covariance = result.covariance
+        index = self.graph.add_node(node)
+        if c.use_scan_matching:
+            self._add_edges(index, covariance)
+            self._add_running(index)
+            if c.do_loop_closing:
+                self._close_loops(index)
+        self.updates += 1
+        self.timings.append((index, time.perf_counter() - started))
+        if t - self._last_map_t >= c.map_update_interval:
+            self._rebuild_map()
+            self._last_map_t = t
+        return node
+
+    def _rebuild_map(self) -> None:
+        nodes = self.graph.nodes
+        self.map.update(compose(self.graph.poses(), self.mount), [n.ranges for n in nodes])
+
+    # ------------------------------------------------------------------ protocol
+
+    def process(self, frame: Frame) -> NDArray[np.float64]:
+        """Take one frame; return the online base-pose estimate (map frame), float64 ``[3]``.
+
+        Raises
+        ------
+        ConfigError
+            The frame has no laser readings.
+        """
+        t = float(frame.t)
+        ranges = np.asarray(frame.ranges, dtype=np.float64).reshape(-1)
+        if ranges.shape[0] == 0:
+            raise ConfigError(f"karto: the frame at t = {t:g} s has no laser readings; a scan is needed")
+        odometry = np.asarray(frame.odometry, dtype=np.float64)
+        nodes = self.graph.nodes
+        if nodes:
+            last = nodes[-1]
+            predicted = compose1(last.pose, ominus1(last.odometry, odometry))
+        else:
+            start = self.config.initial_pose
+            predicted = odometry.copy() if start is None else np.asarray(start, dtype=np.float64)
+        if self._is_node(t, odometry):
+            estimate = self._add_node(len(self._t), t, odometry, predicted, ranges).pose.copy()
+        else:
+            estimate = predicted
+        self._t.append(t)
+        self._odometry.append(odometry)
+        self._anchor.append(len(self.graph.nodes) - 1)
+        self._estimates.append(estimate)
+        return estimate
+
+    def occupancy(self) -> OccupancyGrid:
+        """The published map, rebuilt from the nodes' poses at most every ``map_update_interval`` seconds."""
+        return self.map.occupancy()
+
+    def final_occupancy(self) -> OccupancyGrid:
+        """The map rebuilt now from the nodes' current (final) poses."""
+        self._rebuild_map()
+        return self.map.occupancy()
+
+    def trajectory(self) -> Trajectory:
+        """Every frame placed by odometry from the last node at or before it, at its final pose."""
+        t = np.array(self._t, dtype=np.float64)
+        if not self._t:
+            return Trajectory(t=t, poses=np.zeros((0, 3)))
+        anchor = np.array(self._anchor, dtype=np.intp)
+        node_poses = self.graph.poses()
+        node_odometry = np.array([n.odometry for n in self.graph.nodes], dtype=np.float64)
+        odometry = np.array(self._odometry, dtype=np.float64)
+        poses = compose(node_poses[anchor], ominus(node_odometry[anchor], odometry))
+        return Trajectory(t=t, poses=poses)
+
+    def online_estimates(self) -> NDArray[np.float64]:
+        """float64 ``[T, 3]``: what :meth:`process` returned for every frame."""
+        return np.array(self._estimates, dtype=np.float64).reshape(-1, 3)

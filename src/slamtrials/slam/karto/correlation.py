@@ -1,0 +1,295 @@
+"""Karto's correlation grid: smeared scan points, and the correlative search over (x, y, theta).
+
+Kernels of :mod:`.scanmatch` (numba, ``cache=True``; sin and cos from the C library via ``math``).
+
+Grid. A square ``uint8`` grid of ``roi`` x ``roi`` cells of ``resolution`` metres centred on the scan
+being matched, plus a border of ``half + 1`` cells so the smearing kernel never runs off the array. Cell
+``(gx, gy)`` (ROI coordinates, y up) covers the points that round to it: ``gx = round((x - ox) /
+resolution)`` with Karto's rounding (halves away from zero), ``(ox, oy)`` the world position of ROI
+cell (0, 0). Array index ``[gy + border, gx + border]``. A marked point sets its cell to 100 and every
+cell within ``half`` cells to at least the kernel's ``round(100 exp(-d^2 / (2 sigma^2)))``.
+
+Search. For every searched position (a regular lattice around the search centre) and heading (a regular
+fan), the response is the sum of the grid values under the scan's points, each point's cell offset
+rounded on its own (Karto's lookup tables), divided by ``100 *`` the scan's beam count (every beam
+counts, as Karto counts every reading); points that land outside the array add nothing (Karto checks
+only the flat index, so such points may wrap onto another row there: see docs/karto.md).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+from slamtrials import stablemath
+
+__all__ = ["OCCUPIED_VALUE", "MAX_VARIANCE", "karto_round", "smear_kernel", "find_valid_points", "add_points",
+           "correlate"]
+
+#: Value of a cell holding a scan point (Karto's GridStates_Occupied).
+OCCUPIED_VALUE = 100
+#: Variance (m^2) Karto gives a match with no response.
+MAX_VARIANCE = 500.0
+_DISTANCE_PENALTY_GAIN = 0.2
+_ANGLE_PENALTY_GAIN = 0.2
+_TOLERANCE = 1e-9  # Karto's KT_TOLERANCE
+
+
+@njit(cache=True, nogil=True)
+def _round(value):  # pragma: no cover - compiled
+    """Karto's math::Round: halves away from zero."""
+    return math.floor(value + 0.5) if value >= 0.0 else math.ceil(value - 0.5)
+
+
+def karto_round(value: float) -> int:
+    """Round half away from zero (Karto's ``math::Round``), as an int."""
+    return int(math.floor(value + 0.5) if value >= 0.0 else math.ceil(value - 0.5))
+
+
+def smear_kernel(resolution: float, deviation: float) -> NDArray[np.uint8]:
+    """Karto's smearing kernel: ``uint8 [K, K]``, ``K = 2 round(2 deviation / resolution) + 1``,
+    cell value ``round(100 exp(-d^2 / (2 deviation^2)))`` at distance ``d`` (m) from the centre."""
+    half = karto_round(2.0 * deviation / resolution)
+    offsets = np.arange(-half, half + 1, dtype=np.float64) * resolution
+    distance = stablemath.hypot(offsets[None, :], offsets[:, None])
+    z = stablemath.exp(-0.5 * (distance / deviation) ** 2)
+    return np.floor(z * OCCUPIED_VALUE + 0.5).astype(np.uint8)
+
+
+@njit(cache=True, nogil=True)
+def find_valid_points(px, py, vx, vy):  # pragma: no cover - compiled
+    """Karto's FindValidPoints: which of a scan's points (world frame, beam order, NaN where a beam has no
+    point) face the viewpoint ``(vx, vy)``; returns bool ``[B]``.
+
+    Walking the points in beam order, every step of more than 10 cm is checked for the side of the line
+    from the viewpoint through the previous checked point it lies on; the points since the last
+    check are kept when the step turns counter-clockwise as seen from the viewpoint.
+    """
+    n = px.shape[0]
+    valid = np.zeros(n, dtype=np.bool_)
+    trailing = 0
+    first_time = True
+    fx = 0.0
+    fy = 0.0
+    for i in range(n):
+        x = px[i]
+        y = py[i]
+        if first_time and not math.isnan(x) and not math.isnan(y):
+            fx = x
+            fy = y
+            first_time = False
+        dx = fx - x
+        dy = fy - y
+        if dx * dx + dy * dy > 0.01:
+            a = vy - fy
+            b = fx - vx
+            c = fy * vx - fx * vy
+            side = x * a + y * b + c
+            fx = x
+            fy = y
+            if side < 0.0:
+                trailing = i
+            else:
+                for j in range(trailing, i):
+                    valid[j] = True
+                trailing = i
+    return valid
+
+
+@njit(cache=True, nogil=True)
+def add_points(grid, border, roi, ox, oy, inv_res, px, py, valid, kernel, box):  # pragma: no cover - compiled
+    """Mark the ``valid`` points ``(px, py)`` (world, m) in ``grid`` and smear each newly marked cell.
+
+    ``box`` int64 ``[4]`` (row min, row max, col min, col max of the array cells written) is widened in
+    place, so the caller can clear only what was written.
+    """
+    half = kernel.shape[0] // 2
+    for k in range(px.shape[0]):
+        if not valid[k]:
+            continue
+        x = px[k]
+        y = py[k]
+        if not (math.isfinite(x) and math.isfinite(y)):
+            continue
+        gx = _round((x - ox) * inv_res)
+        gy = _round((y - oy) * inv_res)
+        if gx < 0 or gx >= roi or gy < 0 or gy >= roi:
+            continue
+        r = int(gy) + border
+        c = int(gx) + border
+        if grid[r, c] == OCCUPIED_VALUE:
+            continue
+        grid[r, c] = OCCUPIED_VALUE
+        for j in range(-half, half + 1):
+            for i in range(-half, half + 1):
+                value = kernel[j + half, i + half]
+                if value > grid[r + j, c + i]:
+                    grid[r + j, c + i] = value
+        box[0] = min(box[0], r - half)
+        box[1] = max(box[1], r + half)
+        box[2] = min(box[2], c - half)
+        box[3] = max(box[3], c + half)
+
+
+@njit(cache=True, nogil=True)
+def _lookup(lx, ly, heading0, angle_step, n_angles, inv_res):  # pragma: no cover - compiled
+    """Cell offsets ``[A, P]`` (columns, rows) of the points at each searched heading."""
+    n = lx.shape[0]
+    dcol = np.empty((n_angles, n), dtype=np.int64)
+    drow = np.empty((n_angles, n), dtype=np.int64)
+    for a in range(n_angles):
+        angle = heading0 + a * angle_step
+        c = math.cos(angle)
+        s = math.sin(angle)
+        for p in range(n):
+            dcol[a, p] = int(_round((c * lx[p] - s * ly[p]) * inv_res))
+            drow[a, p] = int(_round((s * lx[p] + c * ly[p]) * inv_res))
+    return dcol, drow
+
+
+@njit(cache=True, nogil=True)
+def _response(grid, row, col, dcol, drow, a, norm):  # pragma: no cover - compiled
+    height, width = grid.shape
+    total = 0
+    for p in range(dcol.shape[1]):
+        r = row + drow[a, p]
+        c = col + dcol[a, p]
+        if 0 <= r < height and 0 <= c < width:
+            total += grid[r, c]
+    return total / norm
+
+
+@njit(cache=True, nogil=True)
+def correlate(grid, border, ox, oy, resolution, lx, ly, n_beams, cx, cy, ctheta, search_offset, search_step,
+              angle_offset, angle_step, penalize, distance_variance, minimum_distance_penalty, angle_variance,
+              minimum_angle_penalty, fine, mean, covariance):  # pragma: no cover - compiled
+    """Karto's CorrelateScan: search around ``(cx, cy, ctheta)``; return the best response (<= 1).
+
+    ``lx, ly``: the scan's points in the laser frame (m), only beams that have one; ``n_beams`` all
+    beams. Positions ``c + k search_step`` for ``|k search_step| <= search_offset`` in x and y, headings
+    ``ctheta + k angle_step`` within ``angle_offset``. ``penalize`` multiplies nonzero responses by the
+    distance and angle penalties (variances in m^2 and rad^2). ``mean`` float64 ``[3]`` receives the
+    average of the poses with the best response (headings averaged through cos and sin). ``covariance``
+    float64 ``[3, 3]``: on the coarse pass (``fine`` False) it is reset and receives the positional
+    covariance of the response surface (Karto's ComputePositionalCovariance); on the fine pass only its
+    heading variance is set (ComputeAngularCovariance).
+    """
+    inv_res = 1.0 / resolution
+    n_x = int(_round(search_offset * 2.0 / search_step)) + 1
+    n_angles = int(_round(angle_offset * 2.0 / angle_step)) + 1
+    heading0 = ctheta - angle_offset
+    dcol, drow = _lookup(lx, ly, heading0, angle_step, n_angles, inv_res)
+    norm = float(n_beams) * OCCUPIED_VALUE
+    responses = np.empty((n_x, n_x, n_angles))
+    for iy in range(n_x):
+        y = -search_offset + iy * search_step
+        row = int(_round((cy + y - oy) * inv_res)) + border
+        for ix in range(n_x):
+            x = -search_offset + ix * search_step
+            col = int(_round((cx + x - ox) * inv_res)) + border
+            for a in range(n_angles):
+                response = _response(grid, row, col, dcol, drow, a, norm)
+                if penalize and abs(response) >= _TOLERANCE:
+                    distance_penalty = 1.0 - _DISTANCE_PENALTY_GAIN * (x * x + y * y) / distance_variance
+                    distance_penalty = max(distance_penalty, minimum_distance_penalty)
+                    da = -angle_offset + a * angle_step
+                    angle_penalty = 1.0 - _ANGLE_PENALTY_GAIN * da * da / angle_variance
+                    angle_penalty = max(angle_penalty, minimum_angle_penalty)
+                    response *= distance_penalty * angle_penalty
+                responses[iy, ix, a] = response
+    best = -1.0
+    for iy in range(n_x):
+        for ix in range(n_x):
+            for a in range(n_angles):
+                best = max(best, responses[iy, ix, a])
+    sum_x = 0.0
+    sum_y = 0.0
+    sum_c = 0.0
+    sum_s = 0.0
+    count = 0
+    for iy in range(n_x):
+        for ix in range(n_x):
+            for a in range(n_angles):
+                if abs(responses[iy, ix, a] - best) < _TOLERANCE:
+                    sum_x += cx + (-search_offset + ix * search_step)
+                    sum_y += cy + (-search_offset + iy * search_step)
+                    heading = heading0 + a * angle_step
+                    sum_c += math.cos(heading)
+                    sum_s += math.sin(heading)
+                    count += 1
+    mean[0] = sum_x / count
+    mean[1] = sum_y / count
+    mean[2] = math.atan2(sum_s / count, sum_c / count)
+    if not fine:
+        _positional_covariance(responses, best, mean[0] - cx, mean[1] - cy, search_offset, search_step, angle_step,
+                               covariance)
+    else:
+        row = int(_round((mean[1] - oy) * inv_res)) + border
+        col = int(_round((mean[0] - ox) * inv_res)) + border
+        best_angle = mean[2]
+        while best_angle - ctheta < -math.pi:
+            best_angle += 2.0 * math.pi
+        while best_angle - ctheta > math.pi:
+            best_angle -= 2.0 * math.pi
+        total = 0.0
+        accumulated = 0.0
+        for a in range(n_angles):
+            response = _response(grid, row, col, dcol, drow, a, norm)
+            if response >= best - 0.1:
+                angle = heading0 + a * angle_step
+                total += response
+                accumulated += (angle - best_angle) ** 2 * response
+        if total > _TOLERANCE:
+            if accumulated < _TOLERANCE:
+                accumulated = angle_step * angle_step
+            accumulated /= total
+        else:
+            accumulated = 1000.0 * angle_step * angle_step
+        covariance[2, 2] = accumulated
+    return min(best, 1.0)
+
+
+@njit(cache=True, nogil=True)
+def _positional_covariance(responses, best, dx, dy, search_offset, search_step, angle_step,
+                           covariance):  # pragma: no cover - compiled
+    """Karto's ComputePositionalCovariance over the best response of each searched position."""
+    for i in range(3):
+        for j in range(3):
+            covariance[i, j] = 1.0 if i == j else 0.0
+    if best < _TOLERANCE:
+        covariance[0, 0] = MAX_VARIANCE
+        covariance[1, 1] = MAX_VARIANCE
+        covariance[2, 2] = 4.0 * angle_step * angle_step
+        return
+    n_x = responses.shape[0]
+    total = 0.0
+    xx = 0.0
+    xy = 0.0
+    yy = 0.0
+    for iy in range(n_x):
+        y = -search_offset + iy * search_step
+        for ix in range(n_x):
+            x = -search_offset + ix * search_step
+            response = responses[iy, ix, 0]
+            for a in range(1, responses.shape[2]):
+                response = max(response, responses[iy, ix, a])
+            if response >= best - 0.1:
+                total += response
+                xx += (x - dx) ** 2 * response
+                xy += (x - dx) * (y - dy) * response
+                yy += (y - dy) ** 2 * response
+    if total > _TOLERANCE:
+        minimum = 0.1 * search_step * search_step
+        multiplier = 1.0 / best
+        covariance[0, 0] = max(xx / total, minimum) * multiplier
+        covariance[0, 1] = xy / total * multiplier
+        covariance[1, 0] = xy / total * multiplier
+        covariance[1, 1] = max(yy / total, minimum) * multiplier
+        covariance[2, 2] = 4.0 * angle_step * angle_step
+    if abs(covariance[0, 0]) < _TOLERANCE:
+        covariance[0, 0] = MAX_VARIANCE
+    if abs(covariance[1, 1]) < _TOLERANCE:
+        covariance[1, 1] = MAX_VARIANCE

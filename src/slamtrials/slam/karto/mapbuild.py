@@ -1,0 +1,101 @@
+"""The published map: every node's scan traced from its optimized laser pose (Karto's OccupancyGrid).
+
+Rebuilt from the graph, not updated scan by scan: when the optimizer moves nodes, their scans are taken
+out at the old poses (weight -1, exact on the integer counts) and put back at the new ones, so the grid
+always equals a rebuild from scratch. Rays are those of :mod:`slamtrials.slam.gridmap`, with Karto's
+range threshold as the usable range. Cells follow Karto's rule: unknown until more than
+``min_pass_through`` beams crossed them, then occupied when hits / crossings exceeds
+``occupancy_threshold``, else free.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+from slamtrials.record import FREE, OCCUPIED, UNKNOWN, LaserGeometry, OccupancyGrid
+from slamtrials.slam.gridmap import GridMap
+
+__all__ = ["NodeMap"]
+
+
+@njit(cache=True, nogil=True)
+def _classify(hits, visits, min_pass_through, threshold):  # pragma: no cover - compiled
+    height, width = visits.shape
+    grid = np.empty((height, width), dtype=np.int8)
+    for r in range(height):
+        out = height - 1 - r
+        for c in range(width):
+            v = visits[r, c]
+            if v <= min_pass_through:
+                grid[out, c] = UNKNOWN
+            elif hits[r, c] > threshold * v:
+                grid[out, c] = OCCUPIED
+            else:
+                grid[out, c] = FREE
+    return grid
+
+
+class NodeMap:
+    """A :class:`~slamtrials.slam.gridmap.GridMap` of node scans that follows the nodes' poses.
+
+    Parameters
+    ----------
+    resolution:
+        Cell size (m).
+    laser:
+        The laser's geometry.
+    max_urange:
+        Beams are cut here (m) and then mark only free cells.
+    min_pass_through, occupancy_threshold:
+        Karto's cell rule (module docstring).
+    """
+
+    def __init__(self, resolution: float, laser: LaserGeometry, *, max_urange: float, min_pass_through: int,
+                 occupancy_threshold: float):
+        self.grid = GridMap(resolution)
+        self.laser = laser
+        self.max_urange = float(max_urange)
+        self.min_pass_through = int(min_pass_through)
+        self.occupancy_threshold = float(occupancy_threshold)
+        self._poses: list[NDArray[np.float64]] = []  # laser pose each traced scan was traced from
+        self._occupancy: OccupancyGrid | None = None
+
+    def update(self, laser_poses: NDArray[np.float64], scans: list[NDArray[np.float32]]) -> int:
+        """Make the grid that of ``scans[k]`` traced from ``laser_poses[k]`` (``[N, 3]``, map frame).
+
+        ``scans`` must extend the list given last time. Returns the number of scans traced or taken out.
+        """
+        poses, ranges, weights = [], [], []
+        for k, pose in enumerate(self._poses):
+            if not np.array_equal(pose, laser_poses[k]):
+                poses += [pose, laser_poses[k]]
+                ranges += [scans[k], scans[k]]
+                weights += [-1, 1]
+        for k in range(len(self._poses), len(scans)):
+            poses.append(laser_poses[k])
+            ranges.append(scans[k])
+            weights.append(1)
+        start = 0
+        while start < len(ranges):  # one compiled call per run of scans with the same beam count
+            end = start + 1
+            while end < len(ranges) and ranges[end].shape == ranges[start].shape:
+                end += 1
+            self.grid.integrate_many(np.array(poses[start:end]), np.stack(ranges[start:end]),
+                                     self.laser.beam_angles(ranges[start].shape[0]), np.array(weights[start:end]),
+                                     range_min=self.laser.range_min, range_max=self.laser.range_max,
+                                     max_urange=self.max_urange)
+            start = end
+        self._poses = [np.array(p, dtype=np.float64) for p in laser_poses[:len(scans)]]
+        self._occupancy = OccupancyGrid(grid=_classify(self.grid.hits, self.grid.visits, self.min_pass_through,
+                                                       self.occupancy_threshold),
+                                        resolution=self.grid.resolution, origin=self.grid.origin)
+        return len(ranges)
+
+    def occupancy(self) -> OccupancyGrid:
+        """The grid as of the last :meth:`update` (an empty 0 x 0 grid before the first)."""
+        if self._occupancy is None:
+            return OccupancyGrid(grid=np.zeros((0, 0), dtype=np.int8), resolution=self.grid.resolution,
+                                 origin=np.zeros(3))
+        return self._occupancy

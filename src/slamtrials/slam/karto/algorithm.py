@@ -193,7 +193,7 @@ class Karto:
                    ranges: NDArray[np.float64]) -> ScanNode:
         if self._angles is None or self._angles.shape[0] != ranges.shape[0]:
             self._angles = self.laser.beam_angles(ranges.shape[0])
-        has_point = np.isfinite(ranges) & (ranges > self.laser.range_min)
+        has_point = np.isfinite(ranges) & (ranges > self.laser.range_min) & (ranges < self.laser.range_max)
         r = np.where(has_point, ranges, np.nan)
         lx, ly = r * stablemath.cos(self._angles), r * stablemath.sin(self._angles)
         near = has_point & (ranges <= self.range_threshold)

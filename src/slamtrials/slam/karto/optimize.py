@@ -267,7 +267,8 @@ def optimize_pose_graph(poses: NDArray[np.float64], source: NDArray[np.int64], t
         new_cost = _cost(candidate, source, target, means, weights)
         rho = (cost - new_cost) / predicted if predicted > 0.0 else -1.0
         step_norm = math.sqrt(_dot(step, step))
-        state_norm = math.sqrt(_dot(x[1:].reshape(-1), x[1:].reshape(-1)))
+        relative = (x[1:] - x[0]).reshape(-1)  # the state measured from the fixed node: where the odometry
+        state_norm = math.sqrt(_dot(relative, relative))  # frame's origin lies must not matter
         if rho > MIN_RELATIVE_DECREASE:
             change = cost - new_cost
             x = candidate

@@ -1,0 +1,97 @@
+"""The karto algorithm end to end on the synthetic corridor loop, its plug-in contract and bad input."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from slamtrials.cli.main import app
+from slamtrials.errors import ConfigError
+from slamtrials.record import Frame
+from slamtrials.slam import ALGORITHMS, make_algorithm
+from slamtrials.slam.karto import Karto, KartoConfig
+
+runner = CliRunner()
+
+
+def _run(square_loop, **overrides):
+    karto = make_algorithm("karto", square_loop.laser.to_dict(), overrides=overrides or None)
+    karto.reset(np.random.default_rng(0))
+    online = np.array([karto.process(frame) for frame in square_loop.frames])
+    return karto, online
+
+
+def _end_error(poses, truth):
+    return math.hypot(poses[-1, 0] - truth[-1, 0], poses[-1, 1] - truth[-1, 1])
+
+
+def test_loop_closure_on_a_square_loop_removes_most_of_the_drift(square_loop):
+    karto, online = _run(square_loop)
+    truth = square_loop.truth
+    assert karto.loop_closures >= 1 and len(karto.optimizations) >= 1
+    assert _end_error(square_loop.odometry, truth) > 1.0  # 3 % turn and 2 % travel drift over a 60 m lap
+    closed = karto.trajectory().poses
+    open_loop, _ = _run(square_loop, do_loop_closing=False)
+    assert open_loop.loop_closures == 0
+    drifted = open_loop.trajectory().poses
+    # back over the start, the closed loop ends where it should; the open one keeps its drift
+    assert _end_error(closed, truth) < 0.15 < 0.3 < _end_error(drifted, truth)
+    nodes = [n.frame for n in karto.graph.nodes]
+    closed_errors = np.hypot(*(closed[nodes, :2] - truth[nodes, :2]).T)
+    drifted_errors = np.hypot(*(drifted[nodes, :2] - truth[nodes, :2]).T)
+    assert closed_errors.mean() < drifted_errors.mean() and closed_errors.max() < 0.3
+
+
+def test_trajectory_has_one_pose_per_frame_and_nodes_follow_the_update_rule(square_loop):
+    karto, online = _run(square_loop)
+    trajectory = karto.trajectory()
+    assert len(trajectory) == len(square_loop.frames)
+    np.testing.assert_array_equal(trajectory.t, [f.t for f in square_loop.frames])
+    np.testing.assert_array_equal(karto.online_estimates(), online)
+    nodes = karto.graph.nodes
+    assert karto.updates == len(nodes) and nodes[0].frame == 0
+    for a, b in zip(nodes[:-1], nodes[1:]):
+        moved = math.hypot(*(b.odometry[:2] - a.odometry[:2]))
+        turned = abs((b.odometry[2] - a.odometry[2] + math.pi) % (2 * math.pi) - math.pi)
+        assert b.t - a.t >= 0.5 and (moved >= 0.5 - 1e-9 or turned >= 0.5)
+    # a frame at a node is estimated at that node's final pose
+    for node in nodes[::10]:
+        np.testing.assert_allclose(trajectory.poses[node.frame], node.pose, atol=1e-12)
+    grid = karto.occupancy()
+    assert grid.grid.size > 0 and (grid.grid == 100).any() and (grid.grid == 0).any()
+
+
+def test_same_input_gives_the_same_bits(square_loop):
+    first, _ = _run(square_loop)
+    second, _ = _run(square_loop)
+    np.testing.assert_array_equal(first.trajectory().poses, second.trajectory().poses)
+    np.testing.assert_array_equal(first.occupancy().grid, second.occupancy().grid)
+
+
+def test_laser_as_dict_or_laser_geometry(square_loop):
+    as_geometry = Karto(KartoConfig(), square_loop.laser)
+    as_dict = make_algorithm("karto", square_loop.laser.to_dict())
+    assert as_geometry.laser == as_dict.laser == square_loop.laser and ALGORITHMS["karto"] is Karto
+
+
+def test_a_frame_without_readings_is_refused(square_loop):
+    karto = make_algorithm("karto", square_loop.laser.to_dict())
+    with pytest.raises(ConfigError, match="no laser readings"):
+        karto.process(Frame(t=0.0, ranges=np.zeros(0, dtype=np.float32), odometry=np.zeros(3), truth=np.zeros(3)))
+
+
+def test_cli_bad_parameters_and_a_log_without_scans_exit_2_with_one_line(tmp_path):
+    log = tmp_path / "odometry_only.clf"
+    log.write_text("ODOM 0.0 0.0 0.0 0 0 0 1.0 host 1.0\nODOM 0.1 0.0 0.0 0 0 0 1.2 host 1.2\n")
+    for extra in (["--set", "nope=1"], ["--set", "minimum_travel_distance=-1"], []):
+        result = runner.invoke(app, ["slam", "--algorithm", "karto", "--input", str(log), "--out", str(tmp_path / "o"),
+                                     *extra])
+        assert result.exit_code == 2, result.output
+        assert len(result.output.strip().splitlines()) == 1 and "Traceback" not in result.output
+    bad = runner.invoke(app, ["slam", "-a", "karto", "-i", str(log), "-o", str(tmp_path / "o"), "--set", "nope=1"])
+    assert "no parameter nope" in bad.output
+    empty = runner.invoke(app, ["slam", "-a", "karto", "-i", str(log), "-o", str(tmp_path / "o")])
+    assert "odometry_only.clf" in empty.output

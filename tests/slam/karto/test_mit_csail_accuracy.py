@@ -1,0 +1,42 @@
+"""Karto's accuracy on real data: the whole MIT CSAIL log against its Freiburg benchmark relations.
+
+karto with slam_toolbox's defaults over all 1,988 scans of ``mit-csail.clf``; the outputs are written as
+``slamtrials slam`` writes them and ``trajectory.clf`` is evaluated as ``slamtrials evaluate -e
+trajectory.clf -r mit-csail.relations`` does. It gave 0.049 m mean translational error when the test was
+written (588 nodes, 13 loop closures); the bound is that plus a margin. The issue's target, 0.035 m, is
+NOT met yet (docs/karto.md, "Accuracy"). Skipped when the data set is absent.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from slamtrials.evaluation import PoseTriple, evaluate_files
+from slamtrials.slamrun import load_recording, run_slam, write_slam_outputs
+
+REPO = Path(__file__).resolve().parents[3]
+DATA = Path(os.environ.get("SLAMTRIALS_SHARED", REPO.parent / "shared")) / "data" / "mit-csail"
+LOG = DATA / "mit-csail.clf"
+RELATIONS = DATA / "mit-csail.relations"
+
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.skipif(not (LOG.is_file() and RELATIONS.is_file()), reason=f"no MIT CSAIL data in {DATA}"),
+]
+
+
+def test_karto_defaults_on_mit_csail(tmp_path):
+    record = load_recording(LOG)
+    result = run_slam(record, "karto", seed=0, source=str(LOG))
+    assert result.config["minimum_travel_distance"] == 0.5
+    assert 500 <= result.updates <= 700  # one node per 0.5 m or 0.5 rad of odometry, at most every 0.5 s
+    write_slam_outputs(result, tmp_path)
+    evaluation = evaluate_files(tmp_path / "trajectory.clf", RELATIONS)
+    assert evaluation.translational.n == 1172 and len(evaluation.errors.unmatched) == 0
+    assert evaluation.translational.mean <= 0.055
+    assert evaluation.rotational.mean <= 0.06
+    odometry = evaluate_files(tmp_path / "trajectory.clf", RELATIONS, estimate_pose=PoseTriple.second)
+    assert odometry.translational.mean > 10 * evaluation.translational.mean

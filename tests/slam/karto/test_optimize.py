@@ -1,0 +1,61 @@
+"""The sparse Levenberg-Marquardt pose-graph optimizer on graphs with known solutions."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from slamtrials.geometry import ominus
+from slamtrials.slam.karto.optimize import information, optimize_pose_graph
+
+
+def _square(n_side: int = 5) -> np.ndarray:
+    poses = []
+    for side in range(4):
+        heading = side * math.pi / 2
+        for k in range(n_side):
+            if side == 0:
+                x, y = k, 0.0
+            elif side == 1:
+                x, y = n_side, k
+            elif side == 2:
+                x, y = n_side - k, n_side
+            else:
+                x, y = 0.0, n_side - k
+            poses.append((x, y, (heading + math.pi) % (2 * math.pi) - math.pi))
+    return np.array(poses, dtype=np.float64)
+
+
+def test_square_loop_with_exact_measurements_is_recovered_from_a_distorted_start():
+    truth = _square()
+    n = truth.shape[0]
+    source = np.array(list(range(n - 1)) + [n - 1])
+    target = np.array(list(range(1, n)) + [0])
+    means = ominus(truth[source], truth[target])  # consecutive edges and the loop-closing edge
+    weights = np.repeat(information(np.diag([0.01, 0.01, 0.001]))[None], source.shape[0], axis=0)
+    start = truth.copy()
+    rng = np.random.default_rng(3)
+    start[1:] += rng.normal(0.0, [0.3, 0.3, 0.1], size=(n - 1, 3))
+    result = optimize_pose_graph(start, source, target, means, weights)
+    np.testing.assert_array_equal(result.poses[0], truth[0])  # the first node is held fixed
+    np.testing.assert_allclose(result.poses[:, :2], truth[:, :2], atol=1e-4)
+    heading_error = (result.poses[:, 2] - truth[:, 2] + math.pi) % (2 * math.pi) - math.pi
+    assert np.abs(heading_error).max() < 1e-4
+    assert result.final_cost < 1e-8 < result.initial_cost
+
+
+def test_inconsistent_loop_spreads_the_error_by_the_weights():
+    # three poses on a line; the direct edge 0 -> 2 says 2.2 m, the chain says 2.0 m; equal weights
+    source, target = np.array([0, 1, 0]), np.array([1, 2, 2])
+    means = np.array([[1.0, 0, 0], [1.0, 0, 0], [2.2, 0, 0]])
+    weights = np.repeat(np.eye(3)[None], 3, axis=0)
+    result = optimize_pose_graph(np.array([[0.0, 0, 0], [1.0, 0, 0], [2.0, 0, 0]]), source, target, means, weights)
+    # least squares: x2 = 2 x1 and 2 x2 - x1 = 3.2, so x1 = 3.2 / 3 and x2 = 6.4 / 3
+    np.testing.assert_allclose(result.poses[:, 0], [0.0, 3.2 / 3, 6.4 / 3], atol=1e-6)
+
+
+def test_information_inverts_a_covariance():
+    cov = np.array([[0.04, 0.01, 0.0], [0.01, 0.09, 0.0], [0.0, 0.0, 0.002]])
+    product = information(cov) @ cov
+    np.testing.assert_allclose(product, np.eye(3), atol=1e-12)

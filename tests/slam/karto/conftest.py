@@ -19,11 +19,12 @@ def _box(x0: float, y0: float, x1: float, y1: float) -> list[tuple[float, float,
 
 def square_loop_segments() -> np.ndarray:
     """Walls ``[S, 4]`` (x0, y0, x1, y1): outer square of side 14 m, inner block of side 10 m (a 2 m
-    corridor around it), with notches and pillars so that no stretch of corridor looks like another."""
+    corridor around it), with notches on the walls (none on the centre line the robot drives) so that no
+    stretch of corridor looks like another."""
     walls = _box(-7, -7, 7, 7) + _box(-5, -5, 5, 5)
-    features = [(-6.6, -3.0, -6.0, -2.4), (6.0, 1.0, 6.6, 1.8), (-2.0, 6.2, -1.2, 6.6), (2.5, -6.6, 3.3, -6.1),
-                (-5.0, 2.0, -4.6, 2.8), (4.6, -3.5, 5.0, -2.5), (0.5, 4.6, 1.1, 5.0), (-3.6, -5.0, -2.6, -4.6),
-                (-6.2, 4.5, -5.9, 4.8), (5.8, 5.5, 6.2, 5.9), (5.7, -6.0, 6.1, -5.6), (-6.0, -6.3, -5.6, -5.9)]
+    features = [(-7.0, -3.0, -6.5, -2.4), (6.5, 1.0, 7.0, 1.8), (-2.0, 6.5, -1.2, 7.0), (2.5, -7.0, 3.3, -6.5),
+                (-5.4, 2.0, -5.0, 2.8), (5.0, -3.5, 5.4, -2.5), (0.5, 5.0, 1.1, 5.4), (-3.6, -5.4, -2.6, -5.0),
+                (-7.0, 4.5, -6.6, 4.8), (6.6, 5.0, 7.0, 5.6), (6.6, -6.0, 7.0, -5.4), (-5.6, -7.0, -5.0, -6.6)]
     for box in features:
         walls += _box(*box)
     return np.array(walls, dtype=np.float64)

@@ -96,3 +96,12 @@ def test_cli_bad_parameters_and_a_log_without_scans_exit_2_with_one_line(tmp_pat
     assert "no parameter nope" in bad.output
     empty = runner.invoke(app, ["slam", "-a", "karto", "-i", str(log), "-o", str(tmp_path / "o")])
     assert "odometry_only.clf" in empty.output
+
+
+def test_a_trial_config_names_karto_alone():
+    from slamtrials.trial.config import TrialConfig
+
+    config = TrialConfig.from_dict({"slam": {"algorithm": "karto"}})
+    assert isinstance(config.slam.resolved(), KartoConfig)
+    with pytest.raises(ConfigError, match="no parameter particles"):
+        TrialConfig.from_dict({"slam": {"algorithm": "karto", "params": {"particles": 30}}})

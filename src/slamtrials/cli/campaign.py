@@ -165,7 +165,7 @@ def status(folder: Annotated[Path, typer.Argument(help="Campaign folder.")]) -> 
 @app.command("replay")
 def replay(
     source: Annotated[Path, typer.Argument(help="Folder of the campaign whose recorded runs are re-evaluated.")],
-    algorithm: Annotated[str, typer.Option("--algorithm", "-a", help="SLAM algorithm to evaluate (built-in: gmapping, odometry).")],
+    algorithm: Annotated[str, typer.Option("--algorithm", "-a", help="SLAM algorithm to evaluate (built-in: gmapping, karto, odometry).")],
     out: Annotated[Path, typer.Option("--out", "-o", help="Folder of the new campaign (an existing replay is resumed).")],
     preset: Annotated[str | None, typer.Option("--preset", "-p", help="Named parameter set of the algorithm.")] = None,
     settings: Annotated[list[str] | None, typer.Option("--set", help="Parameter override key=value (value read as YAML); repeatable.")] = None,

@@ -42,7 +42,7 @@ def parse_settings(settings: list[str]) -> dict[str, Any]:
 
 
 def slam(
-    algorithm: Annotated[str, typer.Option("--algorithm", "-a", help="Registered SLAM algorithm (built-in: gmapping, odometry).")],
+    algorithm: Annotated[str, typer.Option("--algorithm", "-a", help="Registered SLAM algorithm (built-in: gmapping, karto, odometry).")],
     input_: Annotated[Path, typer.Option("--input", "-i", help="Run folder, CARMEN log (.clf/.log, .gz) or ROS bag.")],
     out: Annotated[Path, typer.Option("--out", "-o", help="Folder for trajectory.tum/.clf, map.yaml/.pgm/.png, timing.csv, slam.json.")],
     preset: Annotated[str | None, typer.Option("--preset", "-p", help="Named parameter set of the algorithm.")] = None,

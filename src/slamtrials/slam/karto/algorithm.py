@@ -197,7 +197,8 @@ class Karto:
         r = np.where(has_point, ranges, np.nan)
         lx, ly = r * stablemath.cos(self._angles), r * stablemath.sin(self._angles)
         near = has_point & (ranges <= self.range_threshold)
-        barycenter = np.array([lx[near].mean(), ly[near].mean()]) if near.any() else None
+        count = int(near.sum())  # fsum: correctly rounded, the same on every machine
+        barycenter = np.array([math.fsum(lx[near]) / count, math.fsum(ly[near]) / count]) if count else None
         return ScanNode(frame=frame_index, t=t, odometry=odometry, pose=pose, lx=lx, ly=ly, barycenter=barycenter,
                         ranges=np.asarray(ranges, dtype=np.float32))
 

@@ -59,7 +59,7 @@ class NodeMap:
         self.max_urange = float(max_urange)
         self.min_pass_through = int(min_pass_through)
         self.occupancy_threshold = float(occupancy_threshold)
-        self._poses: list[NDArray[np.float64]] = []  # laser pose each traced scan was traced from
+        self._poses = np.zeros((0, 3))  # laser pose each traced scan was traced from
         self._occupancy: OccupancyGrid | None = None
 
     def update(self, laser_poses: NDArray[np.float64], scans: list[NDArray[np.float32]]) -> int:
@@ -67,13 +67,14 @@ class NodeMap:
 
         ``scans`` must extend the list given last time. Returns the number of scans traced or taken out.
         """
+        laser_poses = np.asarray(laser_poses, dtype=np.float64).reshape(-1, 3)
+        traced = self._poses.shape[0]
         poses, ranges, weights = [], [], []
-        for k, pose in enumerate(self._poses):
-            if not np.array_equal(pose, laser_poses[k]):
-                poses += [pose, laser_poses[k]]
-                ranges += [scans[k], scans[k]]
-                weights += [-1, 1]
-        for k in range(len(self._poses), len(scans)):
+        for k in np.flatnonzero(np.any(self._poses != laser_poses[:traced], axis=1)).tolist():
+            poses += [self._poses[k], laser_poses[k]]
+            ranges += [scans[k], scans[k]]
+            weights += [-1, 1]
+        for k in range(traced, len(scans)):
             poses.append(laser_poses[k])
             ranges.append(scans[k])
             weights.append(1)
@@ -87,7 +88,7 @@ class NodeMap:
                                      range_min=self.laser.range_min, range_max=self.laser.range_max,
                                      max_urange=self.max_urange)
             start = end
-        self._poses = [np.array(p, dtype=np.float64) for p in laser_poses[:len(scans)]]
+        self._poses = laser_poses[:len(scans)].copy()
         self._occupancy = OccupancyGrid(grid=_classify(self.grid.hits, self.grid.visits, self.min_pass_through,
                                                        self.occupancy_threshold),
                                         resolution=self.grid.resolution, origin=self.grid.origin)

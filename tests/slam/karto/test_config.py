@@ -57,3 +57,20 @@ def test_smear_deviation_must_fit_karto_kernel_bounds():
 def test_presets_are_the_defaults():
     cls = get_algorithm("karto")
     assert resolve_config(cls, preset="paper") == resolve_config(cls)
+
+
+def test_slam_karto_preset_is_slam_karto_s_mapper_params():
+    # slam_karto's config/mapper_params.yaml (open_karto's own defaults); its time interval 3600 s
+    # means "no time rule", which is 0 in slam_toolbox's sense used here
+    config = resolve_config(get_algorithm("karto"), preset="slam_karto")
+    expected = {"minimum_travel_distance": 0.2, "minimum_travel_heading": 0.174, "scan_buffer_size": 70,
+                "scan_buffer_maximum_scan_distance": 20.0, "link_match_minimum_response_fine": 0.8,
+                "link_scan_maximum_distance": 10.0, "loop_search_maximum_distance": 4.0,
+                "loop_match_maximum_variance_coarse": 0.4, "loop_match_minimum_response_coarse": 0.8,
+                "loop_match_minimum_response_fine": 0.8, "correlation_search_space_dimension": 0.3,
+                "correlation_search_space_smear_deviation": 0.03, "distance_variance_penalty": 0.3,
+                "angle_variance_penalty": 0.349, "use_response_expansion": False, "minimum_time_interval": 0.0,
+                "loop_search_space_dimension": 8.0, "coarse_angle_resolution": 0.0349}
+    dumped = config.model_dump()
+    for name, value in expected.items():
+        assert dumped[name] == value, name

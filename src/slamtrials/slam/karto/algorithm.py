@@ -118,6 +118,18 @@ class Karto:
         # just `algorithm: karto` (the seed paper ran GMapping only)
         "paper": {},
         "slam_toolbox": {},
+        # slam_karto's config/mapper_params.yaml, which are open_karto's own defaults; slam_karto has no
+        # time throttle between nodes, and leaves Karto's default range threshold (12 m)
+        "slam_karto": {
+            "minimum_time_interval": 0.0, "minimum_travel_distance": 0.2, "minimum_travel_heading": 0.174,
+            "scan_buffer_size": 70, "scan_buffer_maximum_scan_distance": 20.0,
+            "link_match_minimum_response_fine": 0.8, "link_scan_maximum_distance": 10.0,
+            "loop_search_maximum_distance": 4.0, "loop_match_maximum_variance_coarse": 0.4,
+            "loop_match_minimum_response_coarse": 0.8, "loop_match_minimum_response_fine": 0.8,
+            "correlation_search_space_dimension": 0.3, "correlation_search_space_smear_deviation": 0.03,
+            "distance_variance_penalty": 0.3, "angle_variance_penalty": 0.349, "use_response_expansion": False,
+            "max_laser_range": 12.0,
+        },
     }
 
     def __init__(self, config: KartoConfig, laser: LaserGeometry | dict[str, Any]):

@@ -115,7 +115,7 @@ def run_slam(record: RunRecord, algorithm_name: str, *, preset: str | None = Non
         raise ConfigError("the recording has no frames")
     cls = get_algorithm(algorithm_name)
     config = resolve_config(cls, preset=preset, overrides=overrides)
-    algorithm = cls(config, dict(record.laser))
+    algorithm = cls(config, record.laser)
     algorithm.reset(np.random.default_rng(seed))
     total = len(record)
     timing = np.empty(total, dtype=np.float64)

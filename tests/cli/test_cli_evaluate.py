@@ -14,12 +14,12 @@ from slamtrials.geometry import compose, ominus
 from slamtrials.io.relations import read_relations, write_relations
 from slamtrials.io.runfolder import write_run
 from slamtrials.io.tum import write_tum
-from slamtrials.record import Relations, RunRecord, Trajectory
+from slamtrials.record import LaserGeometry, Relations, RunRecord, Trajectory
 
 runner = CliRunner()
 REPO = Path(__file__).resolve().parents[2]
 DATA = Path(os.environ.get("SLAMTRIALS_SHARED", REPO.parent / "shared")) / "data" / "mit-csail"
-LASER = {"angle_min": -2.356, "angle_increment": 0.0087, "range_min": 0.0, "range_max": 30.0, "mount": [0.0, 0.0, 0.0]}
+LASER = LaserGeometry.from_dict({"angle_min": -2.356, "angle_increment": 0.0087, "range_min": 0.0, "range_max": 30.0, "mount": [0.0, 0.0, 0.0]})
 
 
 def _summary_rows(output: str) -> tuple[list[float], list[float]]:

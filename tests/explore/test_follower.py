@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -9,9 +10,10 @@ import pytest
 
 from slamtrials.explore import ExploreConfig, PathFollower
 from slamtrials.explore.follower import free_travel, scan_points, turn_rate
+from slamtrials.record import LaserGeometry
 
-LASER = {"angle_min": -math.radians(135), "angle_increment": math.radians(0.5), "range_min": 0.0,
-         "range_max": 30.0, "mount": [0.0, 0.0, 0.0]}
+LASER = LaserGeometry.from_dict({"angle_min": -math.radians(135), "angle_increment": math.radians(0.5), "range_min": 0.0,
+         "range_max": 30.0, "mount": [0.0, 0.0, 0.0]})
 BEAMS = 541
 
 
@@ -21,14 +23,14 @@ def empty_scan():
 
 def wall_scan(distance):
     """A wall across the robot's path, ``distance`` m ahead (robot frame x = distance)."""
-    angles = LASER["angle_min"] + LASER["angle_increment"] * np.arange(BEAMS)
+    angles = LASER.angle_min + LASER.angle_increment * np.arange(BEAMS)
     with np.errstate(divide="ignore"):
         r = np.where(np.cos(angles) > 1e-6, distance / np.cos(angles), 30.0)
     return np.minimum(r, 30.0).astype(np.float32)
 
 
 def test_scan_points_use_the_mount_and_drop_max_range():
-    laser = dict(LASER, mount=[0.1, 0.0, math.pi / 2])
+    laser = dataclasses.replace(LASER, mount=(0.1, 0.0, math.pi / 2))
     r = empty_scan()
     r[270] = 2.0  # the middle beam: straight ahead of the laser, which looks left
     pts = scan_points(r, laser)

@@ -3,6 +3,7 @@ and a FormatError naming file and line for every kind of malformed log."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 from pathlib import Path
@@ -22,7 +23,7 @@ from slamtrials.io.carmen import (
     write_carmen,
 )
 from slamtrials.io.relations import read_relations
-from slamtrials.record import RunRecord
+from slamtrials.record import LaserGeometry, RunRecord
 
 REPO = Path(__file__).resolve().parents[2]
 SHARED = Path(os.environ.get("SLAMTRIALS_SHARED", REPO.parent / "shared"))
@@ -154,7 +155,7 @@ def _record(n: int = 40, beams: int = 541, seed: int = 1) -> RunRecord:
         t=np.arange(n) * 0.1, scans=rng.uniform(0.05, 30, (n, beams)).astype(np.float32),
         odometry=np.cumsum(rng.normal(0, 0.05, (n, 3)), axis=0), truth=np.cumsum(rng.normal(0, 0.05, (n, 3)), axis=0),
         stalled=np.zeros(n, dtype=bool),
-        laser={"angle_min": -0.75 * math.pi, "angle_increment": increment, "range_min": 0.02, "range_max": 30.0, "mount": [0.1, -0.02, 0.01]},
+        laser=LaserGeometry.from_dict({"angle_min": -0.75 * math.pi, "angle_increment": increment, "range_min": 0.02, "range_max": 30.0, "mount": [0.1, -0.02, 0.01]}),
         metadata={"world": "lab"},
     )
 
@@ -169,12 +170,12 @@ def test_run_export_and_import(tmp_path, kind):
     np.testing.assert_array_equal(back.truth, r6(record.truth))
     np.testing.assert_array_equal(back.odometry, r6(record.odometry))
     assert not back.stalled.any()
-    assert back.laser["mount"] == [0.1, -0.02, 0.01] and back.laser["range_min"] == 0.02 and back.laser["range_max"] == 30.0
+    assert back.laser.mount == (0.1, -0.02, 0.01) and back.laser.range_min == 0.02 and back.laser.range_max == 30.0
     if kind == "ROBOTLASER1":
-        assert (back.laser["angle_min"], back.laser["angle_increment"]) == (record.laser["angle_min"], record.laser["angle_increment"])
+        assert (back.laser.angle_min, back.laser.angle_increment) == (record.laser.angle_min, record.laser.angle_increment)
     else:
-        assert back.laser["angle_min"] == pytest.approx(record.laser["angle_min"], rel=1e-15)
-        assert back.laser["angle_increment"] == pytest.approx(record.laser["angle_increment"], rel=1e-15)
+        assert back.laser.angle_min == pytest.approx(record.laser.angle_min, rel=1e-15)
+        assert back.laser.angle_increment == pytest.approx(record.laser.angle_increment, rel=1e-15)
     assert back.metadata["truth_source"] == TRUTH_SOURCE and back.metadata["carmen_kind"] == kind
 
 
@@ -189,7 +190,7 @@ def test_export_writes_odometry_velocities(tmp_path):
 
 def test_flaser_export_refuses_an_off_centre_scan(tmp_path):
     record = _record(n=3, beams=5)
-    record.laser["angle_min"] = -0.1
+    record.laser = dataclasses.replace(record.laser, angle_min=-0.1)
     with pytest.raises(ValueError, match="centred"):
         write_carmen(tmp_path / "run.clf", carmen_from_run(record, kind="FLASER"))
 

@@ -88,7 +88,7 @@ def replay_slam(record: RunRecord, slam: SlamSettings, seed: int) -> RunRecord:
     from slamtrials.slam import get_algorithm
 
     config = slam.resolved()
-    algorithm = get_algorithm(slam.algorithm)(config, dict(record.laser))
+    algorithm = get_algorithm(slam.algorithm)(config, record.laser)
     sequence = np.random.SeedSequence(int(seed))
     _, slam_seed = sequence.spawn(2)
     algorithm.reset(np.random.default_rng(slam_seed))

@@ -51,6 +51,7 @@ from slamtrials.explore.goals import GoalRecord
 from slamtrials.explore.goalsearch import Found, GoalSearch
 from slamtrials.explore.gridframe import GridFrame, map_arrays
 from slamtrials.explore.recovery import Recovery, StuckMonitor
+from slamtrials.record import LaserGeometry
 
 __all__ = ["ExploreStats", "Explorer"]
 
@@ -180,7 +181,7 @@ class Explorer:
 
     # --- the control step --------------------------------------------------------------------------------
 
-    def command(self, t: float, pose: ArrayLike, ranges: ArrayLike, laser: dict[str, Any], occupancy: Any, *,
+    def command(self, t: float, pose: ArrayLike, ranges: ArrayLike, laser: LaserGeometry, occupancy: Any, *,
                 stalled: bool = False) -> tuple[float, float]:
         """The velocity command ``(v m/s, w rad/s)`` for the next control period.
 
@@ -193,8 +194,7 @@ class Explorer:
         ranges:
             float32 ``[B]`` the current laser scan (m).
         laser:
-            Laser geometry: ``angle_min``, ``angle_increment`` (rad), ``range_min``, ``range_max`` (m),
-            ``mount`` (laser pose in the base frame).
+            The laser's geometry (beam angles, valid ranges, pose in the base frame).
         occupancy:
             The current map: an object with ``grid`` (int8 ``[H, W]``, 100 occupied, 0 free, -1
             unknown, row 0 at the top), ``resolution`` (m) and ``origin`` (float64 ``[3]``, the map-frame
@@ -212,7 +212,7 @@ class Explorer:
         self._stuck = self._monitor.update(float(t), pose, v, self.config.control_period, self._following)
         return v, w
 
-    def _decide(self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: dict[str, Any],
+    def _decide(self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: LaserGeometry,
                 occupancy: Any) -> tuple[float, float]:
         cfg = self.config
         if self._done:
@@ -289,7 +289,7 @@ class Explorer:
         self.stats.look_arounds += 1
         self._follower.clear()
 
-    def _start_recovery(self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: dict[str, Any],
+    def _start_recovery(self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: LaserGeometry,
                         occupancy: Any) -> tuple[float, float]:
         self.stats.recoveries += 1
         self._stuck = False

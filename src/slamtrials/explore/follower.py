@@ -46,7 +46,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numba import njit
@@ -54,6 +53,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from slamtrials import stablemath
 from slamtrials.explore.config import ExploreConfig
+from slamtrials.record import LaserGeometry
 
 __all__ = ["FollowCommand", "PathFollower", "free_travel", "scan_points", "turn_rate"]
 
@@ -84,10 +84,10 @@ def turn_rate(error: float, max_rate: float, max_accel: float) -> float:
 _ANGLE_CACHE: dict[tuple[int, float, float, float], tuple[NDArray[np.float64], NDArray[np.float64]]] = {}
 
 
-def _beam_directions(beams: int, laser: dict[str, Any]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def _beam_directions(beams: int, laser: LaserGeometry) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """(cos, sin) of every beam's direction in the base frame, cached per laser geometry."""
-    mth = float(laser.get("mount", (0.0, 0.0, 0.0))[2])
-    key = (beams, float(laser["angle_min"]), float(laser["angle_increment"]), mth)
+    mth = laser.mount[2]
+    key = (beams, laser.angle_min, laser.angle_increment, mth)
     found = _ANGLE_CACHE.get(key)
     if found is None:
         angles = key[1] + key[2] * np.arange(beams) + mth
@@ -111,17 +111,14 @@ def _scan_points(ranges, cos, sin, mx, my, range_min, range_max):  # pragma: no 
     return out[:k]
 
 
-def scan_points(ranges: ArrayLike, laser: dict[str, Any]) -> NDArray[np.float64]:
+def scan_points(ranges: ArrayLike, laser: LaserGeometry) -> NDArray[np.float64]:
     """float64 ``[K, 2]`` scan returns in the robot base frame (m).
 
-    Beams with NaN, ``r <= range_min`` or ``r >= range_max`` (no return) are left out. ``laser`` is the
-    geometry dict (``angle_min``, ``angle_increment``, ``range_min``, ``range_max``, optional ``mount``).
+    Beams with NaN, ``r <= range_min`` or ``r >= range_max`` (no return) are left out.
     """
     r = np.ascontiguousarray(ranges, dtype=np.float64)
     cos, sin = _beam_directions(r.shape[0], laser)
-    mount = laser.get("mount", (0.0, 0.0, 0.0))
-    return _scan_points(r, cos, sin, float(mount[0]), float(mount[1]), float(laser.get("range_min", 0.0)),
-                        float(laser["range_max"]))
+    return _scan_points(r, cos, sin, laser.mount[0], laser.mount[1], laser.range_min, laser.range_max)
 
 
 @njit(cache=True, nogil=True)
@@ -288,7 +285,7 @@ class PathFollower:
         """Record a command given by someone else (e.g. a recovery), for the acceleration limits."""
         self._v, self._w = float(v), float(w)
 
-    def command(self, pose: ArrayLike, ranges: ArrayLike, laser: dict[str, Any]) -> FollowCommand:
+    def command(self, pose: ArrayLike, ranges: ArrayLike, laser: LaserGeometry) -> FollowCommand:
         """Velocity command towards the path from ``pose`` (float64 ``[3]``, map frame) given the current scan."""
         cfg = self.config
         x, y, theta = (float(v) for v in np.asarray(pose, dtype=np.float64)[:3])

@@ -31,6 +31,7 @@ from slamtrials import stablemath
 from slamtrials.explore.config import ExploreConfig
 from slamtrials.explore.follower import scan_points
 from slamtrials.explore.gridframe import FREE_BELOW, GridFrame, map_arrays
+from slamtrials.record import LaserGeometry
 
 __all__ = ["Recovery", "StuckMonitor", "open_side", "segment_clear"]
 
@@ -88,11 +89,11 @@ class StuckMonitor:
         return math.hypot(x - x0, y - y0) < self.config.stuck_ratio * commanded
 
 
-def open_side(ranges: ArrayLike, laser: dict[str, Any]) -> float:
+def open_side(ranges: ArrayLike, laser: LaserGeometry) -> float:
     """+1.0 if the scan sees more room to the left (beam angle > 0) than to the right, else -1.0."""
     r = np.asarray(ranges, dtype=np.float64)
-    angles = float(laser["angle_min"]) + float(laser["angle_increment"]) * np.arange(r.shape[0])
-    r = np.where(np.isfinite(r), np.minimum(r, float(laser["range_max"])), 0.0)
+    angles = laser.beam_angles(r.shape[0])
+    r = np.where(np.isfinite(r), np.minimum(r, laser.range_max), 0.0)
     r = np.minimum(r, 5.0)  # what matters is the room nearby
     left = float(r[angles > 0.0].sum())
     right = float(r[angles < 0.0].sum())
@@ -143,7 +144,7 @@ class Recovery:
         """Abort any manoeuvre."""
         self._phases = []
 
-    def start(self, t: float, pose: ArrayLike, ranges: ArrayLike, laser: dict[str, Any], occupancy: Any) -> None:
+    def start(self, t: float, pose: ArrayLike, ranges: ArrayLike, laser: LaserGeometry, occupancy: Any) -> None:
         """Begin a manoeuvre at time ``t`` (s) from ``pose`` (map frame) with the current scan and map.
 
         If the scan shows an obstacle within ``_CONTACT`` of the robot's edge, the robot turns so

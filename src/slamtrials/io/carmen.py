@@ -42,7 +42,7 @@ from slamtrials.io.carmen_log import LASER_KINDS, ROBOTLASER_EXTRA, CarmenLaser,
 from slamtrials.io.carmen_read import PARAM_MOUNT, PARAM_RANGE_MIN, read_carmen
 from slamtrials.io.carmen_write import write_carmen
 from slamtrials.io.textfile import float_text
-from slamtrials.record import RunRecord
+from slamtrials.record import LaserGeometry, RunRecord
 
 __all__ = [
     "CarmenLaser",
@@ -101,14 +101,13 @@ def carmen_from_run(record: RunRecord, *, kind: str = "ROBOTLASER1", hostname: s
     if kind == "ROBOTLASER1":
         extra = np.zeros((len(t), len(ROBOTLASER_EXTRA)))
         extra[:, 0], extra[:, 1] = tv, rv
-    mount = [float(v) for v in laser.get("mount", (0.0, 0.0, 0.0))]
-    params = {name: float_text(value) for name, value in zip(PARAM_MOUNT, mount)}
-    params[PARAM_RANGE_MIN] = float_text(laser.get("range_min", 0.0))
+    params = {name: float_text(value) for name, value in zip(PARAM_MOUNT, laser.mount)}
+    params[PARAM_RANGE_MIN] = float_text(laser.range_min)
     return CarmenLog(
         laser=CarmenLaser(kind=kind, t=t.copy(), logger_t=logger_t, hostname=hostname,
                           ranges=np.asarray(record.scans, dtype=np.float32), pose=np.asarray(record.truth, dtype=np.float64),
-                          odometry=odometry, angle_min=float(laser["angle_min"]), angle_increment=float(laser["angle_increment"]),
-                          range_max=float(laser["range_max"]), extra=extra),
+                          odometry=odometry, angle_min=laser.angle_min, angle_increment=laser.angle_increment,
+                          range_max=laser.range_max, extra=extra),
         odom=CarmenOdometry(t=t.copy(), logger_t=logger_t.copy(), hostname=hostname, pose=odometry.copy(),
                             tv=tv, rv=rv, accel=np.zeros(len(t))),
         params=params,
@@ -126,13 +125,10 @@ def run_from_carmen(log: CarmenLog) -> RunRecord:
     and ``slamtrials_laser_range_min`` when present, else zero.
     """
     laser, params = log.laser, log.params
-    geometry: dict[str, Any] = {
-        "angle_min": float(laser.angle_min),
-        "angle_increment": float(laser.angle_increment),
-        "range_min": float(params.get(PARAM_RANGE_MIN, 0.0)),
-        "range_max": float(laser.range_max),
-        "mount": [float(params.get(name, 0.0)) for name in PARAM_MOUNT],
-    }
+    mount = [float(params.get(name, 0.0)) for name in PARAM_MOUNT]
+    geometry = LaserGeometry(angle_min=float(laser.angle_min), angle_increment=float(laser.angle_increment),
+                             range_min=float(params.get(PARAM_RANGE_MIN, 0.0)), range_max=float(laser.range_max),
+                             mount=(mount[0], mount[1], mount[2]))
     hosts = sorted(set(laser.hostnames()))
     metadata: dict[str, Any] = {
         "source_format": "carmen",

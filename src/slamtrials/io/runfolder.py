@@ -29,7 +29,7 @@ from slamtrials.atomicfile import atomic_write, atomic_write_text
 from slamtrials.errors import FormatError
 from slamtrials.io.mapfile import read_map, write_map, write_map_png
 from slamtrials.io.tum import write_tum
-from slamtrials.record import RunRecord, Trajectory
+from slamtrials.record import LaserGeometry, RunRecord, Trajectory
 
 __all__ = ["write_run", "read_run", "FRAMES_FILE", "RUN_FILE", "RUN_FORMAT", "ESTIMATE_FILE", "MAP_FILE", "MAP_PICTURE"]
 
@@ -96,7 +96,7 @@ def write_run(folder: str | Path, record: RunRecord) -> Path:
                      "machine": platform.machine()},
         "frames": len(record),
         "beams": int(record.scans.shape[1]) if record.scans.ndim == 2 else 0,
-        "laser": record.laser,
+        "laser": record.laser.to_dict(),
         **record.metadata,
     }
     atomic_write_text(folder / RUN_FILE, json.dumps(doc, indent=2, default=json_default) + "\n")
@@ -160,7 +160,10 @@ def read_run(folder: str | Path) -> RunRecord:
     arrays = _read_frames(folder / FRAMES_FILE)
     if arrays["scans"].shape[1] != doc.get("beams", arrays["scans"].shape[1]):
         raise FormatError(folder / RUN_FILE, f"says {doc['beams']} beams but frames.npz has {arrays['scans'].shape[1]}")
-    laser = doc.pop("laser")
+    try:
+        laser = LaserGeometry.from_dict(doc.pop("laser"))
+    except ValueError as exc:
+        raise FormatError(folder / RUN_FILE, f"field 'laser': {exc}") from None
     metadata = {k: v for k, v in doc.items() if k not in ("format", "frames", "beams")}
     slam_map = read_map(folder / MAP_FILE) if (folder / MAP_FILE).is_file() else None
     return RunRecord(**arrays, laser=laser, metadata=metadata, map=slam_map)

@@ -29,12 +29,12 @@ from __future__ import annotations
 
 import math
 import weakref
-from typing import Any
 
 import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
+from slamtrials.record import LaserGeometry
 from slamtrials.sim.config import LaserConfig
 from slamtrials.geometry import compose1
 from slamtrials.worlds.world import World, world_to_map
@@ -280,6 +280,6 @@ class LaserModel:
             np.maximum(ranges, np.float32(cfg.min_range), out=ranges)
         return ranges
 
-    def info(self) -> dict[str, Any]:
-        """The laser dict for :class:`~slamtrials.record.RunRecord`."""
-        return self.config.laser_info()
+    def geometry(self) -> LaserGeometry:
+        """The laser's geometry, as :class:`~slamtrials.record.RunRecord` records it."""
+        return self.config.geometry()

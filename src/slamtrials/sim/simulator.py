@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from slamtrials.errors import SimulationError
-from slamtrials.record import Frame
+from slamtrials.record import Frame, LaserGeometry
 from slamtrials.sim.config import SimConfig
 from slamtrials.sim.odometry import Odometry, draw_bias
 from slamtrials.sim.raycast import LaserModel
@@ -124,9 +124,9 @@ class Simulator:
         return dict(self._bias)
 
     @property
-    def laser_info(self) -> dict[str, Any]:
-        """Laser geometry for :meth:`slamtrials.record.RunRecord.from_frames`."""
-        return self._laser.info()
+    def laser(self) -> LaserGeometry:
+        """The laser's geometry, for :meth:`slamtrials.record.RunRecord.from_frames`."""
+        return self._laser.geometry()
 
     @property
     def metadata(self) -> dict[str, Any]:

@@ -5,7 +5,7 @@ A SLAM algorithm is a class with
 * ``name``: the registry name (``slamtrials slam --algorithm NAME``);
 * ``Config``: a pydantic model of its parameters (SI units), every field with a default;
 * ``PRESETS``: named parameter sets, ``{preset name: {parameter: value}}`` (may be empty);
-* a constructor ``Algorithm(config, laser)`` taking a validated ``Config`` and the laser geometry dict
+* a constructor ``Algorithm(config, laser)`` taking a validated ``Config`` and the laser geometry
   of :class:`~slamtrials.record.RunRecord` (``angle_min``, ``angle_increment``, ``range_min``,
   ``range_max``, ``mount``);
 * ``reset(rng)``, ``process(frame) -> pose``, ``occupancy()``, ``trajectory()`` and an ``updates``
@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ValidationError
 
 from slamtrials.errors import ConfigError
-from slamtrials.record import FREE, OCCUPIED, UNKNOWN, Frame, OccupancyGrid, Trajectory
+from slamtrials.record import FREE, OCCUPIED, UNKNOWN, Frame, LaserGeometry, OccupancyGrid, Trajectory
 
 __all__ = [
     "OccupancyGrid",
@@ -62,7 +62,7 @@ class SlamAlgorithm(Protocol):
         Number of map (or filter) updates done since the last :meth:`reset`.
 
     An instance is built as ``Algorithm(config, laser)`` with a validated ``Config`` and the laser
-    geometry dict of :class:`~slamtrials.record.RunRecord`.
+    geometry (:class:`~slamtrials.record.LaserGeometry`).
     """
 
     name: ClassVar[str]
@@ -194,7 +194,7 @@ def resolve_config(cls: type, *, preset: str | None = None, overrides: dict[str,
         raise ConfigError(f"SLAM algorithm {cls.name!r}: " + "; ".join(problems)) from None
 
 
-def make_algorithm(name: str, laser: dict[str, Any], *, preset: str | None = None,
+def make_algorithm(name: str, laser: LaserGeometry, *, preset: str | None = None,
                    overrides: dict[str, Any] | None = None) -> SlamAlgorithm:
     """Build algorithm ``name`` for a laser of geometry ``laser`` with a validated configuration.
 
@@ -203,7 +203,7 @@ def make_algorithm(name: str, laser: dict[str, Any], *, preset: str | None = Non
     name:
         Registry or entry-point name.
     laser:
-        Laser geometry dict of :class:`~slamtrials.record.RunRecord`.
+        The laser's geometry (:class:`~slamtrials.record.LaserGeometry`).
     preset:
         Name of one of the class's :data:`PRESETS`, applied over the defaults.
     overrides:
@@ -215,4 +215,4 @@ def make_algorithm(name: str, laser: dict[str, Any], *, preset: str | None = Non
         See :func:`get_algorithm` and :func:`resolve_config`.
     """
     cls = get_algorithm(name)
-    return cls(resolve_config(cls, preset=preset, overrides=overrides), dict(laser))
+    return cls(resolve_config(cls, preset=preset, overrides=overrides), laser)

@@ -119,8 +119,8 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
     started = time.perf_counter()
 
     sim = Simulator(world, config.sim, np.random.default_rng(sim_seed))
-    laser = sim.laser_info
-    slam = get_algorithm(config.slam.algorithm)(slam_config, dict(laser))
+    laser = sim.laser
+    slam = get_algorithm(config.slam.algorithm)(slam_config, laser)
     slam.reset(np.random.default_rng(slam_seed))
     explorer = Explorer(config.explore_config())
     reachable = world.reachable_by_disc(config.sim.robot.radius)

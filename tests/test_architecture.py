@@ -10,7 +10,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "src" / "slamtrials"
 
 #: Modules every layer may import: they hold no behaviour of any layer.
-UTILITIES = {"errors", "atomicfile", "__about__", "stablemath"}
+UTILITIES = {"errors", "atomicfile", "__about__", "stablemath", "seeding"}
 
 #: Layer -> the slamtrials layers it may import (DESIGN.md, "Layers").
 ALLOWED = {

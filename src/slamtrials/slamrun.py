@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import json
 import math
-import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -35,8 +34,9 @@ from numpy.typing import NDArray
 
 from slamtrials.atomicfile import atomic_write_text
 from slamtrials.errors import ConfigError, FormatError
-from slamtrials.record import Frame, RunRecord, Trajectory
-from slamtrials.slam import OccupancyGrid, get_algorithm, resolve_config
+from slamtrials.record import RunRecord, Trajectory
+from slamtrials.slam import OccupancyGrid
+from slamtrials.slam.offline import estimate_per_frame, run_over_recording
 
 __all__ = ["SlamResult", "run_slam", "write_slam_outputs", "load_recording", "OUTPUT_FILES", "SLAM_FILE"]
 
@@ -87,7 +87,8 @@ class SlamResult:
 
 def run_slam(record: RunRecord, algorithm_name: str, *, preset: str | None = None, overrides: dict[str, Any] | None = None,
              seed: int = 0, on_frame: Callable[[int, int], None] | None = None, source: str = "") -> SlamResult:
-    """Process every frame of ``record`` with algorithm ``algorithm_name``.
+    """Process every frame of ``record`` with algorithm ``algorithm_name``
+    (:func:`slamtrials.slam.offline.run_over_recording`).
 
     Parameters
     ----------
@@ -98,7 +99,8 @@ def run_slam(record: RunRecord, algorithm_name: str, *, preset: str | None = Non
     preset, overrides:
         Configuration (see :func:`slamtrials.slam.resolve_config`).
     seed:
-        Seed of the ``numpy.random.Generator`` handed to ``reset``.
+        The run's seed, used as a trial uses it (:mod:`slamtrials.seeding`): on a trial's run folder,
+        the trial's seed gives the trial's own estimate.
     on_frame:
         Called as ``on_frame(index, total)`` after each frame (for progress bars).
     source:
@@ -109,36 +111,10 @@ def run_slam(record: RunRecord, algorithm_name: str, *, preset: str | None = Non
     ConfigError
         Unknown algorithm, preset or parameter, a bad value, a negative seed or an empty record.
     """
-    if seed < 0:
-        raise ConfigError(f"seed must be a non-negative integer, got {seed}")
-    if len(record) == 0:
-        raise ConfigError("the recording has no frames")
-    cls = get_algorithm(algorithm_name)
-    config = resolve_config(cls, preset=preset, overrides=overrides)
-    algorithm = cls(config, record.laser)
-    algorithm.reset(np.random.default_rng(seed))
-    total = len(record)
-    timing = np.empty(total, dtype=np.float64)
-    for k in range(total):
-        frame = Frame(t=float(record.t[k]), ranges=record.scans[k], odometry=record.odometry[k], truth=record.truth[k],
-                      stalled=bool(record.stalled[k]))
-        started = time.perf_counter()
-        algorithm.process(frame)
-        timing[k] = time.perf_counter() - started
-        if on_frame is not None:
-            on_frame(k, total)
-    return SlamResult(algorithm=algorithm_name, preset=preset, config=config.model_dump(mode="json"), seed=seed,
-                      trajectory=algorithm.trajectory(), occupancy=algorithm.occupancy(), timing=timing,
-                      updates=int(algorithm.updates), record=record, source=source)
-
-
-def _estimate_per_frame(result: SlamResult) -> NDArray[np.float64]:
-    """The estimate at each frame of the record (the trajectory must hold one pose per frame)."""
-    trajectory, record = result.trajectory, result.record
-    if len(trajectory) != len(record) or not np.array_equal(trajectory.t, record.t):
-        raise ConfigError(f"SLAM algorithm {result.algorithm!r} returned {len(trajectory)} poses for {len(record)} frames; "
-                          "trajectory() must hold one pose per processed frame")
-    return trajectory.poses
+    run = run_over_recording(record, algorithm_name, preset=preset, overrides=overrides, seed=seed, on_frame=on_frame)
+    return SlamResult(algorithm=algorithm_name, preset=preset, config=run.config.model_dump(mode="json"), seed=run.seed,
+                      trajectory=run.trajectory, occupancy=run.occupancy, timing=run.timing, updates=run.updates,
+                      record=record, source=source)
 
 
 def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bool = False) -> list[Path]:
@@ -157,7 +133,7 @@ def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bo
     if (out / SLAM_FILE).exists() and not overwrite:
         raise ConfigError(f"{out}: already holds SLAM outputs; choose another --out or pass --overwrite")
     out.mkdir(parents=True, exist_ok=True)
-    estimate = _estimate_per_frame(result)
+    estimate = estimate_per_frame(result.algorithm, result.trajectory, result.record)
     written = [write_tum(out / "trajectory.tum", result.trajectory)]
     as_run = replace(result.record, truth=estimate, estimate=estimate)  # first CARMEN triple = the estimate
     written.append(write_carmen(out / "trajectory.clf", carmen_from_run(as_run)))

@@ -12,6 +12,7 @@ name the file, the field path and the bad value. ``slamtrials config dump`` prin
 
 from __future__ import annotations
 
+import copy
 import hashlib
 import json
 from pathlib import Path
@@ -21,6 +22,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from slamtrials.errors import ConfigError, FormatError, validation_problems
 from slamtrials.explore import ExploreConfig, TerminationConfig
+from slamtrials.explore.config import ROBOT_FIELDS
 from slamtrials.metric.runcount import DEFAULT_MIN_RUNS
 from slamtrials.metric.sampling import DEFAULT_CONFIDENCE, DEFAULT_MARGIN_R, DEFAULT_MARGIN_T, DEFAULT_PILOT
 from slamtrials.sim import SimConfig
@@ -90,6 +92,16 @@ def _beside(folder: Path, entry: Any) -> Any:
     return str(candidate.resolve()) if candidate.exists() else entry
 
 
+def upgrade_stored_config(doc: dict[str, Any]) -> dict[str, Any]:
+    """A stored campaign config's JSON form, as this version writes it (a copy; ``doc`` is not changed)."""
+    doc = copy.deepcopy(doc)
+    explore = doc.get("explore")
+    if isinstance(explore, dict):
+        for name in ROBOT_FIELDS:
+            explore.pop(name, None)
+    return doc
+
+
 class CampaignConfig(BaseModel):
     """Everything a campaign needs: worlds, trial settings, metric, run-count rule, root seed, output.
 
@@ -146,6 +158,15 @@ class CampaignConfig(BaseModel):
         """SHA-256 (hex) of :meth:`identity`, canonical JSON: a stored campaign only resumes with an equal one."""
         text = json.dumps(self.identity(), sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+    @classmethod
+    def from_stored(cls, doc: dict[str, Any]) -> "CampaignConfig":
+        """The config of a stored campaign (its JSON form), written by this or an earlier version.
+
+        Campaigns stored before the explore section lost its robot fields (:data:`ROBOT_FIELDS`) carry
+        them; those versions replaced them by ``sim.robot``'s values anyway, so they are dropped.
+        """
+        return cls.model_validate(upgrade_stored_config(doc))
 
     @classmethod
     def from_dict(cls, data: Any, *, source: str = "campaign config") -> "CampaignConfig":

@@ -23,7 +23,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 
 from slamtrials.campaign.cluster import check_workers, dask_client
 from slamtrials.campaign.config import CampaignConfig, MetricSettings
@@ -38,7 +37,8 @@ from slamtrials.campaign.store import CampaignStore, WorldInfo
 from slamtrials.campaign.summary import summarize_store, write_summary_csv
 from slamtrials.campaign.task import failure, outcome, write_scored_run
 from slamtrials.errors import ConfigError, SlamtrialsError
-from slamtrials.record import Frame, RunRecord
+from slamtrials.record import RunRecord
+from slamtrials.slam.offline import run_over_recording
 from slamtrials.trial import SlamSettings
 
 __all__ = ["replay_campaign", "ReplayTask", "replay_one", "replay_slam"]
@@ -75,33 +75,22 @@ class ReplayTask:
 
 
 def replay_slam(record: RunRecord, slam: SlamSettings, seed: int) -> RunRecord:
-    """Run ``slam`` over every frame of ``record``; return the record with the new ``estimate`` and ``map``.
+    """``record`` with the estimate and map of ``slam`` run over its frames with the run's ``seed``.
 
-    The algorithm's random stream is the second child of ``SeedSequence(seed)``, as in
-    :func:`slamtrials.trial.run_trial`.
+    The algorithm runs through :func:`slamtrials.slam.offline.run_over_recording`, seeded as in
+    :func:`slamtrials.trial.run_trial` (:mod:`slamtrials.seeding`).
 
     Raises
     ------
     ConfigError
         A bad configuration, or an algorithm whose trajectory does not hold one pose per frame.
     """
-    from slamtrials.slam import get_algorithm
-
-    config = slam.resolved()
-    algorithm = get_algorithm(slam.algorithm)(config, record.laser)
-    sequence = np.random.SeedSequence(int(seed))
-    _, slam_seed = sequence.spawn(2)
-    algorithm.reset(np.random.default_rng(slam_seed))
-    for k in range(len(record)):
-        algorithm.process(Frame(t=float(record.t[k]), ranges=record.scans[k], odometry=record.odometry[k],
-                                truth=record.truth[k], stalled=bool(record.stalled[k])))
-    trajectory = algorithm.trajectory()
-    if len(trajectory) != len(record) or not np.array_equal(trajectory.t, record.t):
-        raise ConfigError(f"SLAM algorithm {slam.algorithm!r} returned {len(trajectory)} poses for {len(record)} frames")
+    result = run_over_recording(record, slam.algorithm, preset=slam.preset, overrides=slam.params, seed=seed)
+    estimate = result.estimate_per_frame(record)
     metadata = dict(record.metadata)
-    metadata["slam_config"] = config.model_dump(mode="json")
+    metadata["slam_config"] = result.config.model_dump(mode="json")
     return RunRecord(t=record.t, scans=record.scans, odometry=record.odometry, truth=record.truth, stalled=record.stalled,
-                     laser=record.laser, metadata=metadata, estimate=trajectory.poses, map=algorithm.occupancy())
+                     laser=record.laser, metadata=metadata, estimate=estimate, map=result.occupancy)
 
 
 def replay_one(task: ReplayTask) -> dict[str, Any]:

@@ -39,7 +39,7 @@ from typing import Any
 
 from slamtrials.__about__ import __version__
 from slamtrials.atomicfile import atomic_write_text
-from slamtrials.campaign.config import CampaignConfig
+from slamtrials.campaign.config import CampaignConfig, upgrade_stored_config
 from slamtrials.errors import ConfigError, FormatError
 
 __all__ = ["CampaignStore", "WorldInfo", "WorldRow", "RunRow", "STORE_FORMAT", "DB_FILE", "CONFIG_FILE", "RUNS_DIR",
@@ -274,14 +274,16 @@ class CampaignStore:
 
     def config(self) -> CampaignConfig:
         """The stored campaign config."""
-        return CampaignConfig.model_validate(json.loads(self.meta("config") or "{}"))
+        return CampaignConfig.from_stored(json.loads(self.meta("config") or "{}"))
 
     def check_config(self, config: CampaignConfig) -> None:
         """Raise :class:`ConfigError` (touching nothing) when ``config`` is not the stored campaign's."""
         if self.meta("config_hash") == config.digest():
             return
-        stored = json.loads(self.meta("config") or "{}")
+        stored = upgrade_stored_config(json.loads(self.meta("config") or "{}"))
         stored.pop("output", None)
+        if stored == config.identity():  # stored by an earlier version, same campaign
+            return
         diff = config_differences(stored, config.identity())
         raise ConfigError(f"{self.folder}: holds a campaign with a different config ({diff}); "
                           "resume it with its own config or choose another folder")

@@ -43,7 +43,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from slamtrials import stablemath
-from slamtrials.explore.config import ExploreConfig
+from slamtrials.explore.config import ExploreConfig, RobotLimits
 from slamtrials.explore.costmap import influence_distance
 from slamtrials.explore.follower import PathFollower
 from slamtrials.explore.frontiers import frontier_near
@@ -99,6 +99,8 @@ class Explorer:
     ----------
     config:
         Explorer settings; ``None`` means the defaults.
+    robot:
+        The robot's footprint, motion limits and control period; ``None`` means the paper's robot.
 
     Examples
     --------
@@ -107,12 +109,13 @@ class Explorer:
     >>> explorer.done, explorer.reason                                    # doctest: +SKIP
     """
 
-    def __init__(self, config: ExploreConfig | None = None):
+    def __init__(self, config: ExploreConfig | None = None, robot: RobotLimits | None = None):
         self.config = ExploreConfig() if config is None else config
-        self._search = GoalSearch(self.config)
-        self._follower = PathFollower(self.config)
+        self.robot = RobotLimits() if robot is None else robot
+        self._search = GoalSearch(self.config, self.robot)
+        self._follower = PathFollower(self.config, self.robot)
         self._monitor = StuckMonitor(self.config)
-        self._recovery = Recovery(self.config)
+        self._recovery = Recovery(self.config, self.robot)
         self.reset()
 
     # --- state -------------------------------------------------------------------------------------------
@@ -209,7 +212,7 @@ class Explorer:
         self._following = False
         v, w = self._decide(float(t), np.asarray(pose, dtype=np.float64), ranges, laser, occupancy)
         self._follower.remember(v, w)
-        self._stuck = self._monitor.update(float(t), pose, v, self.config.control_period, self._following)
+        self._stuck = self._monitor.update(float(t), pose, v, self.robot.control_period, self._following)
         return v, w
 
     def _decide(self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: LaserGeometry,
@@ -282,9 +285,9 @@ class Explorer:
     # --- manoeuvres ----------------------------------------------------------------------------------------
 
     def _start_spin(self, t: float, pose: NDArray[np.float64]) -> None:
-        cfg = self.config
-        self._spin_rate = cfg.max_angular_speed
-        self._spin_until = t + 2.0 * math.pi / cfg.max_angular_speed + cfg.max_angular_speed / cfg.max_angular_accel
+        robot = self.robot
+        self._spin_rate = robot.max_angular_speed
+        self._spin_until = t + 2.0 * math.pi / robot.max_angular_speed + robot.max_angular_speed / robot.max_angular_accel
         self._looked.append(pose[:2].copy())
         self.stats.look_arounds += 1
         self._follower.clear()
@@ -337,7 +340,7 @@ class Explorer:
             return
         row, col = (int(v) for v in GridFrame.of(occupancy).to_cell(pose[:2]))
         half = math.ceil(cfg.local_radius / resolution)
-        rim = math.ceil(influence_distance(cfg, resolution) / resolution) + 1
+        rim = math.ceil(influence_distance(cfg, self.robot, resolution) / resolution) + 1
         local = (row - half - rim, row + half + rim + 1, col - half - rim, col + half + rim + 1)
         if local[0] <= whole[0] and local[1] >= whole[1] and local[2] <= whole[2] and local[3] >= whole[3]:
             outcome = self._try(t, pose, occupancy, grid, whole, None)  # the window holds the whole map

@@ -52,7 +52,7 @@ from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from slamtrials import stablemath
-from slamtrials.explore.config import ExploreConfig
+from slamtrials.explore.config import ExploreConfig, RobotLimits, lethal_distance
 from slamtrials.record import LaserGeometry
 
 __all__ = ["FollowCommand", "PathFollower", "free_travel", "scan_points", "turn_rate"]
@@ -201,11 +201,14 @@ class PathFollower:
     Parameters
     ----------
     config:
-        Speed and acceleration limits, look-ahead, clearances.
+        Look-ahead, clearances, narrow-passage speed.
+    robot:
+        Footprint, speed and acceleration limits, control period.
     """
 
-    def __init__(self, config: ExploreConfig):
+    def __init__(self, config: ExploreConfig, robot: RobotLimits | None = None):
         self.config = config
+        self.robot = RobotLimits() if robot is None else robot
         self._path = np.zeros((0, 2))
         self._clearance: NDArray[np.float64] | None = None
         self._remaining = np.zeros(0)
@@ -287,7 +290,7 @@ class PathFollower:
 
     def command(self, pose: ArrayLike, ranges: ArrayLike, laser: LaserGeometry) -> FollowCommand:
         """Velocity command towards the path from ``pose`` (float64 ``[3]``, map frame) given the current scan."""
-        cfg = self.config
+        cfg, robot = self.config, self.robot
         x, y, theta = (float(v) for v in np.asarray(pose, dtype=np.float64)[:3])
         if not self.has_path:
             return self._limited(0.0, 0.0, finished=True)
@@ -301,7 +304,7 @@ class PathFollower:
             return self._limited(0.0, 0.0, finished=True)
         points = scan_points(ranges, laser)
         speed = math.inf if self._previous is None else math.hypot(x - self._previous[0],
-                                                                  y - self._previous[1]) / cfg.control_period
+                                                                  y - self._previous[1]) / robot.control_period
         self._previous = (x, y)
         backing_out = self._backing_out(x, y, theta, speed)
         if backing_out is None:
@@ -318,14 +321,14 @@ class PathFollower:
         while level < len(lookaheads):
             error, curvature, v_scan = self._arc(x, y, theta, 0.0, self._target(x, y, lookaheads[level]), points)
             if abs(error) > cfg.rotate_in_place_angle:
-                return self._limited(0.0, turn_rate(error, cfg.max_angular_speed, cfg.max_angular_accel))
+                return self._limited(0.0, turn_rate(error, robot.max_angular_speed, robot.max_angular_accel))
             if v_scan >= _BLOCKED_SPEED:
                 break
             level += 1
             self._tight = (level, x, y)
         if level >= len(lookaheads):
             return self._creep(x, y, theta, points, to_end)
-        v = self._arc_speed(cfg.max_linear_speed, v_scan, to_end, curvature)
+        v = self._arc_speed(robot.max_linear_speed, v_scan, to_end, curvature)
         return self._limited(v, curvature * v, pure_pursuit=True, curvature=curvature)
 
     def _arc(self, x: float, y: float, theta: float, offset: float, target: tuple[float, float],
@@ -333,21 +336,21 @@ class PathFollower:
         """Pure pursuit towards ``target`` with the heading ``theta + offset`` (``offset`` pi: backwards,
         ``points`` then mirrored): heading error (rad), curvature (1/m) and the largest speed (m/s) at which
         the robot can still stop before the scan's points on that arc."""
-        cfg = self.config
+        cfg, robot = self.config, self.robot
         tx, ty = target
         error = math.remainder(math.atan2(ty - y, tx - x) - theta - offset, 2.0 * math.pi)
         dist = max(math.hypot(tx - x, ty - y), 1e-6)
         curvature = 2.0 * math.sin(error) / dist
-        free = free_travel(points, curvature, cfg.robot_radius + cfg.obstacle_margin)
-        return error, curvature, math.sqrt(2.0 * cfg.max_linear_accel * max(free - cfg.stop_distance, 0.0))
+        free = free_travel(points, curvature, robot.radius + cfg.obstacle_margin)
+        return error, curvature, math.sqrt(2.0 * robot.max_linear_accel * max(free - cfg.stop_distance, 0.0))
 
     def _arc_speed(self, limit: float, v_scan: float, to_end: float, curvature: float) -> float:
         """Speed (m/s) on the arc: ``limit``, the scan's ``v_scan``, stopping at the path's end, the
         narrow-path limit and the turn-rate limit."""
-        cfg = self.config
-        v = min(limit, math.sqrt(2.0 * cfg.max_linear_accel * to_end), v_scan, self._narrow_limit())
+        robot = self.robot
+        v = min(limit, math.sqrt(2.0 * robot.max_linear_accel * to_end), v_scan, self._narrow_limit())
         if abs(curvature) > 1e-9:
-            v = min(v, cfg.max_angular_speed / abs(curvature))
+            v = min(v, robot.max_angular_speed / abs(curvature))
         return v
 
     @property
@@ -428,26 +431,26 @@ class PathFollower:
 
     def _creep(self, x: float, y: float, theta: float, points: NDArray[np.float64], to_end: float) -> FollowCommand:
         """Tight manoeuvring: face the path a few centimetres ahead, then inch straight along it."""
-        cfg = self.config
+        robot = self.robot
         tx, ty = self._target(x, y, _CREEP_LOOKAHEAD)
         error = math.remainder(math.atan2(ty - y, tx - x) - theta, 2.0 * math.pi)
         if abs(error) > _CREEP_ALIGN:
-            return self._limited(0.0, turn_rate(error, cfg.max_angular_speed, cfg.max_angular_accel))
-        free = free_travel(points, 0.0, cfg.robot_radius + _CREEP_MARGIN)
-        v = min(_CREEP_SPEED, math.sqrt(2.0 * cfg.max_linear_accel * max(free - 0.01, 0.0)),
-                math.sqrt(2.0 * cfg.max_linear_accel * to_end))
+            return self._limited(0.0, turn_rate(error, robot.max_angular_speed, robot.max_angular_accel))
+        free = free_travel(points, 0.0, robot.radius + _CREEP_MARGIN)
+        v = min(_CREEP_SPEED, math.sqrt(2.0 * robot.max_linear_accel * max(free - 0.01, 0.0)),
+                math.sqrt(2.0 * robot.max_linear_accel * to_end))
         if v < _BLOCKED_SPEED:
             return self._limited(0.0, 0.0, blocked=True)
         return self._limited(v, 0.0)
 
     def _narrow_limit(self) -> float:
         """Speed limit (m/s) from the smallest clearance of the next metre of path."""
-        cfg = self.config
+        cfg, robot = self.config, self.robot
         if self._clearance is None or self._clearance.shape[0] != self._path.shape[0] or cfg.narrow_clearance <= 0.0:
-            return cfg.max_linear_speed
+            return robot.max_linear_speed
         least = float(self._clearance[self._index:self._narrow_end[self._index] + 1].min())
-        share = min(max((least - cfg.lethal_distance) / cfg.narrow_clearance, 0.0), 1.0)
-        return cfg.narrow_speed + share * (cfg.max_linear_speed - cfg.narrow_speed)
+        share = min(max((least - lethal_distance(cfg, robot)) / cfg.narrow_clearance, 0.0), 1.0)
+        return cfg.narrow_speed + share * (robot.max_linear_speed - cfg.narrow_speed)
 
     def _target(self, x: float, y: float, lookahead: float, last: int | None = None) -> tuple[float, float]:
         """The first path point from the current one at least ``lookahead`` from (x, y), else the last
@@ -463,15 +466,15 @@ class PathFollower:
 
     def _limited(self, v: float, w: float, *, blocked: bool = False, finished: bool = False,
                  pure_pursuit: bool = False, curvature: float = 0.0) -> FollowCommand:
-        cfg = self.config
-        dt = cfg.control_period
+        robot = self.robot
+        dt = robot.control_period
         if v > 0.0:
-            v = min(v, max(self._v, 0.0) + cfg.max_linear_accel * dt)
+            v = min(v, max(self._v, 0.0) + robot.max_linear_accel * dt)
         elif v < 0.0:
-            v = max(v, min(self._v, 0.0) - cfg.max_linear_accel * dt)
+            v = max(v, min(self._v, 0.0) - robot.max_linear_accel * dt)
         if pure_pursuit:
             w = curvature * v  # stay on the arc while speeding up
-        dw = cfg.max_angular_accel * dt
+        dw = robot.max_angular_accel * dt
         w = min(max(w, self._w - dw), self._w + dw)
         self._v, self._w = v, w
         return FollowCommand(v, w, blocked, finished)

@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from slamtrials import stablemath
-from slamtrials.explore.config import ExploreConfig
+from slamtrials.explore.config import ExploreConfig, RobotLimits
 from slamtrials.explore.follower import scan_points
 from slamtrials.explore.gridframe import FREE_BELOW, GridFrame, map_arrays
 from slamtrials.record import LaserGeometry
@@ -131,8 +131,9 @@ def segment_clear(occupancy: Any, a: ArrayLike, b: ArrayLike, radius: float) -> 
 class Recovery:
     """The recovery manoeuvre (see the module docstring): open-loop phases timed in simulated seconds."""
 
-    def __init__(self, config: ExploreConfig):
+    def __init__(self, config: ExploreConfig, robot: RobotLimits | None = None):
         self.config = config
+        self.robot = RobotLimits() if robot is None else robot
         self._phases: list[tuple[float, float, float]] = []  # (end time, v, w)
 
     @property
@@ -153,16 +154,16 @@ class Recovery:
         Otherwise it backs off ``backoff_distance`` (if the map shows room behind) and turns
         ``recovery_turn`` towards the side where the scan sees more room.
         """
-        cfg = self.config
+        cfg, robot = self.config, self.robot
         x, y, theta = (float(v) for v in np.asarray(pose, dtype=np.float64)[:3])
-        rate = 0.8 * cfg.max_angular_speed
+        rate = 0.8 * robot.max_angular_speed
         phases: list[tuple[float, float]] = []  # (duration, v, w) without the end times yet
         points = scan_points(ranges, laser)
         push = None
         if points.shape[0] and cfg.backoff_distance > 0.0:
             dist = stablemath.hypot(points[:, 0], points[:, 1])
             k = int(np.argmin(dist))
-            if dist[k] < cfg.robot_radius + _CONTACT:
+            if dist[k] < robot.radius + _CONTACT:
                 away = math.atan2(-points[k, 1], -points[k, 0])  # robot frame
                 direction = 1.0 if abs(away) <= 0.5 * math.pi else -1.0
                 turn = away if direction > 0 else math.remainder(away - math.pi, 2.0 * math.pi)
@@ -172,7 +173,7 @@ class Recovery:
                 start = (x + _CONTACT * ux, y + _CONTACT * uy)
                 for share in (1.0, 0.6, 0.3):  # as far as the map shows room for
                     length = share * cfg.backoff_distance
-                    if segment_clear(occupancy, start, (x + length * ux, y + length * uy), cfg.robot_radius - _CONTACT):
+                    if segment_clear(occupancy, start, (x + length * ux, y + length * uy), robot.radius - _CONTACT):
                         push = (turn, direction, length)
                         break
         if push is not None:
@@ -181,7 +182,7 @@ class Recovery:
             phases.append((length / cfg.backoff_speed, direction * cfg.backoff_speed, 0.0))
         else:
             behind = (x - (cfg.backoff_distance + 0.05) * math.cos(theta), y - (cfg.backoff_distance + 0.05) * math.sin(theta))
-            if cfg.backoff_distance > 0.0 and segment_clear(occupancy, (x, y), behind, cfg.robot_radius):
+            if cfg.backoff_distance > 0.0 and segment_clear(occupancy, (x, y), behind, robot.radius):
                 phases.append((cfg.backoff_distance / cfg.backoff_speed, -cfg.backoff_speed, 0.0))
             if cfg.recovery_turn > 0.0:
                 phases.append((cfg.recovery_turn / rate, 0.0, open_side(ranges, laser) * rate))

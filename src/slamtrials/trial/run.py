@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from slamtrials import stablemath
+from slamtrials.seeding import check_seed, run_streams
 from slamtrials.explore import Explorer, SnapshotTermination
 from slamtrials.record import Frame, OccupancyGrid, RunRecord
 from slamtrials.sim import Simulator
@@ -108,21 +109,16 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
     SimulationError
         The robot does not fit at the world's start pose.
     """
-    from slamtrials.errors import ConfigError
-
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ConfigError(f"trial seed must be a non-negative integer, got {seed!r}")
+    streams = run_streams(check_seed(seed, "trial seed"))
     config = TrialConfig() if config is None else config
     slam_config = config.slam.resolved()
-    sequence = np.random.SeedSequence(int(seed))
-    sim_seed, slam_seed = sequence.spawn(2)
     started = time.perf_counter()
 
-    sim = Simulator(world, config.sim, np.random.default_rng(sim_seed))
+    sim = Simulator(world, config.sim, np.random.default_rng(streams.simulator))
     laser = sim.laser
     slam = get_algorithm(config.slam.algorithm)(slam_config, laser)
-    slam.reset(np.random.default_rng(slam_seed))
-    explorer = Explorer(config.explore_config())
+    slam.reset(np.random.default_rng(streams.slam))
+    explorer = Explorer(config.explore, config.robot_limits())
     reachable = world.reachable_by_disc(config.sim.robot.radius)
     reachable_area = world.area_of(reachable)
     # the paper chose the snapshot period by the building's size, known in advance

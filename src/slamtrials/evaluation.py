@@ -25,15 +25,14 @@ from enum import Enum
 from pathlib import Path
 
 from slamtrials.errors import FormatError, MetricError
+from slamtrials.metric.matching import DEFAULT_TOLERANCE, RUN_TOLERANCE
+from slamtrials.metric.rule import SamplingRule
 from slamtrials.record import Relations, Trajectory
 
 __all__ = ["EvaluationResult", "PoseTriple", "Quantile", "evaluate_files", "evaluate_run", "format_report", "RELATIONS_FILE", "ERRORS_FILE", "ESTIMATE_FILE", "FILE_TOLERANCE", "RUN_TOLERANCE"]
 
 #: Default matching tolerance (s) for dataset files: the Freiburg program's.
-FILE_TOLERANCE = 0.1
-#: Default matching tolerance (s) for run folders: estimate and ground truth share the simulator's clock
-#: (frames every 0.1 s), so only the same frame's pose is taken directly and the odometry fills the rest.
-RUN_TOLERANCE = 0.001
+FILE_TOLERANCE = DEFAULT_TOLERANCE
 RELATIONS_FILE = "relations.txt"
 ERRORS_FILE = "errors.npz"
 ESTIMATE_FILE = "estimate.tum"
@@ -47,7 +46,7 @@ class PoseTriple(str, Enum):
 
 
 class Quantile(str, Enum):
-    """Reference distribution of the critical value."""
+    """Reference distribution of the critical value (the choices of :attr:`SamplingRule.distribution`)."""
 
     normal = "normal"
     t = "t"
@@ -239,15 +238,9 @@ def evaluate_run(
     estimate: Path | None = None,
     estimate_pose: PoseTriple = PoseTriple.first,
     seed: int = 0,
-    pilot: int = 500,
-    confidence: float = 0.99,
-    margin_t: float = 0.02,
-    margin_r: float = 0.02,
-    quantile: Quantile = Quantile.normal,
-    sides: int = 2,
+    rule: SamplingRule | None = None,
     tolerance: float = RUN_TOLERANCE,
     interpolate: bool = False,
-    squared: bool = False,
     write: bool = True,
 ) -> EvaluationResult:
     """Sample relations from a run folder's ground truth and evaluate the run's estimate on them.
@@ -263,10 +256,10 @@ def evaluate_run(
         Which pose triple of a CARMEN estimate to use.
     seed:
         Seed of the relation sampling.
-    pilot, confidence, margin_t, margin_r, quantile, sides:
-        The sampling rule (:func:`slamtrials.metric.sample_relations`).
-    tolerance, interpolate, squared:
-        Matching and error options. The run's odometry carries ground-truth timestamps without an
+    rule:
+        The sampling rule (:class:`~slamtrials.metric.SamplingRule`); ``None`` means the defaults.
+    tolerance, interpolate:
+        Matching options. The run's odometry carries ground-truth timestamps without an
         estimated pose within ``tolerance`` (default 1 ms: the same frame) to the nearest estimated pose.
     write:
         Write ``relations.txt`` and ``errors.npz`` into the folder.
@@ -301,16 +294,10 @@ def evaluate_run(
             truth,
             source.trajectory,
             rng=seed,
-            pilot=pilot,
-            confidence=confidence,
-            margin_t=margin_t,
-            margin_r=margin_r,
-            distribution=quantile.value,
-            sides=sides,
+            rule=SamplingRule() if rule is None else rule,
             tolerance=tolerance,
             interpolate=interpolate,
             odometry=odometry,
-            squared=squared,
         )
     except MetricError as exc:
         raise _with_lines(exc, sources, None) from None
@@ -353,7 +340,8 @@ def format_report(result: EvaluationResult) -> str:
     if s is not None:
         out.write(
             f"sampling:  pilot {len(s.pilot_relations)} pairs, s_t = {s.std_t:.6g} {unit_t}, s_r = {s.std_r:.6g} {unit_r}; "
-            f"z = {s.critical:.4f} ({s.confidence:g} confidence, {s.distribution}, {'two' if s.sides == 2 else 'one'}-sided); margins {s.margin_t:g} {unit_t}, {s.margin_r:g} {unit_r} "
+            f"z = {s.critical:.4f} ({s.rule.confidence:g} confidence, {s.rule.distribution}, {'two' if s.rule.sides == 2 else 'one'}-sided); "
+            f"margins {s.rule.margin_t:g} {unit_t}, {s.rule.margin_r:g} {unit_r} "
             f"-> N_t = {s.needed_t}, N_r = {s.needed_r}, N = {s.count}{' (capped)' if s.capped else ''}\n"
         )
     out.write(f"Translational error ({unit_t}, {kind}):\n{SUMMARY_HEADER}\n{_row(result.translational)}\n")

@@ -115,3 +115,27 @@ def test_resume_removes_partial_and_unrecorded_run_folders(tmp_path):
     assert {r.idx: r.status for r in store.runs("a")} == {0: "done", 1: "pending"}
     store.close()
     assert clean_partials(folder) == [] and remove_unrecorded(folder, {("a", 0)}) == []
+
+
+def test_a_campaign_stored_by_an_earlier_version_loads_and_resumes(tmp_path):
+    """Earlier versions stored explore's robot fields (then overridden by sim.robot) and fewer metric fields."""
+    import hashlib
+    import json
+
+    config = CampaignConfig(worlds=["a", "b"], seed=5)
+    folder = tmp_path / "c"
+    CampaignStore.create(folder, config, WORLDS).close()
+    old = config.model_dump(mode="json")
+    old["explore"].update({"robot_radius": 0.15, "max_linear_speed": 0.7, "control_period": 0.1})
+    for name in ("sides", "min_relations", "max_relations", "squared"):
+        del old["metric"][name]
+    identity = {k: v for k, v in old.items() if k != "output"}
+    old_hash = hashlib.sha256(json.dumps(identity, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
+    with sqlite3.connect(folder / DB_FILE) as conn:
+        conn.execute("UPDATE meta SET value = ? WHERE key = 'config'", (json.dumps(old),))
+        conn.execute("UPDATE meta SET value = ? WHERE key = 'config_hash'", (old_hash,))
+    with CampaignStore.open(folder) as store:
+        assert store.config() == config
+    open_campaign(folder, config, WORLDS, kind="campaign").close()
+    with pytest.raises(ConfigError, match="different config"):
+        open_campaign(folder, CampaignConfig(worlds=["a", "b"], seed=6), WORLDS, kind="campaign")

@@ -37,9 +37,11 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
 
+from pydantic import ValidationError
+
 from slamtrials.__about__ import __version__
 from slamtrials.atomicfile import atomic_write_text
-from slamtrials.campaign.config import CampaignConfig, upgrade_stored_config
+from slamtrials.campaign.config import CampaignConfig
 from slamtrials.errors import ConfigError, FormatError
 
 __all__ = ["CampaignStore", "WorldInfo", "WorldRow", "RunRow", "STORE_FORMAT", "DB_FILE", "CONFIG_FILE", "RUNS_DIR",
@@ -280,13 +282,21 @@ class CampaignStore:
         """Raise :class:`ConfigError` (touching nothing) when ``config`` is not the stored campaign's."""
         if self.meta("config_hash") == config.digest():
             return
-        stored = upgrade_stored_config(json.loads(self.meta("config") or "{}"))
+        stored = json.loads(self.meta("config") or "{}")
         stored.pop("output", None)
-        if stored == config.identity():  # stored by an earlier version, same campaign
+        if self._stored_by_earlier_version_as(stored, config):
             return
         diff = config_differences(stored, config.identity())
         raise ConfigError(f"{self.folder}: holds a campaign with a different config ({diff}); "
                           "resume it with its own config or choose another folder")
+
+    @staticmethod
+    def _stored_by_earlier_version_as(stored: dict[str, Any], config: CampaignConfig) -> bool:
+        """Whether a config stored by an earlier version (other fields, other digest) is ``config``."""
+        try:
+            return CampaignConfig.from_stored(stored).identity() == config.identity()
+        except ValidationError:
+            return False
 
     def worlds(self) -> list[WorldRow]:
         """The worlds, in campaign order."""

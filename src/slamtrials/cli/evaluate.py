@@ -12,11 +12,15 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from pydantic import ValidationError
 
 from slamtrials.errors import ConfigError
 from slamtrials.evaluation import FILE_TOLERANCE, RUN_TOLERANCE, PoseTriple, Quantile
+from slamtrials.metric.rule import SamplingRule
 
 __all__ = ["evaluate", "register"]
+
+DEFAULT_RULE = SamplingRule()
 
 
 def evaluate(
@@ -31,12 +35,12 @@ def evaluate(
     allow_outside: Annotated[bool, typer.Option("--allow-outside", help="Report relations outside the estimate's time span as unmatched instead of refusing them.")] = False,
     errors_out: Annotated[Path | None, typer.Option("--errors", help="Write per-relation errors here (.npz, or a text table).")] = None,
     seed: Annotated[int, typer.Option("--seed", "-s", help="Seed of the relation sampling (RUN).")] = 0,
-    pilot: Annotated[int, typer.Option("--pilot", help="Pilot pairs of the sampling (RUN).")] = 500,
-    confidence: Annotated[float, typer.Option("--confidence", help="Confidence level of the margins (RUN).")] = 0.99,
-    margin_t: Annotated[float, typer.Option("--margin-t", help="Margin of error of the mean translational error, m (RUN).")] = 0.02,
-    margin_r: Annotated[float, typer.Option("--margin-r", help="Margin of error of the mean rotational error, rad (RUN).")] = 0.02,
-    quantile: Annotated[Quantile, typer.Option("--quantile", help="Critical value: normal or Student t with pilot-1 degrees of freedom (RUN).")] = Quantile.normal,
-    sides: Annotated[int, typer.Option("--sides", help="2 for a two-sided quantile, 1 for one-sided (RUN).")] = 2,
+    pilot: Annotated[int, typer.Option("--pilot", help="Pilot pairs of the sampling (RUN).")] = DEFAULT_RULE.pilot,
+    confidence: Annotated[float, typer.Option("--confidence", help="Confidence level of the margins (RUN).")] = DEFAULT_RULE.confidence,
+    margin_t: Annotated[float, typer.Option("--margin-t", help="Margin of error of the mean translational error, m (RUN).")] = DEFAULT_RULE.margin_t,
+    margin_r: Annotated[float, typer.Option("--margin-r", help="Margin of error of the mean rotational error, rad (RUN).")] = DEFAULT_RULE.margin_r,
+    distribution: Annotated[Quantile, typer.Option("--distribution", "--quantile", help="Critical value: normal or Student t with pilot-1 degrees of freedom (RUN).")] = Quantile(DEFAULT_RULE.distribution),
+    sides: Annotated[int, typer.Option("--sides", help="2 for a two-sided quantile, 1 for one-sided (RUN).")] = DEFAULT_RULE.sides,
 ) -> None:
     """Localization error (Kuemmerle et al.) of an estimate: Mean, Std, Min, Max, NumMeasures in m and rad."""
     from slamtrials.evaluation import evaluate_files, evaluate_run, format_report
@@ -51,13 +55,10 @@ def evaluate(
             raise ConfigError("with a RUN folder, relations are sampled from its ground truth and its odometry is used: drop --relations and --odometry")
         if seed < 0:
             raise ConfigError(f"--seed must be a non-negative integer, got {seed}")
-        if sides not in (1, 2):
-            raise ConfigError(f"--sides must be 1 or 2, got {sides}")
-        result = evaluate_run(
-            run, estimate=estimate, estimate_pose=estimate_pose, seed=seed, pilot=pilot, confidence=confidence,
-            margin_t=margin_t, margin_r=margin_r, quantile=quantile, sides=sides, tolerance=tolerance,
-            interpolate=interpolate, squared=squared,
-        )
+        rule = sampling_rule(pilot=pilot, confidence=confidence, margin_t=margin_t, margin_r=margin_r,
+                             distribution=distribution.value, sides=sides, squared=squared)
+        result = evaluate_run(run, estimate=estimate, estimate_pose=estimate_pose, seed=seed, rule=rule,
+                              tolerance=tolerance, interpolate=interpolate)
     else:
         if estimate is None or relations is None:
             raise ConfigError("give a RUN folder, or both --estimate FILE and --relations FILE")
@@ -69,6 +70,16 @@ def evaluate(
         written = write_errors(errors_out, result.relations, result.errors)
         result = replace(result, written=(*result.written, written))
     typer.echo(format_report(result), nl=False)
+
+
+def sampling_rule(**values: object) -> SamplingRule:
+    """The rule of the command's options; a bad value is a one-line ConfigError naming the option."""
+    try:
+        return SamplingRule.model_validate(values)
+    except ValidationError as exc:
+        problems = "; ".join(f"--{'-'.join(str(p) for p in e['loc']).replace('_', '-')} = {e['input']!r}: {e['msg']}"
+                             for e in exc.errors())
+        raise ConfigError(problems) from None
 
 
 def register(app: typer.Typer) -> None:

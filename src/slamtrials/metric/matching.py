@@ -27,10 +27,13 @@ from slamtrials.geometry import compose, interpolate as interpolate_poses, ominu
 from slamtrials.metric.kernels import EPS, nearest_indices, relative_poses
 from slamtrials.record import Relations, Trajectory
 
-__all__ = ["DEFAULT_TOLERANCE", "check_trajectory", "check_relations", "PoseLookup", "lookup_poses", "RelationMatch", "match_relations"]
+__all__ = ["DEFAULT_TOLERANCE", "RUN_TOLERANCE", "check_trajectory", "check_relations", "PoseLookup", "lookup_poses", "RelationMatch", "match_relations"]
 
 #: Largest accepted gap (s) between a relation timestamp and the matched pose: the Freiburg program's 0.1 s.
 DEFAULT_TOLERANCE = 0.1
+#: Matching tolerance (s) of a simulated run's estimate to its ground truth: they share the simulator's
+#: clock (frames every 0.1 s), so only the same frame's pose is taken directly and the odometry fills the rest.
+RUN_TOLERANCE = 0.001
 
 
 def check_trajectory(trajectory: Trajectory, what: str = "estimate") -> None:

@@ -44,12 +44,20 @@ import pandas as pd
 
 from slamtrials.__about__ import __version__, source_revision
 from slamtrials.atomicfile import atomic_write_text
+from slamtrials.campaign.config import MetricSettings
 from slamtrials.campaign.events import REPLAY_NOTE
 from slamtrials.errors import ConfigError, SlamtrialsError
 from slamtrials.record import Trajectory
 from slamtrials.report import campaign_figures as cf
 from slamtrials.report import html as h
-from slamtrials.report.compare import A_BETTER, B_BETTER, Comparison, Correction, compare_campaigns, world_pair_traps
+from slamtrials.report.compare import (
+    A_BETTER,
+    B_BETTER,
+    Comparison,
+    Correction,
+    compare_campaigns,
+    world_pair_traps,
+)
 from slamtrials.report.load import CampaignData, load_campaign
 from slamtrials.report.tables import METRICS, paper_table
 
@@ -367,8 +375,7 @@ def _fig3(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame, chosen: t
     if chosen is None:
         return h.section(title, "<p>No finished run to check.</p>", id="fig-3")
     world, index = chosen
-    metric = data.config.get("metric", {})
-    options = {k: metric[k] for k in ("pilot", "confidence", "margin_t", "margin_r", "distribution", "tolerance") if k in metric}
+    metric = MetricSettings.model_validate(data.config.get("metric", {}))
     try:
         record = _read_record(data, world, index)
         if record.estimate is None:
@@ -378,7 +385,7 @@ def _fig3(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame, chosen: t
         odometry = Trajectory(t=record.t, poses=record.odometry)
         sequence = np.random.SeedSequence(int(seed))
         means = {component: cf.repeated_sampling_means(truth, estimate, repeats, sequence, component=component,
-                                                       odometry=odometry, **options)
+                                                       rule=metric.rule, tolerance=metric.tolerance, odometry=odometry)
                  for component in ("translational", "rotational")}
     except SlamtrialsError as exc:
         log.warning("relation-sampling check of %s/%d: %s", world, index, exc)
@@ -394,11 +401,11 @@ def _fig3(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame, chosen: t
         ax.axvline(float(row[metric_name]), color="black", ls=":", lw=1.2, gid="campaign_value")
         ax.set_title(f"{world} run #{index}: {SYMBOLS[metric_name]} over {repeats} samplings", fontsize=9)
     caption = (f"The paper's Fig. 3 for run #{index} of {world}: the distribution of the run's mean error over {repeats} "
-               f"independent samplings of relations (each by the campaign's rule: pilot {options.get('pilot')}, "
-               f"{_pct(options.get('confidence'))} confidence, margins \u00b1{options.get('margin_t')} m and "
-               f"\u00b1{options.get('margin_r')} rad), with a fitted normal; dotted: the value the campaign recorded "
+               f"independent samplings of relations (each by the campaign's rule: pilot {metric.pilot}, "
+               f"{_pct(metric.confidence)} confidence, margins \u00b1{metric.margin_t:g} m and "
+               f"\u00b1{metric.margin_r:g} rad), with a fitted normal; dotted: the value the campaign recorded "
                f"({row['eps_t']:.4f} m, {row['eps_r']:.4f} rad). Sampling seed {seed}.")
-    spread = [f"{SYMBOLS[m]}: mean {v.mean():.4g}, sd {v.std(ddof=1):.2g} over samplings (margin \u00b1{options.get('margin_' + m[-1])})"
+    spread = [f"{SYMBOLS[m]}: mean {v.mean():.4g}, sd {v.std(ddof=1):.2g} over samplings (margin \u00b1{getattr(metric, 'margin_' + m[-1]):g})"
               for m, v in zip(METRICS, means.values())]
     return h.section(title, figs.save(fig, "fig3_sampling", caption), "<p>" + h.esc("; ".join(spread)) + "</p>", id="fig-3",
                      intro="Is the sampled mean of one run approximately normal with a spread within the margin of error?")

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from slamtrials import stablemath
+from slamtrials.errors import ConfigError
 from slamtrials.seeding import check_seed, run_streams
 from slamtrials.explore import Explorer, SnapshotTermination
 from slamtrials.record import Frame, OccupancyGrid, RunRecord

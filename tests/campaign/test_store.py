@@ -8,13 +8,21 @@ import pytest
 
 from slamtrials.campaign import CampaignConfig
 from slamtrials.campaign.folder import campaign_lock, open_campaign, prepare_resume
-from slamtrials.campaign.runfiles import clean_partials, publish_run, remove_unrecorded, run_folder
+from slamtrials.campaign.results import RunDetails, RunDone
+from slamtrials.campaign.runfiles import (
+    clean_partials,
+    publish_run,
+    remove_unrecorded,
+    run_folder,
+)
 from slamtrials.campaign.store import DB_FILE, CampaignStore, WorldInfo
 from slamtrials.errors import ConfigError
 
 WORLDS = [WorldInfo("a", "a", 0, 10.0), WorldInfo("b", "/x/b.yaml", 1, 20.0)]
-RESULT = {"eps_t": 0.25, "eps_r": 0.03, "relations": 12, "termination": "map_converged", "mapped_fraction": 0.97,
-          "sim_duration": 100.0, "wall_time": 2.0, "worker": "w:1", "folder": "runs/a/000", "details": {"frames": 5}}
+RESULT = RunDone(world="a", index=0, eps_t=0.25, eps_r=0.03, relations=12, termination="map_converged",
+                 mapped_fraction=0.97, sim_duration=100.0, wall_time=2.0, worker="w:1", folder="runs/a/000",
+                 details=RunDetails(frames=5, distance_m=3.0, observed_fraction=0.99, slam_updates=7,
+                                    relation_std_t=0.1, relation_std_r=0.01, relations_capped=False))
 
 
 def snapshot(folder):

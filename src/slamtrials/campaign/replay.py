@@ -31,6 +31,7 @@ from slamtrials.campaign.events import REPLAY_NOTE, CampaignEvent, CampaignResul
 from slamtrials.campaign.execute import result_notes
 from slamtrials.campaign.folder import campaign_lock, check_campaign_folder, open_campaign, prepare_resume
 from slamtrials.campaign.loop import next_step
+from slamtrials.campaign.results import RunResult
 from slamtrials.campaign.runfiles import publish_run
 from slamtrials.campaign.score import score_run
 from slamtrials.campaign.store import CampaignStore, WorldInfo
@@ -93,7 +94,7 @@ def replay_slam(record: RunRecord, slam: SlamSettings, seed: int) -> RunRecord:
                      laser=record.laser, metadata=metadata, estimate=estimate, map=result.occupancy)
 
 
-def replay_one(task: ReplayTask) -> dict[str, Any]:
+def replay_one(task: ReplayTask) -> RunResult:
     """Re-evaluate one recorded run (see the module docstring); return what the driver records."""
     from slamtrials.io.runfolder import read_run
 

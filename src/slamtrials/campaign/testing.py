@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from slamtrials.record import LaserGeometry, OccupancyGrid, RunRecord
+from slamtrials.trial import TrialSummary
 
 __all__ = ["FakeTrial"]
 
@@ -65,6 +66,10 @@ class FakeTrial:
         record.metadata = {
             "world": getattr(world, "name", "world"),
             "seed": int(seed),
-            "trial": {"termination_reason": "fake", "mapped_fraction": 1.0, "duration_s": 1.0, "distance_m": 1.0},
+            "trial": TrialSummary(termination_reason="fake", mapped_fraction=1.0, mapped_fraction_global=1.0,
+                                  observed_fraction=1.0, reachable_area_m2=1.0, mapped_fraction_connected=1.0,
+                                  connected_free_area_m2=1.0, mapped_free_area_m2=1.0, distance_m=1.0, turning_rad=0.0,
+                                  duration_s=1.0, wall_time_s=self.sleep, realtime_factor=1.0, slam_updates=1,
+                                  slam_seconds=0.0, stalled_frames=0).to_dict(),
         }
         return record

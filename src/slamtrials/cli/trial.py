@@ -29,7 +29,7 @@ def trial(
     from slamtrials.io.runfolder import RUN_FILE, write_run
     from slamtrials.io.yamlfile import read_yaml_mapping
     from slamtrials.report.runplot import save_run_figure
-    from slamtrials.trial import TrialConfig, run_trial
+    from slamtrials.trial import TrialConfig, TrialSummary, run_trial
     from slamtrials.worlds import load_world
 
     if seed < 0:
@@ -56,11 +56,12 @@ def trial(
     record.metadata.update(world_source=str(world))
     write_run(out, record)
     save_run_figure(the_world, record, out / TRIAL_PICTURE, title=f"{the_world.name}, seed {seed}")
-    info = record.metadata["trial"]
+    info = TrialSummary.of(record)
+    assert info is not None  # run_trial always stores it
     console.print(
-        f"{out}: {info['termination_reason']} after {info['duration_s']:.0f} s simulated in {info['wall_time_s']:.1f} s "
-        f"({info['realtime_factor']:.0f}x real time); mapped {100 * info['mapped_fraction']:.1f} % of the reachable "
-        f"{info['reachable_area_m2']:.0f} m^2, travelled {info['distance_m']:.0f} m, {info['slam_updates']} SLAM updates",
+        f"{out}: {info.termination_reason} after {info.duration_s:.0f} s simulated in {info.wall_time_s:.1f} s "
+        f"({info.realtime_factor:.0f}x real time); mapped {100 * info.mapped_fraction:.1f} % of the reachable "
+        f"{info.reachable_area_m2:.0f} m^2, travelled {info.distance_m:.0f} m, {info.slam_updates} SLAM updates",
         soft_wrap=True, highlight=False)
 
 

@@ -17,7 +17,6 @@ was covered:
 
 from __future__ import annotations
 
-
 import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree

@@ -29,13 +29,10 @@ from slamtrials.metric.matching import DEFAULT_TOLERANCE, RUN_TOLERANCE
 from slamtrials.metric.rule import SamplingRule
 from slamtrials.record import Relations, Trajectory
 
-__all__ = ["EvaluationResult", "PoseTriple", "Quantile", "evaluate_files", "evaluate_run", "format_report", "RELATIONS_FILE", "ERRORS_FILE", "ESTIMATE_FILE", "FILE_TOLERANCE", "RUN_TOLERANCE"]
+__all__ = ["EvaluationResult", "PoseTriple", "Quantile", "evaluate_files", "evaluate_run", "format_report", "FILE_TOLERANCE", "RUN_TOLERANCE"]
 
 #: Default matching tolerance (s) for dataset files: the Freiburg program's.
 FILE_TOLERANCE = DEFAULT_TOLERANCE
-RELATIONS_FILE = "relations.txt"
-ERRORS_FILE = "errors.npz"
-ESTIMATE_FILE = "estimate.tum"
 
 
 class PoseTriple(str, Enum):
@@ -271,24 +268,25 @@ def evaluate_run(
     """
     from slamtrials.io.errorsfile import write_errors
     from slamtrials.io.relations import write_relations
-    from slamtrials.io.runfolder import FRAMES_FILE, read_run
+    from slamtrials.io.runfolder import RunFolder, read_run
     from slamtrials.metric import sample_relations
 
     run = Path(run)
+    files = RunFolder(run)
     record = read_run(run)
     truth = Trajectory(t=record.t, poses=record.truth)
     odometry = Trajectory(t=record.t, poses=record.odometry)
-    sources = {"truth": _Source(truth, run / FRAMES_FILE, "run", "ground truth")}
-    if estimate is None and (run / ESTIMATE_FILE).is_file():
-        estimate = run / ESTIMATE_FILE
+    sources = {"truth": _Source(truth, files.frames, "run", "ground truth")}
+    if estimate is None and files.estimate.is_file():
+        estimate = files.estimate
     if estimate is not None:
         source = _read_trajectory(Path(estimate), estimate_pose, "estimate")
     elif record.estimate is not None:
-        source = _Source(Trajectory(t=record.t, poses=record.estimate), run / FRAMES_FILE, "run", f"{run} (the run's estimate)")
+        source = _Source(Trajectory(t=record.t, poses=record.estimate), files.frames, "run", f"{run} (the run's estimate)")
     else:
-        source = _Source(odometry, run / FRAMES_FILE, "run", f"{run} (no SLAM estimate in the folder: the run's odometry)")
+        source = _Source(odometry, files.frames, "run", f"{run} (no SLAM estimate in the folder: the run's odometry)")
     sources["estimate"] = source
-    sources["odometry"] = _Source(odometry, run / FRAMES_FILE, "run", "odometry")
+    sources["odometry"] = _Source(odometry, files.frames, "run", "odometry")
     try:
         sampled = sample_relations(
             truth,
@@ -302,11 +300,11 @@ def evaluate_run(
     except MetricError as exc:
         raise _with_lines(exc, sources, None) from None
     written: tuple[Path, ...] = ()
-    relations_path = run / RELATIONS_FILE
+    relations_path = files.relations
     if write:
-        written = (write_relations(relations_path, sampled.relations), write_errors(run / ERRORS_FILE, sampled.relations, sampled.errors))
+        written = (write_relations(relations_path, sampled.relations), write_errors(files.errors, sampled.relations, sampled.errors))
     trans, rot = _summaries(sampled.errors)
-    label = f"{run / RELATIONS_FILE if write else 'sampled'} ({len(sampled.relations)} relations sampled from the ground truth, seed {seed})"
+    label = f"{files.relations if write else 'sampled'} ({len(sampled.relations)} relations sampled from the ground truth, seed {seed})"
     return EvaluationResult(sampled.relations, sampled.errors, trans, rot, source.label, label, tolerance, sampled, relations_path if write else None, written)
 
 

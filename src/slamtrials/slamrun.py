@@ -173,13 +173,13 @@ def load_recording(path: str | Path) -> RunRecord:
     FormatError
         The path does not exist or the file does not parse.
     """
-    from slamtrials.io.runfolder import RUN_FILE, read_run
+    from slamtrials.io.runfolder import RunFolder, read_run
     from slamtrials.io.transfer import detect_recording_format, read_carmen_run
 
     path = Path(path)
     if not path.exists():
         raise FormatError(path, "no such file or folder")
-    if path.is_dir() and (path / RUN_FILE).exists():
+    if path.is_dir() and RunFolder(path).is_complete():
         return read_run(path)
     if detect_recording_format(path) == "carmen":
         return read_carmen_run(path)

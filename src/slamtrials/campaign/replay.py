@@ -145,14 +145,14 @@ class ReplayPlanner:
 
 def _recorded_runs(store: CampaignStore) -> dict[str, dict[int, tuple[int, str]]]:
     """``{world: {index: (seed, folder)}}`` of the source's done runs, each checked to be complete."""
-    from slamtrials.io.runfolder import RUN_FILE
+    from slamtrials.io.layout import RunFolder
 
     recorded: dict[str, dict[int, tuple[int, str]]] = {w.name: {} for w in store.worlds()}
     for run in store.runs():
         if run.status != "done":
             continue
         folder = run.folder or f"runs/{run.world}/{run.idx:03d}"
-        if not (store.folder / folder / RUN_FILE).is_file():
+        if not RunFolder(store.folder / folder).is_complete():
             raise ConfigError(f"{store.folder / folder}: recorded run {run.world} #{run.idx} is missing its run folder")
         recorded[run.world][run.idx] = (run.seed, folder)
     return recorded

@@ -83,11 +83,13 @@ def worker_name() -> str:
 def write_scored_run(folder: Path, record: RunRecord, score: RunScore) -> None:
     """Write relations, errors, then the run folder (``run.json`` last) into ``folder``."""
     from slamtrials.io.errorsfile import write_errors
+    from slamtrials.io.layout import RunFolder
     from slamtrials.io.relations import write_relations
     from slamtrials.io.runfolder import write_run
 
-    write_relations(folder / "relations.txt", score.sampled.relations)
-    write_errors(folder / "errors.npz", score.sampled.relations, score.sampled.errors)
+    files = RunFolder(folder)
+    write_relations(files.relations, score.sampled.relations)
+    write_errors(files.errors, score.sampled.relations, score.sampled.errors)
     write_run(folder, record)
 
 

@@ -79,12 +79,12 @@ def import_run(
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace a run already stored in --out.")] = False,
 ) -> None:
     """Import a ROS bag or a CARMEN log as a run folder, so recordings (also of real robots) can be evaluated."""
-    from slamtrials.io.runfolder import RUN_FILE, write_run
+    from slamtrials.io.runfolder import RunFolder, write_run
     from slamtrials.io.transfer import detect_recording_format, read_carmen_run
 
     if no_truth and truth_topic is not None:
         raise ConfigError("give either --truth-topic or --no-truth, not both")
-    if (out / RUN_FILE).exists() and not overwrite:
+    if RunFolder(out).is_complete() and not overwrite:
         raise ConfigError(f"{out}: already holds a run; choose another --out or pass --overwrite")
     kind = ImportFormat(detect_recording_format(source)) if fmt is ImportFormat.auto else fmt
     if kind is ImportFormat.bag:

@@ -58,6 +58,7 @@ from slamtrials.report.compare import (
     compare_campaigns,
     world_pair_traps,
 )
+from slamtrials.io.layout import RunFolder
 from slamtrials.report.load import CampaignData, load_campaign
 from slamtrials.report.tables import METRICS, paper_table
 
@@ -518,7 +519,7 @@ def _provenance(data: CampaignData) -> str:
     config_text = yaml.safe_dump(data.config, sort_keys=False, default_flow_style=None, width=110)
     seen: Counter = Counter()
     for folder in data.done["folder"]:
-        path = data.folder / str(folder) / "run.json"
+        path = RunFolder(data.folder / str(folder)).run_json
         try:
             doc = json.loads(path.read_text(encoding="utf-8"))
         except (OSError, ValueError):

@@ -88,7 +88,7 @@ def _check(log: CarmenLog) -> None:
         raise ValueError("write_carmen: laser.ranges holds negative ranges")
     for name in ("t", "logger_t", "pose", "tv", "rv", "accel"):
         _finite(f"odom.{name}", getattr(odom, name))
-    for host in set(laser.hostnames()) | set(odom.hostnames()):
+    for host in sorted(set(laser.hostnames()) | set(odom.hostnames())):  # sorted: the same host named first on every run
         _token("hostname", host)
     for key, value in log.params.items():
         _token("PARAM name", key)

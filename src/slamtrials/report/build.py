@@ -668,7 +668,7 @@ def trap_sentences(comparison: Comparison, metric: str = "eps_t") -> list[str]:
     unit = UNITS[metric]
     out = []
     rows = comparison.for_metric(metric)
-    for _, r in rows.sort_values("trap_fraction", ascending=False, na_position="last").iterrows():
+    for _, r in rows.sort_values("trap_fraction", ascending=False, na_position="last", kind="stable").iterrows():
         diff = r["difference"]
         if diff == 0 or not np.sign(r["trap_difference"]) == -np.sign(diff):
             continue
@@ -753,7 +753,7 @@ def compare_report(campaign_a: str | Path, campaign_b: str | Path, out_dir: str 
                                 f"coloured by verdict ({correction} correction); diamonds: the most misleading single-run pair "
                                 "where it contradicts the means; right margin: share of run pairs that reverse the means."))
     trap_rows = comparison.for_metric("eps_t")
-    trap_rows = trap_rows[np.isfinite(trap_rows["trap_fraction"])].sort_values("trap_fraction", ascending=False).head(12)
+    trap_rows = trap_rows[np.isfinite(trap_rows["trap_fraction"])].sort_values("trap_fraction", ascending=False, kind="stable").head(12)
     trap_picture = ""
     if len(trap_rows):
         ncols = min(4, len(trap_rows))

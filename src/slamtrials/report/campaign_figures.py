@@ -116,7 +116,7 @@ def draw_sorted_errors(ax, runs: pd.DataFrame, worlds: list[str] | None = None, 
     names = sorted(runs["world"].astype(str).unique()) if worlds is None else list(worlds)
     for world in names:
         values, _ = _world_values(runs, world, metric)
-        ax.plot(np.arange(1, len(values) + 1), np.sort(values)[::-1], "o-", ms=3, lw=1.2, label=world, gid=f"world:{world}")
+        ax.plot(np.arange(1, len(values) + 1), np.sort(values, kind="stable")[::-1], "o-", ms=3, lw=1.2, label=world, gid=f"world:{world}")
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("run (largest error first)")
     ax.set_ylabel(METRIC_LABELS[metric])

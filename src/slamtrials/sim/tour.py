@@ -105,7 +105,7 @@ def tour_waypoints(
     order, remaining = [0], set(range(1, len(goals)))
     while remaining:
         here = order[-1]
-        nxt = min(remaining, key=lambda g: distances[here, goals[g]])
+        nxt = min(remaining, key=lambda g: (distances[here, goals[g]], g))  # equal distances: the lower goal index
         order.append(nxt)
         remaining.remove(nxt)
 

@@ -96,7 +96,8 @@ ALGORITHMS: dict[str, type[SlamAlgorithm]] = {}
 
 _CONTRACT = ("name", "Config", "PRESETS", "reset", "process", "occupancy", "trajectory")
 
-_Class = TypeVar("_Class", bound=type)
+#: Any class may be registered (``type[Any]``: its attributes are unknown until checked below).
+_Class = TypeVar("_Class", bound="type[Any]")
 
 
 def register_algorithm(cls: _Class) -> _Class:
@@ -111,8 +112,7 @@ def register_algorithm(cls: _Class) -> _Class:
     missing = [member for member in _CONTRACT if member not in dir(cls)]
     if missing:
         raise ConfigError(f"SLAM algorithm class {cls.__qualname__} lacks {', '.join(missing)} (see slamtrials.slam.SlamAlgorithm)")
-    # The class attributes are checked one by one here (any class may be passed), hence getattr.
-    name, config, presets = getattr(cls, "name"), getattr(cls, "Config"), getattr(cls, "PRESETS")
+    name, config, presets = cls.name, cls.Config, cls.PRESETS
     if not isinstance(name, str) or not name:
         raise ConfigError(f"SLAM algorithm class {cls.__qualname__}: name must be a non-empty string, got {name!r}")
     if not (isinstance(config, type) and issubclass(config, BaseModel)):

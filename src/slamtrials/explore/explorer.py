@@ -210,9 +210,10 @@ class Explorer:
         """
         self._stalls = self._stalls + 1 if stalled else 0
         self._following = False
-        v, w = self._decide(float(t), np.asarray(pose, dtype=np.float64), ranges, laser, occupancy)
+        pose_array = np.asarray(pose, dtype=np.float64)
+        v, w = self._decide(float(t), pose_array, ranges, laser, occupancy)
         self._follower.remember(v, w)
-        self._stuck = self._monitor.update(float(t), pose, v, self.robot.control_period, self._following)
+        self._stuck = self._monitor.update(float(t), pose_array, v, self.robot.control_period, self._following)
         return v, w
 
     def _decide(self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: LaserGeometry,
@@ -398,7 +399,8 @@ class Explorer:
     def _take(self, t: float, found: Found) -> None:
         """Make ``found`` the goal and follow its path."""
         path = found.path
-        length = float(stablemath.hypot(*np.diff(path, axis=0).T).sum()) if len(path) > 1 else 0.0
+        step = np.diff(path, axis=0)
+        length = float(stablemath.hypot(step[:, 0], step[:, 1]).sum()) if len(path) > 1 else 0.0
         goal_xy = found.goal.copy()
         if self._goal is not None and (found.kept or math.dist(goal_xy, self._goal.xy) <= self.config.blacklist_radius):
             self._goal.xy = goal_xy

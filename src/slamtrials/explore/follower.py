@@ -53,6 +53,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from slamtrials import stablemath
 from slamtrials.explore.config import ExploreConfig, RobotLimits, lethal_distance
+from slamtrials.geometry import Pose1Like
 from slamtrials.record import LaserGeometry
 
 __all__ = ["FollowCommand", "PathFollower", "free_travel", "scan_points", "turn_rate"]
@@ -242,7 +243,8 @@ class PathFollower:
         points = np.asarray(path, dtype=np.float64).reshape(-1, 2)
         self._path = points
         self._clearance = None if clearance is None else np.asarray(clearance, dtype=np.float64).reshape(-1)
-        seg = stablemath.hypot(*np.diff(points, axis=0).T) if len(points) > 1 else np.zeros(0)
+        step = np.diff(points, axis=0)
+        seg = stablemath.hypot(step[:, 0], step[:, 1]) if len(points) > 1 else np.zeros(0)
         self._remaining = np.concatenate([np.cumsum(seg[::-1])[::-1], [0.0]]) if len(points) else np.zeros(0)
         # for each point, the index of the last point within _NARROW_AHEAD and _TARGET_WINDOW along the path
         along = self._remaining[0] - self._remaining if len(points) else np.zeros(0)
@@ -273,12 +275,12 @@ class PathFollower:
         self._v = 0.0
         self._w = 0.0
 
-    def remaining(self, pose: ArrayLike) -> float:
+    def remaining(self, pose: Pose1Like) -> float:
         """Path length (m) still ahead: from ``pose`` to the nearest path point (searched forward from the
         current one), then along the path; ``inf`` without a path."""
         if not self.has_path:
             return math.inf
-        x, y = float(pose[0]), float(pose[1])  # type: ignore[index]
+        x, y = float(pose[0]), float(pose[1])
         stop = min(self._index + _SEARCH_AHEAD, len(self._path))
         d = stablemath.hypot(self._path[self._index:stop, 0] - x, self._path[self._index:stop, 1] - y)
         k = int(np.argmin(d))

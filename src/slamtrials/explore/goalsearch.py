@@ -230,6 +230,8 @@ class GoalSearch:
         path[0] = pose[:2]
         target = path[-1].copy()
         if views:
+            if result.goal is None:  # both searches above return only results with a goal
+                raise RuntimeError("goal search: the chosen search result has no goal cell")
             target = _nearest_cell(unreachable, frame, result.goal, cfg.view_distance)
         clearance = costmap.clearance[cells[:, 0], cells[:, 1]].astype(np.float64)
         return outcome, Found(path=path, clearance=clearance, target=target, kept=result.kept)

@@ -31,6 +31,7 @@ from slamtrials import stablemath
 from slamtrials.explore.config import ExploreConfig, RobotLimits
 from slamtrials.explore.follower import scan_points
 from slamtrials.explore.gridframe import FREE_BELOW, GridFrame, map_arrays
+from slamtrials.geometry import Pose1Like
 from slamtrials.record import LaserGeometry
 
 __all__ = ["Recovery", "StuckMonitor", "open_side", "segment_clear"]
@@ -55,10 +56,10 @@ class StuckMonitor:
         self._anchor = None
         self._direction = 1.0
 
-    def update(self, t: float, pose: ArrayLike, v_command: float, dt: float, following: bool = True) -> bool:
+    def update(self, t: float, pose: Pose1Like, v_command: float, dt: float, following: bool = True) -> bool:
         """Record that at time ``t`` (s) the robot was at ``pose`` and was then commanded ``v_command``
         (m/s) for ``dt`` s, while following a path or not; return whether it is stuck."""
-        x, y = float(pose[0]), float(pose[1])  # type: ignore[index]
+        x, y = float(pose[0]), float(pose[1])
         if not following:
             self._anchor = None
         elif self._anchor is None or math.hypot(x - self._anchor[1], y - self._anchor[2]) >= self.config.idle_distance:
@@ -124,7 +125,8 @@ def segment_clear(occupancy: Any, a: ArrayLike, b: ArrayLike, radius: float) -> 
     length2 = float(seg[0] * seg[0] + seg[1] * seg[1])
     along = (centres[:, 0] - pa[0]) * seg[0] + (centres[:, 1] - pa[1]) * seg[1]
     s = np.zeros(len(centres)) if length2 == 0.0 else np.clip(along / length2, 0.0, 1.0)
-    gap = stablemath.hypot(*(centres - (pa + s[:, None] * seg)).T)
+    offset = centres - (pa + s[:, None] * seg)
+    gap = stablemath.hypot(offset[:, 0], offset[:, 1])
     return bool(gap.min() >= radius + 0.5 * resolution)
 
 
@@ -157,7 +159,7 @@ class Recovery:
         cfg, robot = self.config, self.robot
         x, y, theta = (float(v) for v in np.asarray(pose, dtype=np.float64)[:3])
         rate = 0.8 * robot.max_angular_speed
-        phases: list[tuple[float, float]] = []  # (duration, v, w) without the end times yet
+        phases: list[tuple[float, float, float]] = []  # (duration, v, w) without the end times yet
         points = scan_points(ranges, laser)
         push = None
         if points.shape[0] and cfg.backoff_distance > 0.0:

@@ -202,12 +202,13 @@ class GMapping:
         laser_odometry = compose1(odometry, self.mount)
         if self._angles is None or self._angles.shape[0] != ranges.shape[0]:
             self._angles = self.laser.beam_angles(ranges.shape[0])
-        first = self._last_laser_odometry is None
-        if first:
+        previous = self._last_laser_odometry
+        first = previous is None
+        if previous is None:
             start = laser_odometry if c.initial_pose is None else compose1(np.asarray(c.initial_pose), self.mount)
             self.poses[:] = start
         else:
-            self.poses = sample_motion(self.poses, self._last_laser_odometry, laser_odometry, c.srr, c.srt, c.str, c.stt,
+            self.poses = sample_motion(self.poses, previous, laser_odometry, c.srr, c.srt, c.str, c.stt,
                                        self.rng)
         due = self._due(t, laser_odometry)
         self._last_laser_odometry = laser_odometry

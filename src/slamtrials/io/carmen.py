@@ -138,7 +138,8 @@ def run_from_carmen(log: CarmenLog) -> RunRecord:
         "carmen_odom_lines": len(log.odom),
         "carmen_params": dict(params),
         "carmen_skipped": dict(log.skipped),
-        "field_of_view_deg": math.degrees(laser.angle_increment * (laser.beams - 1)),
+        "carmen_tolerated": dict(log.tolerated),
+        "field_of_view_deg": math.degrees(laser.angle_increment * max(laser.beams - 1, 0)),
     }
     n = len(laser)
     return RunRecord(t=laser.t.copy(), scans=laser.ranges.astype(np.float32, copy=True), odometry=laser.odometry.copy(),

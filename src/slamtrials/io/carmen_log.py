@@ -174,9 +174,14 @@ class CarmenLog:
     skipped:
         Line types read past without being interpreted (e.g. ``RLASER``, ``RAWLASER1``, ``TRUEPOS``,
         ``SYNC``) -> number of such lines. Never written back.
+    tolerated:
+        Oddities the reader tolerated -> number of lines (keys and meanings in
+        :data:`slamtrials.io.carmen_read.TOLERATED`: lines with non-finite poses skipped, timestamps
+        reordered, a truncated last line, scans padded, ...). Never written back.
     """
 
     laser: CarmenLaser
     odom: CarmenOdometry = field(default_factory=CarmenOdometry.empty)
     params: dict[str, str] = field(default_factory=dict)
     skipped: dict[str, int] = field(default_factory=dict)
+    tolerated: dict[str, int] = field(default_factory=dict)

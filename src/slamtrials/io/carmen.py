@@ -114,6 +114,12 @@ def carmen_from_run(record: RunRecord, *, kind: str = "ROBOTLASER1", hostname: s
     )
 
 
+def _param_float(params: dict[str, str], name: str) -> float:
+    """A numeric PARAM as :func:`read_carmen` checked it (its value's first token), 0 when absent."""
+    words = params.get(name, "0").split()
+    return float(words[0]) if words else 0.0
+
+
 def run_from_carmen(log: CarmenLog) -> RunRecord:
     """A CARMEN log as a run record, one frame per laser line.
 
@@ -125,9 +131,9 @@ def run_from_carmen(log: CarmenLog) -> RunRecord:
     and ``slamtrials_laser_range_min`` when present, else zero.
     """
     laser, params = log.laser, log.params
-    mount = [float(params.get(name, 0.0)) for name in PARAM_MOUNT]
+    mount = [_param_float(params, name) for name in PARAM_MOUNT]
     geometry = LaserGeometry(angle_min=float(laser.angle_min), angle_increment=float(laser.angle_increment),
-                             range_min=float(params.get(PARAM_RANGE_MIN, 0.0)), range_max=float(laser.range_max),
+                             range_min=_param_float(params, PARAM_RANGE_MIN), range_max=float(laser.range_max),
                              mount=(mount[0], mount[1], mount[2]))
     hosts = sorted(set(laser.hostnames()))
     metadata: dict[str, Any] = {

@@ -38,6 +38,8 @@ __all__ = ["read_carmen", "PARAM_RANGE_MAX", "PARAM_FOV", "PARAM_RESOLUTION", "P
 
 log = logging.getLogger(__name__)
 
+_FLOAT32_MAX = float(np.finfo(np.float32).max)
+
 #: PARAM names that give an old-format (FLASER) laser's geometry: metres, degrees, degrees.
 PARAM_RANGE_MAX = "robot_front_laser_max"
 PARAM_FOV = "laser_front_laser_fov"
@@ -97,7 +99,7 @@ def _flaser_geometry(path: Path, params: dict[str, str], where: dict[str, int], 
 def _check_ranges(path: Path, kind: str, ranges: list[NDArray[np.float64]], numbers: list[int]) -> None:
     """Every reading a finite, non-negative float32 number; FormatError at the first that is not."""
     for row, values in enumerate(ranges):
-        bad = ~np.isfinite(values) | (values < 0) | (values > np.finfo(np.float32).max)
+        bad = ~np.isfinite(values) | (values < 0) | (values > _FLOAT32_MAX)
         if bad.any():
             col = int(np.argmax(bad))
             value = values[col]
@@ -219,16 +221,18 @@ def _geometry(path: Path, kind: str, kept: list[LaserLine], numbers: list[int], 
         bad = first_bad_row(~np.isfinite(config))
         if bad is not None:
             raise FormatError(path, f"ROBOTLASER1 {CONFIG[bad[1]]} is not finite: {config[bad]}", line=numbers[bad[0]])
-        small = np.flatnonzero(~(config[:, 3] > 0))
+        small = np.flatnonzero(~((config[:, 3] > 0) & (config[:, 3] <= _FLOAT32_MAX)))
         if small.size:
             i = int(small[0])
-            raise FormatError(path, f"ROBOTLASER1 maximum_range must be positive, got {config[i, 3]}", line=numbers[i])
+            raise FormatError(path, f"ROBOTLASER1 maximum_range must be positive (and a float32), got {config[i, 3]}", line=numbers[i])
         geometry[:, 0], geometry[:, 1], geometry[:, 2] = config[:, 0], config[:, 2], config[:, 3]
         return geometry
     counts = [len(line.ranges) for line in kept]
     range_max = param_number(path, params, where, PARAM_RANGE_MAX)
+    if range_max is not None and range_max > _FLOAT32_MAX:
+        raise FormatError(path, f"PARAM {PARAM_RANGE_MAX} is too large for float32: {range_max}", line=where[PARAM_RANGE_MAX])
     if range_max is None:
-        usable = [line.ranges[np.isfinite(line.ranges) & (line.ranges <= np.finfo(np.float32).max)] for line in kept]
+        usable = [line.ranges[np.isfinite(line.ranges) & (line.ranges <= _FLOAT32_MAX)] for line in kept]
         top = max((float(r.max()) for r in usable if len(r)), default=0.0)
         range_max = float(str(np.float32(top)))  # shortest decimal of the float32 maximum: 81.91, not 81.910004
     by_count = {count: _flaser_geometry(path, params, where, count) for count in set(counts)}

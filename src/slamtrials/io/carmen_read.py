@@ -268,7 +268,8 @@ def _laser(path: Path, kind: str, parsed: list[LaserLine], numbers_list: list[in
     rows = stamps[order]
     common = dict(kind=kind, t=rows[:, -2].copy(), logger_t=rows[:, -1].copy(), hostname=_one_or_all([hosts[i] for i in order.tolist()]),
                   ranges=scans, pose=rows[:, :3].copy(), odometry=rows[:, 3:6].copy(),
-                  angle_min=angle_min, angle_increment=increment, range_max=range_max)
+                  angle_min=angle_min, angle_increment=increment, range_max=range_max,
+                  line_readings=np.array([len(r) for r in readings], dtype=np.int64))
     if kind == "FLASER":
         return CarmenLaser(**common)
     first = kept[0]

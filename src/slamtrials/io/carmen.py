@@ -18,6 +18,9 @@ logger's timestamp the seconds since logging started. slamtrials reads and write
 
 Other line types (``RLASER``, ``ROBOTLASER2``, ``RAWLASER1..4``, ``TRUEPOS``, ``SYNC``, ...) are skipped
 and counted. Ranges are written to the millimetre (CARMEN's ``%.3f``), other numbers to 6 decimals.
+Logs may be gzip- or bzip2-compressed. What the reader tolerates in logs of the wild (pose-only
+``FLASER 0`` lines, ``nan`` poses, timestamps going backwards, beam counts that change, a truncated last
+line, PARAM trailers) is listed in :mod:`slamtrials.io.carmen_read` and docs/real-datasets.md.
 
 Which pose is which. Each laser line has two pose triples. In logs of real robots the first is the pose
 of the laser, often corrected afterwards by a SLAM program (in ``mit-csail.clf`` the two are equal),
@@ -128,7 +131,8 @@ def run_from_carmen(log: CarmenLog) -> RunRecord:
     pose triple and ``stalled`` all False. A CARMEN log has no ground truth: ``truth`` is only as good as
     the pose its first triple holds, and ``metadata["truth_source"]`` says so (:data:`TRUTH_SOURCE`).
     The laser mounting and minimum range come from the PARAMs :data:`~slamtrials.io.carmen_read.PARAM_MOUNT`
-    and ``slamtrials_laser_range_min`` when present, else zero.
+    and ``slamtrials_laser_range_min`` when present, else zero. ``metadata["carmen_tolerated"]`` keeps
+    what the reader tolerated (:attr:`CarmenLog.tolerated`).
     """
     laser, params = log.laser, log.params
     mount = [_param_float(params, name) for name in PARAM_MOUNT]

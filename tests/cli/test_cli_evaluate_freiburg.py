@@ -181,7 +181,7 @@ def test_the_cli_shows_each_tolerated_oddity_once(tmp_path):
     log.write_text("".join(lines) + lines[-1][:25])  # a last line cut short
     code = "import sys; from slamtrials.cli.main import main; sys.argv[0] = 'slamtrials'; main()"
     done = subprocess.run([sys.executable, "-c", code, "evaluate", "-e", str(log), "-r", str(relations)],
-                          capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(REPO / "src")})
+                          capture_output=True, text=True, check=False, env={**os.environ, "PYTHONPATH": str(REPO / "src")})
     assert done.returncode == 0, done.stderr
     warnings = [line for line in done.stderr.splitlines() if line.startswith("WARNING")]
     assert len(warnings) == 3, done.stderr

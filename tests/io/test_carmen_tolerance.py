@@ -153,7 +153,7 @@ def test_backwards_timestamps_are_ordered_stably_and_repeats_dropped(tmp_path, c
 def test_a_truncated_last_line_is_skipped_with_a_warning(tmp_path, caplog, cut):
     path = tmp_path / "log.clf"
     whole = _flaser(1.0) + _flaser(2.0) + _flaser(3.0)
-    path.write_text(whole[: len(whole) - 1 + (cut if cut < 0 else 0)] if cut < 0 else whole + _flaser(4.0)[:cut])
+    path.write_text(whole[: len(whole) - 1 + cut] if cut < 0 else whole + _flaser(4.0)[:cut])
     log = read_carmen(path)
     assert len(log.laser) == (2 if cut < 0 else 3) and log.tolerated == {"truncated_last_line": 1}
     assert len(_warnings(caplog)) == 1 and "cut short" in _warnings(caplog)[0]

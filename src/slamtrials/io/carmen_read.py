@@ -199,7 +199,8 @@ def read_carmen(path: str | Path, *, ranges: bool = True) -> CarmenLog:
     for key in (*PARAM_MOUNT, PARAM_RANGE_MIN):
         param_number(path, params, param_lines, key, positive=False)
     if kind is None:
-        raise FormatError(path, "no FLASER or ROBOTLASER1 line: not a CARMEN log with a front laser", line=final)
+        rear = f" ({skipped['RLASER']} RLASER lines: slamtrials reads the front laser, as the Freiburg evaluator does)" if skipped["RLASER"] else ""
+        raise FormatError(path, f"no FLASER or ROBOTLASER1 line: not a CARMEN log with a front laser{rear}", line=final)
     laser = _laser(path, kind, laser_lines, numbers, hosts, params, param_lines, tally, ranges)
     odom = _odometry(path, odom_rows, odom_numbers, odom_hosts, tally)
     tally.warn(kind, {"laser_padded": f" to {laser.beams} beams ({laser.range_max:g} m)",
@@ -266,14 +267,13 @@ def _laser(path: Path, kind: str, parsed: list[LaserLine], numbers_list: list[in
         scans = np.zeros((len(kept), 0), dtype=np.float32)
         angle_min, increment, range_max = (float(v) for v in geometry[0])
     rows = stamps[order]
-    common = dict(kind=kind, t=rows[:, -2].copy(), logger_t=rows[:, -1].copy(), hostname=_one_or_all([hosts[i] for i in order.tolist()]),
-                  ranges=scans, pose=rows[:, :3].copy(), odometry=rows[:, 3:6].copy(),
-                  angle_min=angle_min, angle_increment=increment, range_max=range_max,
-                  line_readings=np.array([len(r) for r in readings], dtype=np.int64))
-    if kind == "FLASER":
-        return CarmenLaser(**common)
+    common = {"kind": kind, "t": rows[:, -2].copy(), "logger_t": rows[:, -1].copy(),
+              "hostname": _one_or_all([hosts[i] for i in order.tolist()]), "ranges": scans, "pose": rows[:, :3].copy(),
+              "odometry": rows[:, 3:6].copy(), "angle_min": angle_min, "angle_increment": increment, "range_max": range_max,
+              "line_readings": np.array([len(r) for r in readings], dtype=np.int64)}
     first = kept[0]
-    assert first.config is not None and first.integers is not None
+    if first.config is None or first.integers is None:  # FLASER
+        return CarmenLaser(**common)
     return CarmenLaser(**common, laser_type=first.integers[0], accuracy=float(first.config[4]), remission_mode=first.integers[1],
                        extra=rows[:, 6 : 6 + len(EXTRA)].copy())
 

@@ -51,7 +51,7 @@ def test_param_lines_with_any_trailing_fields(tmp_path):
     log = read_carmen(path)
     assert log.params["robot_frontlaser_offset"] == "0.0" and log.params["robot_front_laser_max"] == "80.0"
     assert log.laser.range_max == 80.0
-    assert run_from_carmen(log).laser["mount"] == [0.0, 0.05, 0.0]
+    assert run_from_carmen(log).laser.mount == (0.0, 0.05, 0.0)
     assert log.tolerated == {}
 
 
@@ -215,7 +215,7 @@ def test_fr079_bzip2_log_reads_directly():
     # each frame's odometry is its FLASER line's own second triple, in the frame of the ODOM lines
     assert np.abs(laser.odometry[0, :2] - log.odom.pose[0, :2]).max() < 0.01
     record = read_carmen_run(FR079)
-    assert record.scans.shape == (4934, 360) and record.laser["mount"] == [-0.04, 0.0, 0.0]
+    assert record.scans.shape == (4934, 360) and record.laser.mount == (-0.04, 0.0, 0.0)
 
 
 @pytest.mark.skipif(not MIT.is_file(), reason="shared data not present")
@@ -226,3 +226,12 @@ def test_mit_csail_reads_the_same_compressed(tmp_path):
     assert b.laser.ranges.shape == (1988, 361) and b.tolerated == {}
     np.testing.assert_array_equal(a.laser.ranges, b.laser.ranges)
     np.testing.assert_array_equal(a.laser.t, b.laser.t)
+
+
+def test_a_geometry_a_run_cannot_hold_is_one_format_error(tmp_path):
+    path = tmp_path / "one.clf"
+    path.write_text(_flaser(1.0, beams=1) + _flaser(2.0, beams=1))  # one beam: no angular increment
+    assert read_carmen(path).laser.ranges.shape == (2, 1)
+    with pytest.raises(FormatError, match="laser geometry cannot be used: .*angle_increment") as info:
+        read_carmen_run(path)
+    assert "\n" not in str(info.value)

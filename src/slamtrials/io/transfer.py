@@ -135,4 +135,7 @@ def read_carmen_run(path: str | Path) -> RunRecord:
     if log.laser.beams == 0:
         raise FormatError(path, f"its {log.laser.kind} lines hold no readings (a pose-only trajectory): nothing to map or "
                           "replay; evaluate it with slamtrials evaluate --estimate")
-    return run_from_carmen(log)
+    try:
+        return run_from_carmen(log)
+    except ValueError as exc:  # a geometry LaserGeometry refuses (one beam, a clockwise scan, no positive range)
+        raise FormatError(path, f"its {log.laser.kind} laser geometry cannot be used: {exc}") from None

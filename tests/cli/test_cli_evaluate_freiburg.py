@@ -41,7 +41,7 @@ def _test_log(path: Path, t, poses, second=None) -> Path:
     return path
 
 
-def _by_hand(t, poses, relations_path: Path) -> tuple[str, str]:
+def _by_hand(t, poses, relations_path: Path, tolerance: float = 0.1) -> tuple[str, str]:
     """The Freiburg program's numbers, computed here from its definition: the pose nearest in time to each
     relation timestamp (all within 0.1 s here), the relative pose from t1 to t2, the difference to the relation's (translation: length of the
     difference of the two translations; rotation: |wrapped angle difference|), then its %f row: mean, sample
@@ -50,7 +50,7 @@ def _by_hand(t, poses, relations_path: Path) -> tuple[str, str]:
 
     def at(stamp: float) -> np.ndarray:
         k = int(np.argmin(np.abs(t - stamp)))
-        assert abs(t[k] - stamp) <= 0.1
+        assert abs(t[k] - stamp) <= tolerance  # np.argmin: the first in the file on a tie, as the program scans
         return poses[k]
 
     trans, rot = [], []
@@ -147,6 +147,17 @@ def test_relations_of_another_log_are_one_line_and_exit_2(tmp_path):
         assert result.output.count("\n") == 1, result.output
         assert f"{relations}: no relation timestamp (7 relations in [" in result.output and "not of this log" in result.output
         assert f"within 0.1 s of a pose: {log} has" in result.output and "Traceback" not in result.output
+
+
+def test_infinite_tolerance_is_the_programs_nearest_pose_whatever_the_gap(tmp_path):
+    """Without -o the metricEvaluator takes the nearest pose however far; ``--tolerance inf`` does the same."""
+    t, poses, relations = _synthetic(tmp_path)
+    sparse = np.arange(0, len(t), 3)
+    log = _test_log(tmp_path / "sparse.log", t[sparse], poses[sparse])
+    result = runner.invoke(app, ["evaluate", "-e", str(log), "-r", str(relations), "--tolerance", "inf"])
+    assert result.exit_code == 0, result.output
+    assert _rows(result.output) == _by_hand(t[sparse], poses[sparse], relations, tolerance=math.inf)
+    assert "matched 7 of 7 relations" in result.output
 
 
 @pytest.mark.skipif(not (DATA / "mit-csail.relations").is_file() or not FR079.is_file(), reason="shared data not present")

@@ -97,14 +97,16 @@ def _data_line(path: Path, index: int, keep=lambda tokens: True) -> int | None:
 
 def _is_carmen(path: Path) -> bool:
     """A CARMEN log starts (after comments) with a message name; a TUM file with a number."""
-    from slamtrials.io.textfile import data_lines, read_lines
+    from slamtrials.io.compressed import read_head
 
-    for _, tokens in data_lines(read_lines(path)):
-        try:
-            float(tokens[0])
-        except ValueError:
-            return True
-        return False
+    for line in read_head(path).decode("utf-8", errors="replace").split("\n"):
+        tokens = line.split()
+        if tokens and not tokens[0].startswith("#"):
+            try:
+                float(tokens[0])
+            except ValueError:
+                return True
+            return False
     return False
 
 

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import bz2
+import gzip
 import math
 import os
 import subprocess
@@ -117,6 +118,20 @@ def test_compressed_test_log(tmp_path):
     result = runner.invoke(app, ["evaluate", "-e", str(packed), "-r", str(relations)])
     assert result.exit_code == 0, result.output
     assert _rows(result.output) == _by_hand(t, poses, relations)
+
+
+def test_a_compressed_test_log_cut_short_warns_once_per_oddity(tmp_path, caplog):
+    t, poses, relations = _synthetic(tmp_path)
+    log = _test_log(tmp_path / "test.log", t, poses)
+    packed = tmp_path / "test.log.gz"
+    data = gzip.compress(log.read_bytes() * 50)  # the trajectory 50 times over: only the first copy is in time order
+    packed.write_bytes(data[: len(data) // 2])
+    result = runner.invoke(app, ["evaluate", "-e", str(packed), "-r", str(relations)])
+    assert result.exit_code == 0, result.output
+    assert _rows(result.output) == _by_hand(t, poses, relations)
+    messages = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    assert sum("ends early" in m for m in messages) == 1, messages
+    assert sum("cut short" in m for m in messages) == 1 and sum("repeat an earlier line's timestamp" in m for m in messages) == 1
 
 
 def test_changing_beam_counts_are_evaluated_from_the_poses(tmp_path):

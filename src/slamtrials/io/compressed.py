@@ -15,7 +15,7 @@ from pathlib import Path
 
 from slamtrials.errors import FormatError
 
-__all__ = ["read_maybe_compressed", "compression_of"]
+__all__ = ["read_maybe_compressed", "read_head", "compression_of"]
 
 log = logging.getLogger(__name__)
 
@@ -78,3 +78,35 @@ def read_maybe_compressed(path: Path) -> bytes:
         raise FormatError(path, f"cannot read: {exc.strerror or exc}") from None
     kind = compression_of(data[:4])
     return data if kind is None else _decompress(path, data, kind)
+
+
+def read_head(path: Path, size: int = 1 << 16) -> bytes:
+    """About the first ``size`` bytes of ``path``'s (decompressed) content, to tell formats apart; no
+    warnings, and a corrupt or short stream simply gives less. (bzip2 gives nothing before its first
+    block, up to 900 kB of input, is read.)
+
+    Raises
+    ------
+    FormatError
+        The file is missing, a directory or unreadable.
+    """
+    try:
+        with open(path, "rb") as handle:
+            data = handle.read(size)
+            kind = compression_of(data[:4])
+            if kind is None:
+                return data
+            engine, out = _decompressor(kind), b""
+            try:
+                while data and len(out) < size and not engine.eof:
+                    out += engine.decompress(data)
+                    data = handle.read(size)
+            except (OSError, EOFError, ValueError, zlib.error):
+                pass
+            return out[:size]
+    except FileNotFoundError:
+        raise FormatError(path, "no such file") from None
+    except IsADirectoryError:
+        raise FormatError(path, "is a directory, expected a text file") from None
+    except OSError as exc:
+        raise FormatError(path, f"cannot read: {exc.strerror or exc}") from None

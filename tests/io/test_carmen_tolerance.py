@@ -235,3 +235,18 @@ def test_a_geometry_a_run_cannot_hold_is_one_format_error(tmp_path):
     with pytest.raises(FormatError, match="laser geometry cannot be used: .*angle_increment") as info:
         read_carmen_run(path)
     assert "\n" not in str(info.value)
+
+
+def test_a_trajectory_written_as_a_freiburg_test_log_reads_back(tmp_path):
+    from slamtrials.io.carmen import carmen_from_trajectory, write_carmen
+    from slamtrials.record import Trajectory
+
+    t = 1134864600.0 + 0.25 * np.arange(6)
+    poses = np.column_stack([np.arange(6) * 0.5, np.sin(np.arange(6)), 0.1 * np.arange(6)])
+    path = write_carmen(tmp_path / "test.log", carmen_from_trajectory(Trajectory(t=t, poses=poses)))
+    lines = [line for line in path.read_text().splitlines() if not line.startswith("#")]
+    assert len(lines) == 6 and lines[1].startswith("FLASER 0 0.500000 0.841471 0.100000 0.500000 0.841471 0.100000 1134864600.250000 ")
+    log = read_carmen(path)
+    assert log.laser.pose_only and log.params == {} and log.tolerated == {}
+    np.testing.assert_allclose(log.laser.odometry, poses, atol=5e-7)
+    np.testing.assert_array_equal(log.laser.t, t)

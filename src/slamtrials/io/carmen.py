@@ -45,7 +45,7 @@ from slamtrials.io.carmen_log import LASER_KINDS, ROBOTLASER_EXTRA, CarmenLaser,
 from slamtrials.io.carmen_read import PARAM_MOUNT, PARAM_RANGE_MIN, read_carmen
 from slamtrials.io.carmen_write import write_carmen
 from slamtrials.io.textfile import float_text
-from slamtrials.record import LaserGeometry, RunRecord
+from slamtrials.record import LaserGeometry, RunRecord, Trajectory
 
 __all__ = [
     "CarmenLaser",
@@ -54,6 +54,7 @@ __all__ = [
     "read_carmen",
     "write_carmen",
     "carmen_from_run",
+    "carmen_from_trajectory",
     "run_from_carmen",
     "TRUTH_SOURCE",
 ]
@@ -115,6 +116,27 @@ def carmen_from_run(record: RunRecord, *, kind: str = "ROBOTLASER1", hostname: s
                             tv=tv, rv=rv, accel=np.zeros(len(t))),
         params=params,
     )
+
+
+def carmen_from_trajectory(trajectory: Trajectory, *, hostname: str = "slamtrials") -> CarmenLog:
+    """A trajectory as the Freiburg evaluator's test logs hold one: ``FLASER 0 x y th x y th ts host ts``.
+
+    Both pose triples are the trajectory's pose (the metricEvaluator reads the second, slamtrials'
+    ``evaluate`` either), ``logger_t`` is the time since the first pose, and there are no ODOM lines.
+
+    Parameters
+    ----------
+    trajectory:
+        Poses ``[N, 3]`` (m, m, rad) at strictly increasing times (s).
+    hostname:
+        ``ipc_hostname`` of every line.
+    """
+    t = np.asarray(trajectory.t, dtype=np.float64)
+    poses = np.asarray(trajectory.poses, dtype=np.float64)
+    laser = CarmenLaser(kind="FLASER", t=t.copy(), logger_t=t - t[0] if len(t) else t.copy(), hostname=hostname,
+                        ranges=np.zeros((len(t), 0), dtype=np.float32), pose=poses.copy(), odometry=poses.copy(),
+                        angle_min=0.0, angle_increment=0.0, range_max=0.0)
+    return CarmenLog(laser=laser)
 
 
 def _param_float(params: dict[str, str], name: str) -> float:

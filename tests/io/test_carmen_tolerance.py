@@ -12,9 +12,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from slamtrials.errors import FormatError
 from slamtrials.io.carmen import read_carmen, run_from_carmen
+from slamtrials.io.carmen_read import TOLERATED
 from slamtrials.io.transfer import read_carmen_run
 
 REPO = Path(__file__).resolve().parents[2]
@@ -250,3 +253,34 @@ def test_a_trajectory_written_as_a_freiburg_test_log_reads_back(tmp_path):
     assert log.laser.pose_only and log.params == {} and log.tolerated == {}
     np.testing.assert_allclose(log.laser.odometry, poses, atol=5e-7)
     np.testing.assert_array_equal(log.laser.t, t)
+
+
+@settings(max_examples=60, deadline=None)
+@given(data=st.data())
+def test_any_mix_of_oddities_reads_as_the_clean_log(tmp_path_factory, data):
+    """Lines shuffled, repeated, given nan poses and a cut last line: what is read is the clean log's lines
+    with finite poses, in time order, the first of each repeated timestamp; each oddity counted as it was made."""
+    n = data.draw(st.integers(min_value=2, max_value=25))
+    t = 100.0 + np.cumsum(data.draw(st.lists(st.integers(1, 5), min_size=n, max_size=n))) * 0.1
+    lines = [_flaser(float(t[k]), pose=(k, 0, 0), ranges="1 2 3") for k in range(n)]
+    order = data.draw(st.permutations(range(n)))
+    bad = set(data.draw(st.lists(st.sampled_from(range(n)), max_size=n - 1, unique=True)))
+    repeats = data.draw(st.lists(st.sampled_from(range(n)), max_size=3, unique=True))
+    text = [lines[k].replace(f" {k} 0 0 ", " nan 0 0 ", 1) if k in bad else lines[k] for k in order]
+    for k in repeats:  # a later line with an earlier line's timestamp and another pose
+        text.append(_flaser(float(t[k]), pose=(1000 + k, 0, 0), ranges="1 2 3"))
+    cut = data.draw(st.booleans())
+    body = "".join(text) + ("FLASER 3 1 2" if cut else "")
+    path = tmp_path_factory.mktemp("mix") / "log.clf"
+    path.write_text(body)
+    log = read_carmen(path)
+    good = sorted(k for k in range(n) if k not in bad)
+    first_repeat = [k for k in repeats if k in bad]  # a repeat of a skipped line is the only line at its time
+    expected_t = sorted([float(t[k]) for k in good] + [float(t[k]) for k in first_repeat])
+    np.testing.assert_array_equal(log.laser.t, expected_t)
+    expected_x = {float(t[k]): k for k in good} | {float(t[k]): 1000 + k for k in first_repeat}
+    assert log.laser.pose[:, 0].tolist() == [expected_x[v] for v in expected_t]
+    assert log.tolerated.get("laser_nonfinite", 0) == len(bad)
+    assert log.tolerated.get("laser_duplicate", 0) == len([k for k in repeats if k not in bad])
+    assert log.tolerated.get("truncated_last_line", 0) == int(cut)
+    assert set(log.tolerated) <= set(TOLERATED)

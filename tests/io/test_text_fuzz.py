@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 
 from slamtrials.errors import FormatError
 from slamtrials.io.carmen import CarmenLog, read_carmen
+from slamtrials.io.carmen_read import TOLERATED
 from slamtrials.io.compressed import read_maybe_compressed
 from slamtrials.io.relations import read_relations
 from slamtrials.io.tum import read_tum
@@ -109,6 +110,8 @@ def _sane_carmen(log: CarmenLog) -> None:
     assert np.all(np.diff(laser.t) > 0) and np.isfinite(laser.pose).all() and np.isfinite(laser.odometry).all()
     assert math.isfinite(laser.angle_min) and math.isfinite(laser.angle_increment) and laser.range_max >= 0
     assert np.all(np.diff(log.odom.t) >= 0) and np.isfinite(log.odom.pose).all()
+    assert set(log.tolerated) <= set(TOLERATED) and all(count > 0 for count in log.tolerated.values())
+    assert laser.line_readings is not None and laser.line_readings.shape == (len(laser),)
 
 
 def _sane_tum(trajectory: Trajectory) -> None:

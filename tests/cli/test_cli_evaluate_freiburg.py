@@ -213,4 +213,4 @@ def test_the_cli_shows_each_tolerated_oddity_once(tmp_path):
     assert len(warnings) == 3, done.stderr
     assert any("1 FLASER lines with a non-finite pose" in w for w in warnings)
     assert any("1 FLASER lines with a timestamp earlier" in w for w in warnings)
-    assert any("last line cut short" in w for w in warnings)
+    assert any("last line is cut short" in w for w in warnings)

@@ -59,7 +59,7 @@ TOLERATED = {
     "laser_range_raised": "{kind} lines with a shorter maximum range: their no-return readings raised to the common one",
     "odom_nonfinite": "ODOM lines with a non-finite pose, velocity or timestamp skipped",
     "odom_reordered": "ODOM lines with a timestamp earlier than a line before them: ODOM lines ordered by timestamp (stable)",
-    "truncated_last_line": "last line cut short (no newline at the end of the file) skipped",
+    "truncated_last_line": "the last line is cut short (no newline at the end of the file): skipped",
 }
 
 
@@ -80,7 +80,10 @@ class _Tally:
     def warn(self, kind: str, detail: dict[str, str]) -> None:
         for key, count in self.counts.items():
             what = TOLERATED[key].format(kind=kind) + detail.get(key, "")
-            log.warning("%s: %d %s (first: line %d)", self.path, count, what, self.first[key])
+            if key == "truncated_last_line":
+                log.warning("%s:%d: %s", self.path, self.first[key], what)
+            else:
+                log.warning("%s: %d %s (first: line %d)", self.path, count, what, self.first[key])
 
 
 def _flaser_geometry(path: Path, params: dict[str, str], where: dict[str, int], beams: int) -> tuple[float, float]:

@@ -117,7 +117,7 @@ def _order(t: NDArray[np.float64], numbers: NDArray[np.int64], tally: _Tally, wh
     order = np.argsort(t, kind="stable")
     if unique and len(order) > 1:
         repeat = np.concatenate([[False], np.diff(t[order]) == 0])
-        tally.add(f"{what}_duplicate", np.sort(numbers[order[repeat]]))
+        tally.add(f"{what}_duplicate", np.sort(numbers[order[repeat]], kind="stable"))
         order = order[~repeat]
     return order
 
@@ -239,7 +239,7 @@ def _geometry(path: Path, kind: str, kept: list[LaserLine], numbers: list[int], 
         usable = [line.ranges[np.isfinite(line.ranges) & (line.ranges <= _FLOAT32_MAX)] for line in kept]
         top = max((float(r.max()) for r in usable if len(r)), default=0.0)
         range_max = float(str(np.float32(top)))  # shortest decimal of the float32 maximum: 81.91, not 81.910004
-    by_count = {count: _flaser_geometry(path, params, where, count) for count in set(counts)}
+    by_count = {count: _flaser_geometry(path, params, where, count) for count in sorted(set(counts))}
     for i, count in enumerate(counts):
         geometry[i] = (*by_count[count], range_max)
     return geometry

@@ -221,7 +221,7 @@ def _geometry(path: Path, kind: str, kept: list[LaserLine], numbers: list[int], 
     n = len(kept)
     geometry = np.empty((n, 3))
     if kind == "ROBOTLASER1":
-        config = np.stack([line.config for line in kept])
+        config = np.stack([line.config if line.config is not None else np.full(len(CONFIG), np.nan) for line in kept])
         bad = first_bad_row(~np.isfinite(config))
         if bad is not None:
             raise FormatError(path, f"ROBOTLASER1 {CONFIG[bad[1]]} is not finite: {config[bad]}", line=numbers[bad[0]])
@@ -270,15 +270,14 @@ def _laser(path: Path, kind: str, parsed: list[LaserLine], numbers_list: list[in
         scans = np.zeros((len(kept), 0), dtype=np.float32)
         angle_min, increment, range_max = (float(v) for v in geometry[0])
     rows = stamps[order]
-    common = {"kind": kind, "t": rows[:, -2].copy(), "logger_t": rows[:, -1].copy(),
-              "hostname": _one_or_all([hosts[i] for i in order.tolist()]), "ranges": scans, "pose": rows[:, :3].copy(),
-              "odometry": rows[:, 3:6].copy(), "angle_min": angle_min, "angle_increment": increment, "range_max": range_max,
-              "line_readings": np.array([len(r) for r in readings], dtype=np.int64)}
     first = kept[0]
-    if first.config is None or first.integers is None:  # FLASER
-        return CarmenLaser(**common)
-    return CarmenLaser(**common, laser_type=first.integers[0], accuracy=float(first.config[4]), remission_mode=first.integers[1],
-                       extra=rows[:, 6 : 6 + len(EXTRA)].copy())
+    integers = first.integers if first.integers is not None else (0, 0)  # ROBOTLASER1's laser_type, remission_mode
+    return CarmenLaser(kind=kind, t=rows[:, -2].copy(), logger_t=rows[:, -1].copy(),
+                       hostname=_one_or_all([hosts[i] for i in order.tolist()]), ranges=scans, pose=rows[:, :3].copy(),
+                       odometry=rows[:, 3:6].copy(), angle_min=angle_min, angle_increment=increment, range_max=range_max,
+                       laser_type=integers[0], accuracy=float(first.config[4]) if first.config is not None else 0.0,
+                       remission_mode=integers[1], extra=rows[:, 6 : 6 + len(EXTRA)].copy() if kind == "ROBOTLASER1" else None,
+                       line_readings=np.array([len(r) for r in readings], dtype=np.int64))
 
 
 def _odometry(path: Path, rows: list[list[float]], numbers_list: list[int], hosts: list[str], tally: _Tally) -> CarmenOdometry:

@@ -284,3 +284,40 @@ def test_any_mix_of_oddities_reads_as_the_clean_log(tmp_path_factory, data):
     assert log.tolerated.get("laser_duplicate", 0) == len([k for k in repeats if k not in bad])
     assert log.tolerated.get("truncated_last_line", 0) == int(cut)
     assert set(log.tolerated) <= set(TOLERATED)
+
+
+@settings(max_examples=80, deadline=None)
+@given(data=st.data())
+def test_common_grid_puts_every_reading_at_its_angle(data):
+    """Lines on one grid (same increment, starts whole increments apart): each reading lands in the column of
+    its angle, every other cell is a no-return reading, and nothing is lost."""
+    from slamtrials.io.carmen_grid import common_grid
+
+    increment = data.draw(st.sampled_from([0.25, math.radians(0.5), -0.1]))
+    base = data.draw(st.floats(-2.0, 0.0))
+    n = data.draw(st.integers(1, 6))
+    offsets = data.draw(st.lists(st.integers(0, 4), min_size=n, max_size=n))
+    counts = data.draw(st.lists(st.integers(0, 6), min_size=n, max_size=n))
+    maxima = data.draw(st.lists(st.sampled_from([30.0, 40.0]), min_size=n, max_size=n))
+    ranges = [np.arange(1, c + 1, dtype=np.float64) + 0.1 * k for k, c in enumerate(counts)]  # below every maximum
+    geometry = np.array([[base + o * increment, increment, m] for o, m in zip(offsets, maxima)])
+    filled = [k for k in range(n) if counts[k]]
+    widest = max(counts)
+    if filled:  # shifts beyond the widest line, or a grid over twice as wide, are refused as not one laser
+        span = max(offsets[k] + counts[k] for k in filled) - min(offsets[k] for k in filled)
+        if any(abs(offsets[k] - offsets[filled[0]]) > widest for k in filled) or span > 2 * widest:
+            with pytest.raises(FormatError, match="grid"):
+                common_grid(Path("x.clf"), "ROBOTLASER1", list(range(1, n + 1)), ranges, geometry)
+            return
+    grid = common_grid(Path("x.clf"), "ROBOTLASER1", list(range(1, n + 1)), ranges, geometry)
+    assert grid.range_max == max(maxima) and grid.ranges.shape[0] == n
+    if not any(counts):
+        assert grid.ranges.shape[1] == 0
+        return
+    assert grid.angle_increment == increment
+    for k in range(n):
+        row = grid.ranges[k]
+        for j, value in enumerate(ranges[k]):
+            column = round((base + (offsets[k] + j) * increment - grid.angle_min) / increment)
+            assert row[column] == np.float32(value)
+        assert np.count_nonzero(row != grid.range_max) == counts[k]

@@ -96,7 +96,8 @@ def common_grid(path: Path, kind: str, numbers: list[int], ranges: list[NDArray[
         start, inc = float(geometry[i, 0]), float(geometry[i, 1])
         same_increment = counts[i] == 1 or abs(inc - increment) <= _INCREMENT_TOL * max(1.0, abs(increment))
         steps = (start - start0) / increment if increment != 0 else (0.0 if start == start0 else np.inf)
-        on_grid = same_increment and abs(steps) <= widest and abs(steps - round(steps)) <= _OFFSET_TOL
+        near = abs(steps) <= widest + 1  # finite and small enough to round; shifts beyond the widest line refused
+        on_grid = same_increment and near and abs(steps - round(steps)) <= _OFFSET_TOL and abs(round(steps)) <= widest
         if not on_grid:
             raise FormatError(path, f"{kind} has {counts[i]} readings from {start!r} rad every {inc!r} rad, not on the angular "
                               f"grid of line {numbers[ref]} ({counts[ref]} from {start0!r} every {increment!r}): slamtrials "

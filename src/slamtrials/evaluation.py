@@ -20,6 +20,7 @@ to the file and line it came from (re-reading the file's data lines the way the 
 from __future__ import annotations
 
 import io
+import logging
 from dataclasses import dataclass
 from enum import Enum
 from pathlib import Path
@@ -29,6 +30,8 @@ from slamtrials.metric.matching import DEFAULT_TOLERANCE, RUN_TOLERANCE
 from slamtrials.metric.rule import SamplingRule
 from slamtrials.record import Relations, Trajectory
 
+logger = logging.getLogger(__name__)
+
 __all__ = ["EvaluationResult", "PoseTriple", "Quantile", "evaluate_files", "evaluate_run", "format_report", "FILE_TOLERANCE", "RUN_TOLERANCE"]
 
 #: Default matching tolerance (s) for dataset files: the Freiburg program's.
@@ -36,8 +39,14 @@ FILE_TOLERANCE = DEFAULT_TOLERANCE
 
 
 class PoseTriple(str, Enum):
-    """Which pose triple of a CARMEN laser line is the estimate."""
+    """Which pose triple of a CARMEN laser line is the estimate.
 
+    ``auto``: the second for a log whose laser lines hold no readings (a pose-only test log, written
+    for the Freiburg metricEvaluator, which reads the second triple: FLASER ``odom_x odom_y odom_theta``,
+    ROBOTLASER1 ``robot_pose``), else the first (slamtrials' own ``trajectory.clf``: the estimate first).
+    """
+
+    auto = "auto"
     first = "first"
     second = "second"
 
@@ -68,6 +77,8 @@ class _Source:
             from slamtrials.io.carmen_log import LASER_KINDS
 
             return _data_line(self.path, index, lambda tokens: tokens[0] in LASER_KINDS)
+        if self.kind == "carmen-odom":
+            return _data_line(self.path, index, lambda tokens: tokens[0] == "ODOM")
         return None
 
 
@@ -86,23 +97,44 @@ def _data_line(path: Path, index: int, keep=lambda tokens: True) -> int | None:
 
 def _is_carmen(path: Path) -> bool:
     """A CARMEN log starts (after comments) with a message name; a TUM file with a number."""
-    from slamtrials.io.textfile import data_lines, read_lines
+    from slamtrials.io.compressed import read_head
 
-    for _, tokens in data_lines(read_lines(path)):
-        try:
-            float(tokens[0])
-        except ValueError:
-            return True
-        return False
+    for line in read_head(path).decode("utf-8", errors="replace").split("\n"):
+        tokens = line.split()
+        if tokens and not tokens[0].startswith("#"):
+            try:
+                float(tokens[0])
+            except ValueError:
+                return True
+            return False
     return False
 
 
 def _read_trajectory(path: Path, triple: PoseTriple, what: str) -> _Source:
-    """A CARMEN log (laser lines' first or second triple at their ipc_timestamp) or a TUM file."""
+    """A CARMEN log (laser lines' first or second triple at their ipc_timestamp) or a TUM file.
+
+    As odometry (``what == "odometry"``), a CARMEN log with ODOM lines gives its ODOM lines (the first of
+    equal timestamps), as the Freiburg metricEvaluator takes them; without, its laser lines' second triple.
+    """
     if _is_carmen(path):
+        import numpy as np
+
         from slamtrials.io.carmen import read_carmen
 
-        laser = read_carmen(path).laser
+        log = read_carmen(path, ranges=False)  # only the poses: any readings, beam counts or grids
+        laser = log.laser
+        if what == "odometry" and len(log.odom):
+            first = np.concatenate([[True], np.diff(log.odom.t) > 0])
+            label = f"{path} (CARMEN, {int(first.sum())} ODOM lines)"
+            return _Source(Trajectory(t=log.odom.t[first], poses=log.odom.pose[first]), path, "carmen-odom", label)
+        pose_only = laser.pose_only
+        if triple is PoseTriple.auto:
+            triple = PoseTriple.second if pose_only else PoseTriple.first
+            if what == "estimate" and pose_only:
+                differ = int(np.count_nonzero((laser.pose != laser.odometry).any(axis=1)))
+                if differ:
+                    logger.warning("%s: the two pose triples differ on %d of %d pose-only %s lines: the second is evaluated, as the "
+                                   "Freiburg metricEvaluator does (--estimate-pose first for the other)", path, differ, len(laser), laser.kind)
         poses = laser.pose if triple is PoseTriple.first else laser.odometry
         label = f"{path} (CARMEN, {len(laser)} {laser.kind} lines, {triple.value} pose triple)"
         return _Source(Trajectory(t=laser.t, poses=poses), path, "carmen", label)
@@ -110,6 +142,28 @@ def _read_trajectory(path: Path, triple: PoseTriple, what: str) -> _Source:
 
     trajectory = read_tum(path)
     return _Source(trajectory, path, "tum", f"{path} (TUM, {len(trajectory)} poses)")
+
+
+def _check_belong(relations: Relations, relations_path: Path, sources: dict[str, _Source], tolerance: float) -> None:
+    """Refuse relations none of whose timestamps is within ``tolerance`` of a pose of the estimate (or of
+    the odometry): valid files that do not belong together, which would otherwise give an empty result."""
+    import numpy as np
+
+    from slamtrials.metric.kernels import nearest_indices
+
+    stamps = np.concatenate([relations.t1, relations.t2])
+    stamps = stamps[np.isfinite(stamps)]
+    spans = []
+    for source in sources.values():
+        t = source.trajectory.t
+        if len(t) == 0 or not (np.all(np.isfinite(t)) and np.all(np.diff(t) > 0)):
+            return  # the metric refuses such a trajectory, naming the line
+        if len(stamps) == 0 or nearest_indices(t, stamps, tolerance)[2].any():
+            return
+        spans.append(f"{source.path} has {len(t)} poses in [{float(t[0])!r}, {float(t[-1])!r}] s")
+    where = f"[{float(stamps.min())!r}, {float(stamps.max())!r}] s" if len(stamps) else "no finite time"
+    raise FormatError(relations_path, f"no relation timestamp ({len(relations)} relations in {where}) is within {tolerance:g} s of "
+                      f"a pose: {'; '.join(spans)}. These relations are not of this log")
 
 
 def _with_lines(exc: MetricError, sources: dict[str, _Source], relations_path: Path | None) -> Exception:
@@ -175,7 +229,7 @@ def evaluate_files(
     relations: Path,
     *,
     odometry: Path | None = None,
-    estimate_pose: PoseTriple = PoseTriple.first,
+    estimate_pose: PoseTriple = PoseTriple.auto,
     tolerance: float = FILE_TOLERANCE,
     interpolate: bool = False,
     squared: bool = False,
@@ -190,17 +244,19 @@ def evaluate_files(
     relations:
         Relations file, ``t1 t2 x y z roll pitch yaw`` per line.
     odometry:
-        Optional CARMEN log (second pose triple of its laser lines) or TUM file used to carry relation
-        timestamps without an estimated pose within ``tolerance`` to the nearest estimated pose.
+        Optional CARMEN log (its ODOM lines, else the second pose triple of its laser lines) or TUM file
+        used to carry relation timestamps without an estimated pose within ``tolerance`` to the nearest
+        estimated pose.
     estimate_pose:
-        Which pose triple of a CARMEN estimate to use.
+        Which pose triple of a CARMEN estimate to use (:class:`PoseTriple`; ``auto`` by default).
     tolerance, interpolate, squared, allow_outside:
         See :func:`slamtrials.metric.evaluate_relations`.
 
     Raises
     ------
     FormatError
-        A file that does not parse, or data the metric refuses (naming the file and line).
+        A file that does not parse, data the metric refuses (naming the file and line), or relations
+        none of whose timestamps is within ``tolerance`` of an estimated (or odometry) pose.
     """
     from slamtrials.io.relations import read_relations
     from slamtrials.metric import evaluate_relations
@@ -210,6 +266,7 @@ def evaluate_files(
     if odometry is not None:
         sources["odometry"] = _read_trajectory(Path(odometry), PoseTriple.second, "odometry")
     rel = read_relations(relations)
+    _check_belong(rel, Path(relations), sources, tolerance)
     try:
         errors = evaluate_relations(
             estimate_source.trajectory,
@@ -233,7 +290,7 @@ def evaluate_run(
     run: Path,
     *,
     estimate: Path | None = None,
-    estimate_pose: PoseTriple = PoseTriple.first,
+    estimate_pose: PoseTriple = PoseTriple.auto,
     seed: int = 0,
     rule: SamplingRule | None = None,
     tolerance: float = RUN_TOLERANCE,
@@ -312,7 +369,8 @@ def evaluate_run(
 
 
 def _row(summary) -> str:
-    return ", ".join(f"{v:.6g}" for v in summary.as_tuple()[:4]) + f", {summary.n}"
+    """``mean, std, min, max, n`` as the Freiburg metricEvaluator writes them (``%f, %f, %f, %f, %d``)."""
+    return ", ".join(f"{v:f}" for v in summary.as_tuple()[:4]) + f", {summary.n}"
 
 
 def format_report(result: EvaluationResult) -> str:

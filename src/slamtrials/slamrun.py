@@ -164,7 +164,7 @@ def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bo
 
 
 def load_recording(path: str | Path) -> RunRecord:
-    """Read a run folder, a CARMEN log (``.clf``, ``.log``, ``.carmen``, optionally ``.gz``) or a ROS bag.
+    """Read a run folder, a CARMEN log (``.clf``, ``.log``, ``.carmen``, optionally ``.gz``, ``.bz2``) or a ROS bag.
 
     A bag without the ground-truth topic is read without ground truth (NaN), which SLAM does not need.
 

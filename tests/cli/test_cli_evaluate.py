@@ -194,8 +194,11 @@ def test_pose_indices_map_to_file_lines(tmp_path):
         "ODOM 0 0 0 0 0 0 10.05 h 0\n"
         "FLASER 2 1.0 1.0 0 0 0 0 0 0 10.1 h 0\n"
     )
-    source = _read_trajectory(clf, PoseTriple.second, "odometry")
-    mapped = _with_lines(MetricError("pose 1 is bad", what="odometry", index=1), {"odometry": source}, None)
+    source = _read_trajectory(clf, PoseTriple.second, "estimate")
+    mapped = _with_lines(MetricError("pose 1 is bad", what="estimate", index=1), {"estimate": source}, None)
     assert (mapped.path, mapped.line) == (clf, 4)
+    source = _read_trajectory(clf, PoseTriple.second, "odometry")  # odometry: the ODOM lines, as the Freiburg program
+    mapped = _with_lines(MetricError("pose 0 is bad", what="odometry", index=0), {"odometry": source}, None)
+    assert (mapped.path, mapped.line) == (clf, 3) and "1 ODOM lines" in source.label
     unknown = MetricError("no index")
     assert _with_lines(unknown, {}, None) is unknown

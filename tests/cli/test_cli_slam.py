@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import bz2
 import json
 
 import numpy as np
@@ -91,6 +92,23 @@ def test_bad_options_exit_2_with_one_line(run_folder, tmp_path, extra, expected)
     result = runner.invoke(app, ["slam", "--input", str(folder), "--out", str(tmp_path / "o"), *extra])
     assert result.exit_code == 2
     assert expected in result.output and len(result.output.strip().splitlines()) == 1, result.output
+    assert not (tmp_path / "o").exists()
+
+
+def test_slam_reads_a_bzip2_log_and_refuses_a_pose_only_one(run_folder, tmp_path):
+    _, record = run_folder
+    log = tmp_path / "run.clf"
+    export_record(record, log, "carmen")
+    packed = tmp_path / "run.clf.bz2"
+    packed.write_bytes(bz2.compress(log.read_bytes()))
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["slam", "-a", "odometry", "-i", str(packed), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert len(read_tum(out / "trajectory.tum")) == len(record)
+    poses = tmp_path / "poses.log"  # a trajectory as SLAM programs write it for the Freiburg evaluator
+    poses.write_text("".join(f"FLASER 0 {k} 0 0 {k} 0 0 {100.0 + k} h {k}\n" for k in range(5)))
+    refused = runner.invoke(app, ["slam", "-a", "odometry", "-i", str(poses), "-o", str(tmp_path / "o")])
+    assert refused.exit_code == 2 and "pose-only" in refused.output and len(refused.output.strip().splitlines()) == 1
     assert not (tmp_path / "o").exists()
 
 

@@ -2,7 +2,7 @@
 
 A thin wrapper over :mod:`slamtrials.evaluation` (see there for the two forms, dataset files and RUN
 folders); prints ``Mean, Std, Min, Max, NumMeasures`` of the translational (m) and rotational (rad)
-errors and can write the per-relation errors (``--errors FILE``: ``.npz``, or a text table otherwise).
+errors (``%f`` fixed-point, six decimals, as the Freiburg metricEvaluator's ``-e`` file) and can write the per-relation errors (``--errors FILE``: ``.npz``, or a text table otherwise).
 """
 
 from __future__ import annotations
@@ -27,9 +27,9 @@ def evaluate(
     run: Annotated[Path | None, typer.Argument(help="Simulated run folder: sample relations from its ground truth and evaluate its estimate.")] = None,
     estimate: Annotated[Path | None, typer.Option("--estimate", "-e", help="Estimated trajectory: CARMEN log or TUM file.")] = None,
     relations: Annotated[Path | None, typer.Option("--relations", "-r", help="Relations file 't1 t2 x y z roll pitch yaw' (real datasets).")] = None,
-    odometry: Annotated[Path | None, typer.Option("--odometry", help="CARMEN log (or TUM file) whose odometry carries unmatched relation timestamps to the nearest estimated pose.")] = None,
-    estimate_pose: Annotated[PoseTriple, typer.Option("--estimate-pose", help="Pose triple of a CARMEN estimate: first (laser pose, e.g. SLAM-corrected) or second (raw odometry).")] = PoseTriple.first,
-    tolerance: Annotated[float | None, typer.Option("--tolerance", help="Largest gap (s) between a relation timestamp and the matched pose, inclusive. Default: 0.1 (the Freiburg program's) for files; 0.001 for a RUN, whose estimate shares the simulator's clock, so that a ground-truth pose between two estimated poses is reached through the odometry rather than given a neighbour's pose.")] = None,
+    odometry: Annotated[Path | None, typer.Option("--odometry", help="CARMEN log (its ODOM lines, else its laser lines' second triple, as the Freiburg program takes them) or TUM file whose odometry carries unmatched relation timestamps to the nearest estimated pose.")] = None,
+    estimate_pose: Annotated[PoseTriple, typer.Option("--estimate-pose", help="Pose triple of a CARMEN estimate: first (laser pose, e.g. SLAM-corrected; slamtrials' trajectory.clf) or second (raw odometry; what the Freiburg metricEvaluator reads). auto: second for a pose-only log (FLASER 0 lines, a Freiburg-style test log), else first.")] = PoseTriple.auto,
+    tolerance: Annotated[float | None, typer.Option("--tolerance", help="Largest gap (s) between a relation timestamp and the matched pose, inclusive. Default: 0.1 (the Freiburg program's) for files; 0.001 for a RUN, whose estimate shares the simulator's clock, so that a ground-truth pose between two estimated poses is reached through the odometry rather than given a neighbour's pose. inf: the nearest pose whatever the gap (the Freiburg program without -o).")] = None,
     interpolate: Annotated[bool, typer.Option("--interpolate", help="Interpolate between the poses around each relation timestamp.")] = False,
     squared: Annotated[bool, typer.Option("--squared", help="Report squared errors (m^2, rad^2) instead of absolute ones.")] = False,
     allow_outside: Annotated[bool, typer.Option("--allow-outside", help="Report relations outside the estimate's time span as unmatched instead of refusing them.")] = False,

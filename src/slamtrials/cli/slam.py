@@ -46,7 +46,7 @@ def parse_settings(settings: list[str]) -> dict[str, Any]:
 
 def slam(
     algorithm: Annotated[str, typer.Option("--algorithm", "-a", help="Registered SLAM algorithm (built-in: gmapping, odometry).")],
-    input_: Annotated[Path, typer.Option("--input", "-i", help="Run folder, CARMEN log (.clf/.log, .gz) or ROS bag.")],
+    input_: Annotated[Path, typer.Option("--input", "-i", help="Run folder, CARMEN log (.clf/.log, .gz, .bz2) or ROS bag.")],
     out: Annotated[Path, typer.Option("--out", "-o", help="Folder for trajectory.tum/.clf, map.yaml/.pgm/.png, timing.csv, slam.json.")],
     preset: Annotated[str | None, typer.Option("--preset", "-p", help="Named parameter set of the algorithm.")] = None,
     settings: Annotated[list[str] | None, typer.Option("--set", help="Parameter override key=value (value read as YAML); repeatable.")] = None,

@@ -67,7 +67,7 @@ def export_run(
 
 
 def import_run(
-    source: Annotated[Path, typer.Argument(metavar="FILE", help="ROS 1 .bag, ROS 2 bag folder or .mcap, or CARMEN log (.clf, .log, .gz).")],
+    source: Annotated[Path, typer.Argument(metavar="FILE", help="ROS 1 .bag, ROS 2 bag folder or .mcap, or CARMEN log (.clf, .log, .gz, .bz2).")],
     out: Annotated[Path, typer.Option("--out", "-o", help="Run folder to write (frames.npz, run.json).")],
     fmt: Annotated[ImportFormat, typer.Option("--format", "-f", help="Input format; auto: from the name and first bytes.")] = ImportFormat.auto,
     scan_topic: Annotated[str | None, typer.Option("--scan-topic", help="Bag: sensor_msgs/LaserScan topic [default: /base_scan].")] = None,

@@ -149,7 +149,7 @@ def _check_belong(relations: Relations, relations_path: Path, sources: dict[str,
     the odometry): valid files that do not belong together, which would otherwise give an empty result."""
     import numpy as np
 
-    from slamtrials.metric.kernels import nearest_indices
+    from slamtrials.metric.matching import relations_meet
 
     stamps = np.concatenate([relations.t1, relations.t2])
     stamps = stamps[np.isfinite(stamps)]
@@ -158,7 +158,7 @@ def _check_belong(relations: Relations, relations_path: Path, sources: dict[str,
         t = source.trajectory.t
         if len(t) == 0 or not (np.all(np.isfinite(t)) and np.all(np.diff(t) > 0)):
             return  # the metric refuses such a trajectory, naming the line
-        if len(stamps) == 0 or nearest_indices(t, stamps, tolerance)[2].any():
+        if len(stamps) == 0 or relations_meet(t, relations, tolerance):
             return
         spans.append(f"{source.path} has {len(t)} poses in [{float(t[0])!r}, {float(t[-1])!r}] s")
     where = f"[{float(stamps.min())!r}, {float(stamps.max())!r}] s" if len(stamps) else "no finite time"

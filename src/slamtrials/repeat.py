@@ -17,7 +17,6 @@ This module composes io, slam, metric, campaign (the Dask client) and report, li
 from __future__ import annotations
 
 import json
-import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -29,7 +28,7 @@ import numpy as np
 from slamtrials.atomicfile import atomic_write, atomic_write_text
 from slamtrials.errors import ConfigError, MetricError
 from slamtrials.metric.divergence import DEFAULT_DIVERGENCE_FACTOR, Divergence, divergence
-from slamtrials.metric.matching import DEFAULT_TOLERANCE
+from slamtrials.metric.matching import DEFAULT_TOLERANCE, relations_meet
 from slamtrials.metric.relerrors import evaluate_relations
 from slamtrials.metric.runcount import runs_needed
 from slamtrials.metric.stats import EnvironmentStats, environment_stats
@@ -171,14 +170,11 @@ def check_relations_fit(record: RunRecord, relations: Relations, tolerance: floa
     Valid files that do not belong together (a log and another dataset's relations) would otherwise give
     an empty or meaningless result.
     """
-    stamps = np.concatenate([relations.t1, relations.t2])
-    t = record.t
-    index = np.clip(np.searchsorted(t, stamps), 1, max(len(t) - 1, 1))
-    nearest = np.minimum(np.abs(stamps - t[index - 1]), np.abs(t[np.minimum(index, len(t) - 1)] - stamps))
-    if len(stamps) == 0 or not np.any(nearest <= tolerance):
-        raise ConfigError(f"{relations_source} and {source} do not belong together: no relation timestamp "
-                          f"({stamps.min() if len(stamps) else math.nan:.3f} to {stamps.max() if len(stamps) else math.nan:.3f} s) "
-                          f"is within {tolerance:g} s of a frame ({t[0]:.3f} to {t[-1]:.3f} s)")
+    if not relations_meet(record.t, relations, tolerance):
+        stamps = np.concatenate([relations.t1, relations.t2])
+        span = f"{np.nanmin(stamps):.3f} to {np.nanmax(stamps):.3f} s" if len(stamps) else "none"
+        raise ConfigError(f"{relations_source} and {source} do not belong together: no relation timestamp ({span}) "
+                          f"is within {tolerance:g} s of a frame ({record.t[0]:.3f} to {record.t[-1]:.3f} s)")
 
 
 def _one_run(record: RunRecord, relations: Relations, settings: RepeatSettings, seed: int) -> RepeatedRun:

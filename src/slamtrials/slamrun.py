@@ -8,8 +8,11 @@ registry (:mod:`slamtrials.slam`) and times every call; :func:`write_slam_output
     the estimate, one pose per frame (TUM: ``t x y z qx qy qz qw``, map frame).
 ``trajectory.clf``
     a CARMEN log of the run whose FIRST pose triple is the SLAM estimate and SECOND the recorded
-    odometry (ROBOTLASER1 lines), as SLAM programs of the Freiburg benchmark write their corrected logs;
-    ``slamtrials evaluate --estimate trajectory.clf --relations ...`` evaluates it.
+    odometry (ROBOTLASER1 lines, with the scans): the run as a corrected log, which ``slamtrials
+    evaluate --estimate trajectory.clf --relations ...`` evaluates (its first triple).
+``trajectory.log``
+    the estimate as the Freiburg metricEvaluator's test logs hold one (``FLASER 0`` lines, the estimate in
+    both triples: that program reads the second), for the original tool and for ``slamtrials evaluate``.
 ``map.yaml``, ``map.pgm``, ``map.png``
     the final map in ROS map_server form and as a picture.
 ``timing.csv``
@@ -42,7 +45,7 @@ __all__ = ["SlamResult", "run_slam", "write_slam_outputs", "load_recording", "OU
 
 SLAM_FILE = "slam.json"
 #: Files :func:`write_slam_outputs` writes, in order (``slam.json`` last).
-OUTPUT_FILES = ("trajectory.tum", "trajectory.clf", "map.yaml", "map.pgm", "map.png", "timing.csv", SLAM_FILE)
+OUTPUT_FILES = ("trajectory.tum", "trajectory.clf", "trajectory.log", "map.yaml", "map.pgm", "map.png", "timing.csv", SLAM_FILE)
 
 
 @dataclass(frozen=True, eq=False)
@@ -125,7 +128,7 @@ def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bo
     ConfigError
         ``out_dir`` already holds SLAM outputs (``slam.json``) and ``overwrite`` is False.
     """
-    from slamtrials.io.carmen import carmen_from_run, write_carmen
+    from slamtrials.io.carmen import carmen_from_run, carmen_from_trajectory, write_carmen
     from slamtrials.io.mapfile import write_map, write_map_png
     from slamtrials.io.tum import write_tum
 
@@ -137,6 +140,7 @@ def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bo
     written = [write_tum(out / "trajectory.tum", result.trajectory)]
     as_run = replace(result.record, truth=estimate, estimate=estimate)  # first CARMEN triple = the estimate
     written.append(write_carmen(out / "trajectory.clf", carmen_from_run(as_run)))
+    written.append(write_carmen(out / "trajectory.log", carmen_from_trajectory(Trajectory(t=result.record.t, poses=estimate))))
     grid = result.occupancy
     written.append(write_map(out / "map.yaml", grid.grid, grid.resolution, grid.origin))
     written.append(out / "map.pgm")
@@ -157,6 +161,7 @@ def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bo
         "ms_per_frame_max": 1000.0 * float(result.timing.max()) if len(result.timing) else math.nan,
         "map": {"shape": list(grid.grid.shape), "resolution": grid.resolution, "origin": [float(v) for v in grid.origin]},
         "trajectory_clf": "first pose triple = SLAM estimate, second = recorded odometry",
+        "trajectory_log": "FLASER 0 lines, SLAM estimate in both pose triples (the Freiburg metricEvaluator's input)",
     }
     atomic_write_text(out / SLAM_FILE, json.dumps(summary, indent=2) + "\n")
     written.append(out / SLAM_FILE)

@@ -42,7 +42,7 @@ def test_slam_writes_every_output_and_evaluate_reads_them(run_folder, tmp_path):
     result = runner.invoke(app, ["slam", "--algorithm", "odometry", "--input", str(folder), "--out", str(out), "--set", "resolution=0.1"])
     assert result.exit_code == 0, result.output
     assert f"{len(record)} frames, {len(record)} updates" in result.output and "ms per frame" in result.output
-    for name in ("trajectory.tum", "trajectory.clf", "map.yaml", "map.pgm", "map.png", "timing.csv", "slam.json"):
+    for name in ("trajectory.tum", "trajectory.clf", "trajectory.log", "map.yaml", "map.pgm", "map.png", "timing.csv", "slam.json"):
         assert (out / name).is_file(), name
     tum = read_tum(out / "trajectory.tum")
     np.testing.assert_allclose(tum.t, record.t, atol=1e-6)
@@ -61,6 +61,9 @@ def test_slam_writes_every_output_and_evaluate_reads_them(run_folder, tmp_path):
     assert "Translational error" in evaluated.output
     from_clf = runner.invoke(app, ["evaluate", str(folder), "--estimate", str(out / "trajectory.clf")])
     assert from_clf.exit_code == 0, from_clf.output
+    test_log = read_carmen(out / "trajectory.log")  # the Freiburg program's input: the estimate in both triples
+    assert test_log.laser.beams == 0 and np.array_equal(test_log.laser.pose, test_log.laser.odometry)
+    np.testing.assert_allclose(test_log.laser.odometry, record.odometry, atol=1e-5)
 
 
 def test_slam_reads_a_carmen_log_and_refuses_to_overwrite(run_folder, tmp_path):

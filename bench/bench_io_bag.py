@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from slamtrials.io.rosbag import run_from_bag, write_rosbag1, write_rosbag2
-from slamtrials.record import RunRecord
+from slamtrials.record import LaserGeometry, RunRecord
 
 from benchutil import cpu_model
 
@@ -45,8 +45,8 @@ def synthetic_run(seed: int = 0) -> RunRecord:
     phase = rng.uniform(0, 2 * np.pi, (FRAMES, 1))
     scans = 4.0 + 3.0 * np.abs(np.sin(angles[None, :] * 2.0 + phase)) + rng.normal(0, 0.001, (FRAMES, BEAMS))
     scans = np.clip(scans, 0.1, 30.0).astype(np.float32)
-    laser = {"angle_min": float(angles[0]), "angle_increment": float(angles[1] - angles[0]), "range_min": 0.0,
-             "range_max": 30.0, "mount": [0.1, 0.0, 0.0]}
+    laser = LaserGeometry.from_dict({"angle_min": float(angles[0]), "angle_increment": float(angles[1] - angles[0]), "range_min": 0.0,
+             "range_max": 30.0, "mount": [0.1, 0.0, 0.0]})
     return RunRecord(t=t, scans=scans, odometry=odometry, truth=truth, stalled=rng.random(FRAMES) < 0.01, laser=laser,
                      metadata={"world": "synthetic", "sim_config": {"dt": 0.1}})
 

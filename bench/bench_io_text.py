@@ -22,7 +22,7 @@ import numpy as np
 
 from slamtrials.io.carmen import carmen_from_run, read_carmen, run_from_carmen, write_carmen
 from slamtrials.io.tum import read_tum, write_tum
-from slamtrials.record import RunRecord, Trajectory
+from slamtrials.record import LaserGeometry, RunRecord, Trajectory
 
 FRAMES, BEAMS, REPEATS = 18_000, 541, 3
 SHARED = Path(os.environ.get("SLAMTRIALS_SHARED", Path(__file__).resolve().parents[1].parent / "shared"))
@@ -38,7 +38,7 @@ def make_run(seed: int = 0) -> RunRecord:
         odometry=truth + rng.normal(0, 0.01, truth.shape),
         truth=truth,
         stalled=np.zeros(FRAMES, dtype=bool),
-        laser={"angle_min": -3 * np.pi / 4, "angle_increment": 1.5 * np.pi / (BEAMS - 1), "range_min": 0.0, "range_max": 30.0, "mount": [0.0, 0.0, 0.0]},
+        laser=LaserGeometry.from_dict({"angle_min": -3 * np.pi / 4, "angle_increment": 1.5 * np.pi / (BEAMS - 1), "range_min": 0.0, "range_max": 30.0, "mount": [0.0, 0.0, 0.0]}),
     )
 
 

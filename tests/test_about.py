@@ -14,7 +14,7 @@ import pytest
 import slamtrials
 from slamtrials.__about__ import source_revision
 from slamtrials.io.runfolder import write_run
-from slamtrials.record import RunRecord
+from slamtrials.record import LaserGeometry, RunRecord
 
 
 def test_source_revision_names_the_checkout_the_package_came_from():
@@ -35,7 +35,7 @@ def test_run_folders_carry_it(tmp_path):
     t = np.arange(3) * 0.1
     poses = np.zeros((3, 3))
     record = RunRecord(t=t, scans=np.ones((3, 4), dtype=np.float32), odometry=poses, truth=poses,
-                       stalled=np.zeros(3, dtype=bool), laser={"angle_min": -1.0, "angle_increment": 0.5, "range_min": 0.0, "range_max": 10.0})
+                       stalled=np.zeros(3, dtype=bool), laser=LaserGeometry.from_dict({"angle_min": -1.0, "angle_increment": 0.5, "range_min": 0.0, "range_max": 10.0}))
     folder = write_run(tmp_path / "run", record)
     versions = json.loads((folder / "run.json").read_text())["versions"]
     assert versions["slamtrials"] == slamtrials.__version__

@@ -10,7 +10,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "src" / "slamtrials"
 
 #: Modules every layer may import: they hold no behaviour of any layer.
-UTILITIES = {"errors", "atomicfile", "__about__", "stablemath"}
+UTILITIES = {"errors", "atomicfile", "__about__", "stablemath", "seeding"}
 
 #: Layer -> the slamtrials layers it may import (DESIGN.md, "Layers").
 ALLOWED = {
@@ -27,7 +27,7 @@ ALLOWED = {
     "report": {"geometry", "record", "worlds", "metric", "io", "campaign"},
 }
 #: Top-level modules that compose layers like the CLI does (no layer may import them).
-COMPOSERS = {"demo", "evaluation", "slamrun", "cli", "__init__"}
+COMPOSERS = {"demo", "evaluation", "slamrun", "repeat", "cli", "__init__"}
 
 #: Layers that must not do I/O, print or plot (DESIGN.md).
 COMPUTING = {"geometry", "record", "sim", "slam", "explore", "trial", "metric"}
@@ -133,3 +133,87 @@ def test_numba_kernels_use_no_result_changing_fast_math(path: Path) -> None:
                 assert not set(flags) & _RESULT_CHANGING_FASTMATH, (
                     f"{path}:{node.value.lineno}: fastmath {sorted(set(flags) & _RESULT_CHANGING_FASTMATH)} "
                     "changes results with the CPU")
+
+
+#: Sort kinds whose order of equal keys is fixed. numpy's default (quicksort) is not stable, and its SIMD
+#: versions (x86-simd-sort, picked by CPU) order equal keys differently: on AVX-512 CPUs the generator once
+#: put a world's start pose 0.2 m away from where an AVX2 machine put it.
+_STABLE_KINDS = {"stable", "mergesort"}
+
+
+def _is_set_expression(node: ast.AST) -> bool:
+    """``set(...)``, ``frozenset(...)``, a set literal or comprehension, or a union/difference/... of them."""
+    if isinstance(node, (ast.Set, ast.SetComp)):
+        return True
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id in {"set", "frozenset"}:
+        return True
+    if isinstance(node, ast.BinOp) and isinstance(node.op, (ast.BitOr, ast.BitAnd, ast.Sub, ast.BitXor)):
+        return _is_set_expression(node.left) or _is_set_expression(node.right)
+    return False
+
+
+def ordering_problems(tree: ast.AST) -> list[str]:
+    """Sorts whose order of ties depends on the implementation, and iterations over sets, as ``line: what``.
+
+    * ``np.sort``/``np.argsort`` and the ``.sort()``/``.argsort()``/``.sort_values()`` methods need
+      ``kind="stable"`` (or ``"mergesort"``); a ``.sort()`` with ``key=`` or ``reverse=`` is Python's
+      list sort, which is stable. ``np.lexsort`` is stable; ``argpartition`` never is.
+    * Iterating a set (``for x in set(...)``, in a comprehension, or through ``list``/``tuple``/``join``):
+      the order of strings changes with PYTHONHASHSEED; iterate ``sorted(...)`` instead.
+    """
+    problems = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute):
+            name = node.func.attr
+            keywords = {k.arg: k.value for k in node.keywords}
+            kind = keywords.get("kind")
+            stable = isinstance(kind, ast.Constant) and kind.value in _STABLE_KINDS
+            python_list_sort = name == "sort" and ("key" in keywords or "reverse" in keywords) and kind is None
+            if name in {"sort", "argsort", "sort_values"} and not stable and not python_list_sort:
+                problems.append(f"{node.lineno}: {ast.unparse(node.func)}() without kind=\"stable\" orders equal keys by "
+                                "implementation (numpy's SIMD sorts differ by CPU)")
+            if name == "argpartition":
+                problems.append(f"{node.lineno}: argpartition orders equal keys by implementation; use a stable argsort")
+        iterated = []
+        if isinstance(node, (ast.For, ast.comprehension)):
+            iterated.append(node.iter)
+        if isinstance(node, ast.Call) and node.args and (
+                (isinstance(node.func, ast.Name) and node.func.id in {"list", "tuple", "enumerate"})
+                or (isinstance(node.func, ast.Attribute) and node.func.attr == "join")):
+            iterated.append(node.args[0])
+        problems += [f"{it.lineno}: iterates a set, whose order of strings depends on PYTHONHASHSEED; iterate sorted(...)"
+                     for it in iterated if _is_set_expression(it)]
+    return problems
+
+
+#: Layers whose order of things reaches runs, maps, worlds or files: the reproducible ones and the report.
+ORDERED = REPRODUCIBLE | {"report"}
+
+
+@pytest.mark.parametrize("path", [p for p in SOURCES if _layer_of(p) in ORDERED], ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_reproducible_layers_order_ties_by_rule_not_by_sort_implementation(path: Path) -> None:
+    problems = ordering_problems(ast.parse(path.read_text(encoding="utf-8")))
+    assert not problems, f"{path}:" + f"\n{path}:".join(problems)
+
+
+@pytest.mark.parametrize(("source", "flagged"), [
+    ("np.argsort(d)[0]", True),
+    ("np.sort(values)", True),
+    ("a.argsort()", True),
+    ("a.sort()", True),
+    ("np.argsort(d, kind='quicksort')", True),
+    ("table.sort_values('x', ascending=False)", True),
+    ("np.argpartition(d, 3)", True),
+    ("for host in set(a) | set(b):\n    pass", True),
+    ("names = [n for n in {'a', 'b'}]", True),
+    ("text = ', '.join(set(names))", True),
+    ("np.argsort(d, kind='stable')[0]", False),
+    ("a.sort(kind='mergesort')", False),
+    ("table.sort_values('x', kind='stable')", False),
+    ("np.lexsort((fine, coarse))[0]", False),
+    ("items.sort(key=len)", False),
+    ("for host in sorted(set(a) | set(b)):\n    pass", False),
+    ("ok = 'x' in {'a', 'b'}", False),
+])
+def test_ordering_guard_flags_unstable_sorts_and_set_iteration(source: str, flagged: bool) -> None:
+    assert bool(ordering_problems(ast.parse(source))) == flagged

@@ -20,34 +20,39 @@ to the file and line it came from (re-reading the file's data lines the way the 
 from __future__ import annotations
 
 import io
+import logging
 from dataclasses import dataclass
 from enum import Enum
 from pathlib import Path
 
 from slamtrials.errors import FormatError, MetricError
+from slamtrials.metric.matching import DEFAULT_TOLERANCE, RUN_TOLERANCE
+from slamtrials.metric.rule import SamplingRule
 from slamtrials.record import Relations, Trajectory
 
-__all__ = ["EvaluationResult", "PoseTriple", "Quantile", "evaluate_files", "evaluate_run", "format_report", "RELATIONS_FILE", "ERRORS_FILE", "ESTIMATE_FILE", "FILE_TOLERANCE", "RUN_TOLERANCE"]
+logger = logging.getLogger(__name__)
+
+__all__ = ["EvaluationResult", "PoseTriple", "Quantile", "evaluate_files", "evaluate_run", "format_report", "FILE_TOLERANCE", "RUN_TOLERANCE"]
 
 #: Default matching tolerance (s) for dataset files: the Freiburg program's.
-FILE_TOLERANCE = 0.1
-#: Default matching tolerance (s) for run folders: estimate and ground truth share the simulator's clock
-#: (frames every 0.1 s), so only the same frame's pose is taken directly and the odometry fills the rest.
-RUN_TOLERANCE = 0.001
-RELATIONS_FILE = "relations.txt"
-ERRORS_FILE = "errors.npz"
-ESTIMATE_FILE = "estimate.tum"
+FILE_TOLERANCE = DEFAULT_TOLERANCE
 
 
 class PoseTriple(str, Enum):
-    """Which pose triple of a CARMEN laser line is the estimate."""
+    """Which pose triple of a CARMEN laser line is the estimate.
 
+    ``auto``: the second for a log whose laser lines hold no readings (a pose-only test log, written
+    for the Freiburg metricEvaluator, which reads the second triple: FLASER ``odom_x odom_y odom_theta``,
+    ROBOTLASER1 ``robot_pose``), else the first (slamtrials' own ``trajectory.clf``: the estimate first).
+    """
+
+    auto = "auto"
     first = "first"
     second = "second"
 
 
 class Quantile(str, Enum):
-    """Reference distribution of the critical value."""
+    """Reference distribution of the critical value (the choices of :attr:`SamplingRule.distribution`)."""
 
     normal = "normal"
     t = "t"
@@ -72,6 +77,8 @@ class _Source:
             from slamtrials.io.carmen_log import LASER_KINDS
 
             return _data_line(self.path, index, lambda tokens: tokens[0] in LASER_KINDS)
+        if self.kind == "carmen-odom":
+            return _data_line(self.path, index, lambda tokens: tokens[0] == "ODOM")
         return None
 
 
@@ -90,23 +97,44 @@ def _data_line(path: Path, index: int, keep=lambda tokens: True) -> int | None:
 
 def _is_carmen(path: Path) -> bool:
     """A CARMEN log starts (after comments) with a message name; a TUM file with a number."""
-    from slamtrials.io.textfile import data_lines, read_lines
+    from slamtrials.io.compressed import read_head
 
-    for _, tokens in data_lines(read_lines(path)):
-        try:
-            float(tokens[0])
-        except ValueError:
-            return True
-        return False
+    for line in read_head(path).decode("utf-8", errors="replace").split("\n"):
+        tokens = line.split()
+        if tokens and not tokens[0].startswith("#"):
+            try:
+                float(tokens[0])
+            except ValueError:
+                return True
+            return False
     return False
 
 
 def _read_trajectory(path: Path, triple: PoseTriple, what: str) -> _Source:
-    """A CARMEN log (laser lines' first or second triple at their ipc_timestamp) or a TUM file."""
+    """A CARMEN log (laser lines' first or second triple at their ipc_timestamp) or a TUM file.
+
+    As odometry (``what == "odometry"``), a CARMEN log with ODOM lines gives its ODOM lines (the first of
+    equal timestamps), as the Freiburg metricEvaluator takes them; without, its laser lines' second triple.
+    """
     if _is_carmen(path):
+        import numpy as np
+
         from slamtrials.io.carmen import read_carmen
 
-        laser = read_carmen(path).laser
+        log = read_carmen(path, ranges=False)  # only the poses: any readings, beam counts or grids
+        laser = log.laser
+        if what == "odometry" and len(log.odom):
+            first = np.concatenate([[True], np.diff(log.odom.t) > 0])
+            label = f"{path} (CARMEN, {int(first.sum())} ODOM lines)"
+            return _Source(Trajectory(t=log.odom.t[first], poses=log.odom.pose[first]), path, "carmen-odom", label)
+        pose_only = laser.pose_only
+        if triple is PoseTriple.auto:
+            triple = PoseTriple.second if pose_only else PoseTriple.first
+            if what == "estimate" and pose_only:
+                differ = int(np.count_nonzero((laser.pose != laser.odometry).any(axis=1)))
+                if differ:
+                    logger.warning("%s: the two pose triples differ on %d of %d pose-only %s lines: the second is evaluated, as the "
+                                   "Freiburg metricEvaluator does (--estimate-pose first for the other)", path, differ, len(laser), laser.kind)
         poses = laser.pose if triple is PoseTriple.first else laser.odometry
         label = f"{path} (CARMEN, {len(laser)} {laser.kind} lines, {triple.value} pose triple)"
         return _Source(Trajectory(t=laser.t, poses=poses), path, "carmen", label)
@@ -114,6 +142,28 @@ def _read_trajectory(path: Path, triple: PoseTriple, what: str) -> _Source:
 
     trajectory = read_tum(path)
     return _Source(trajectory, path, "tum", f"{path} (TUM, {len(trajectory)} poses)")
+
+
+def _check_belong(relations: Relations, relations_path: Path, sources: dict[str, _Source], tolerance: float) -> None:
+    """Refuse relations none of whose timestamps is within ``tolerance`` of a pose of the estimate (or of
+    the odometry): valid files that do not belong together, which would otherwise give an empty result."""
+    import numpy as np
+
+    from slamtrials.metric.matching import relations_meet
+
+    stamps = np.concatenate([relations.t1, relations.t2])
+    stamps = stamps[np.isfinite(stamps)]
+    spans = []
+    for source in sources.values():
+        t = source.trajectory.t
+        if len(t) == 0 or not (np.all(np.isfinite(t)) and np.all(np.diff(t) > 0)):
+            return  # the metric refuses such a trajectory, naming the line
+        if len(stamps) == 0 or relations_meet(t, relations, tolerance):
+            return
+        spans.append(f"{source.path} has {len(t)} poses in [{float(t[0])!r}, {float(t[-1])!r}] s")
+    where = f"[{float(stamps.min())!r}, {float(stamps.max())!r}] s" if len(stamps) else "no finite time"
+    raise FormatError(relations_path, f"no relation timestamp ({len(relations)} relations in {where}) is within {tolerance:g} s of "
+                      f"a pose: {'; '.join(spans)}. These relations are not of this log")
 
 
 def _with_lines(exc: MetricError, sources: dict[str, _Source], relations_path: Path | None) -> Exception:
@@ -179,7 +229,7 @@ def evaluate_files(
     relations: Path,
     *,
     odometry: Path | None = None,
-    estimate_pose: PoseTriple = PoseTriple.first,
+    estimate_pose: PoseTriple = PoseTriple.auto,
     tolerance: float = FILE_TOLERANCE,
     interpolate: bool = False,
     squared: bool = False,
@@ -194,17 +244,19 @@ def evaluate_files(
     relations:
         Relations file, ``t1 t2 x y z roll pitch yaw`` per line.
     odometry:
-        Optional CARMEN log (second pose triple of its laser lines) or TUM file used to carry relation
-        timestamps without an estimated pose within ``tolerance`` to the nearest estimated pose.
+        Optional CARMEN log (its ODOM lines, else the second pose triple of its laser lines) or TUM file
+        used to carry relation timestamps without an estimated pose within ``tolerance`` to the nearest
+        estimated pose.
     estimate_pose:
-        Which pose triple of a CARMEN estimate to use.
+        Which pose triple of a CARMEN estimate to use (:class:`PoseTriple`; ``auto`` by default).
     tolerance, interpolate, squared, allow_outside:
         See :func:`slamtrials.metric.evaluate_relations`.
 
     Raises
     ------
     FormatError
-        A file that does not parse, or data the metric refuses (naming the file and line).
+        A file that does not parse, data the metric refuses (naming the file and line), or relations
+        none of whose timestamps is within ``tolerance`` of an estimated (or odometry) pose.
     """
     from slamtrials.io.relations import read_relations
     from slamtrials.metric import evaluate_relations
@@ -214,6 +266,7 @@ def evaluate_files(
     if odometry is not None:
         sources["odometry"] = _read_trajectory(Path(odometry), PoseTriple.second, "odometry")
     rel = read_relations(relations)
+    _check_belong(rel, Path(relations), sources, tolerance)
     try:
         errors = evaluate_relations(
             estimate_source.trajectory,
@@ -237,17 +290,11 @@ def evaluate_run(
     run: Path,
     *,
     estimate: Path | None = None,
-    estimate_pose: PoseTriple = PoseTriple.first,
+    estimate_pose: PoseTriple = PoseTriple.auto,
     seed: int = 0,
-    pilot: int = 500,
-    confidence: float = 0.99,
-    margin_t: float = 0.02,
-    margin_r: float = 0.02,
-    quantile: Quantile = Quantile.normal,
-    sides: int = 2,
+    rule: SamplingRule | None = None,
     tolerance: float = RUN_TOLERANCE,
     interpolate: bool = False,
-    squared: bool = False,
     write: bool = True,
 ) -> EvaluationResult:
     """Sample relations from a run folder's ground truth and evaluate the run's estimate on them.
@@ -263,10 +310,10 @@ def evaluate_run(
         Which pose triple of a CARMEN estimate to use.
     seed:
         Seed of the relation sampling.
-    pilot, confidence, margin_t, margin_r, quantile, sides:
-        The sampling rule (:func:`slamtrials.metric.sample_relations`).
-    tolerance, interpolate, squared:
-        Matching and error options. The run's odometry carries ground-truth timestamps without an
+    rule:
+        The sampling rule (:class:`~slamtrials.metric.SamplingRule`); ``None`` means the defaults.
+    tolerance, interpolate:
+        Matching options. The run's odometry carries ground-truth timestamps without an
         estimated pose within ``tolerance`` (default 1 ms: the same frame) to the nearest estimated pose.
     write:
         Write ``relations.txt`` and ``errors.npz`` into the folder.
@@ -278,48 +325,43 @@ def evaluate_run(
     """
     from slamtrials.io.errorsfile import write_errors
     from slamtrials.io.relations import write_relations
-    from slamtrials.io.runfolder import FRAMES_FILE, read_run
+    from slamtrials.io.runfolder import RunFolder, read_run
     from slamtrials.metric import sample_relations
 
     run = Path(run)
+    files = RunFolder(run)
     record = read_run(run)
     truth = Trajectory(t=record.t, poses=record.truth)
     odometry = Trajectory(t=record.t, poses=record.odometry)
-    sources = {"truth": _Source(truth, run / FRAMES_FILE, "run", "ground truth")}
-    if estimate is None and (run / ESTIMATE_FILE).is_file():
-        estimate = run / ESTIMATE_FILE
+    sources = {"truth": _Source(truth, files.frames, "run", "ground truth")}
+    if estimate is None and files.estimate.is_file():
+        estimate = files.estimate
     if estimate is not None:
         source = _read_trajectory(Path(estimate), estimate_pose, "estimate")
     elif record.estimate is not None:
-        source = _Source(Trajectory(t=record.t, poses=record.estimate), run / FRAMES_FILE, "run", f"{run} (the run's estimate)")
+        source = _Source(Trajectory(t=record.t, poses=record.estimate), files.frames, "run", f"{run} (the run's estimate)")
     else:
-        source = _Source(odometry, run / FRAMES_FILE, "run", f"{run} (no SLAM estimate in the folder: the run's odometry)")
+        source = _Source(odometry, files.frames, "run", f"{run} (no SLAM estimate in the folder: the run's odometry)")
     sources["estimate"] = source
-    sources["odometry"] = _Source(odometry, run / FRAMES_FILE, "run", "odometry")
+    sources["odometry"] = _Source(odometry, files.frames, "run", "odometry")
     try:
         sampled = sample_relations(
             truth,
             source.trajectory,
             rng=seed,
-            pilot=pilot,
-            confidence=confidence,
-            margin_t=margin_t,
-            margin_r=margin_r,
-            distribution=quantile.value,
-            sides=sides,
+            rule=SamplingRule() if rule is None else rule,
             tolerance=tolerance,
             interpolate=interpolate,
             odometry=odometry,
-            squared=squared,
         )
     except MetricError as exc:
         raise _with_lines(exc, sources, None) from None
     written: tuple[Path, ...] = ()
-    relations_path = run / RELATIONS_FILE
+    relations_path = files.relations
     if write:
-        written = (write_relations(relations_path, sampled.relations), write_errors(run / ERRORS_FILE, sampled.relations, sampled.errors))
+        written = (write_relations(relations_path, sampled.relations), write_errors(files.errors, sampled.relations, sampled.errors))
     trans, rot = _summaries(sampled.errors)
-    label = f"{run / RELATIONS_FILE if write else 'sampled'} ({len(sampled.relations)} relations sampled from the ground truth, seed {seed})"
+    label = f"{files.relations if write else 'sampled'} ({len(sampled.relations)} relations sampled from the ground truth, seed {seed})"
     return EvaluationResult(sampled.relations, sampled.errors, trans, rot, source.label, label, tolerance, sampled, relations_path if write else None, written)
 
 
@@ -327,7 +369,8 @@ def evaluate_run(
 
 
 def _row(summary) -> str:
-    return ", ".join(f"{v:.6g}" for v in summary.as_tuple()[:4]) + f", {summary.n}"
+    """``mean, std, min, max, n`` as the Freiburg metricEvaluator writes them (``%f, %f, %f, %f, %d``)."""
+    return ", ".join(f"{v:f}" for v in summary.as_tuple()[:4]) + f", {summary.n}"
 
 
 def format_report(result: EvaluationResult) -> str:
@@ -353,7 +396,8 @@ def format_report(result: EvaluationResult) -> str:
     if s is not None:
         out.write(
             f"sampling:  pilot {len(s.pilot_relations)} pairs, s_t = {s.std_t:.6g} {unit_t}, s_r = {s.std_r:.6g} {unit_r}; "
-            f"z = {s.critical:.4f} ({s.confidence:g} confidence, {s.distribution}, {'two' if s.sides == 2 else 'one'}-sided); margins {s.margin_t:g} {unit_t}, {s.margin_r:g} {unit_r} "
+            f"z = {s.critical:.4f} ({s.rule.confidence:g} confidence, {s.rule.distribution}, {'two' if s.rule.sides == 2 else 'one'}-sided); "
+            f"margins {s.rule.margin_t:g} {unit_t}, {s.rule.margin_r:g} {unit_r} "
             f"-> N_t = {s.needed_t}, N_r = {s.needed_r}, N = {s.count}{' (capped)' if s.capped else ''}\n"
         )
     out.write(f"Translational error ({unit_t}, {kind}):\n{SUMMARY_HEADER}\n{_row(result.translational)}\n")

@@ -7,13 +7,19 @@ over leading dimensions and never loop in Python.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from typing import Any, TypeAlias
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from slamtrials import stablemath
 
-__all__ = ["wrap_angle", "compose", "inverse", "ominus", "transform_points", "as_poses", "wrap_angle1", "compose1", "ominus1", "interpolate"]
+__all__ = ["Pose1Like", "wrap_angle", "compose", "inverse", "ominus", "transform_points", "as_poses", "wrap_angle1", "compose1", "ominus1", "interpolate"]
+
+#: One pose ``(x, y, theta)`` (or one point) given as numbers: a sequence of floats or a 1-D array.
+#: The single-pose functions read its elements one by one as Python floats.
+Pose1Like: TypeAlias = "Sequence[float] | NDArray[Any]"
 
 
 def as_poses(poses: ArrayLike) -> NDArray[np.float64]:
@@ -106,26 +112,26 @@ def wrap_angle1(angle: float) -> float:
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
-def compose1(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
+def compose1(a: Pose1Like, b: Pose1Like) -> NDArray[np.float64]:
     """:func:`compose` for two single poses ``[3]``, in scalar arithmetic.
 
     The simulator composes a few single poses every step; ``geometry.compose`` is written for arrays of
     poses and costs tens of microseconds on one pose, this costs about one. Same formulas and results.
     """
-    ax, ay, at = (float(v) for v in a)  # type: ignore[union-attr]
-    bx, by, bt = (float(v) for v in b)  # type: ignore[union-attr]
+    ax, ay, at = (float(v) for v in a)
+    bx, by, bt = (float(v) for v in b)
     c, s = math.cos(at), math.sin(at)
     return np.array([ax + c * bx - s * by, ay + s * bx + c * by, wrap_angle1(at + bt)])
 
 
-def ominus1(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
+def ominus1(a: Pose1Like, b: Pose1Like) -> NDArray[np.float64]:
     """:func:`ominus` for two single poses ``[3]``: pose ``b`` in the frame of ``a``.
 
     Computed directly as the rotation by ``-theta_a`` of ``b - a`` (equal to ``compose(inverse(a), b)``
     up to rounding).
     """
-    ax, ay, at = (float(v) for v in a)  # type: ignore[union-attr]
-    bx, by, bt = (float(v) for v in b)  # type: ignore[union-attr]
+    ax, ay, at = (float(v) for v in a)
+    bx, by, bt = (float(v) for v in b)
     c, s = math.cos(at), math.sin(at)
     dx, dy = bx - ax, by - ay
     return np.array([c * dx + s * dy, -s * dx + c * dy, wrap_angle1(bt - at)])

@@ -119,8 +119,7 @@ class RunRecord:
     stalled:
         bool ``[T]`` collision flag per frame.
     laser:
-        Laser geometry: ``angle_min``, ``angle_increment`` (rad), ``range_min``, ``range_max`` (m) and
-        ``mount`` (x, y, theta of the laser in the base frame).
+        The laser's geometry (:class:`LaserGeometry`).
     metadata:
         Free-form JSON-serialisable facts about the run (world name, seed, drawn odometry bias, ...).
     estimate:
@@ -134,12 +133,14 @@ class RunRecord:
     odometry: NDArray[np.float64]
     truth: NDArray[np.float64]
     stalled: NDArray[np.bool_]
-    laser: dict[str, Any]
+    laser: LaserGeometry
     metadata: dict[str, Any] = field(default_factory=dict)
     estimate: NDArray[np.float64] | None = None
     map: OccupancyGrid | None = None
 
     def __post_init__(self) -> None:
+        if not isinstance(self.laser, LaserGeometry):
+            raise TypeError(f"RunRecord.laser must be a LaserGeometry, got {type(self.laser).__name__}")
         n = len(self.t)
         expected = {"scans": (n,), "odometry": (n, 3), "truth": (n, 3), "stalled": (n,)}
         for name, shape in expected.items():
@@ -151,7 +152,7 @@ class RunRecord:
         return len(self.t)
 
     @classmethod
-    def from_frames(cls, frames: list[Frame], laser: dict[str, Any], metadata: dict[str, Any] | None = None) -> "RunRecord":
+    def from_frames(cls, frames: list[Frame], laser: LaserGeometry, metadata: dict[str, Any] | None = None) -> "RunRecord":
         """Stack a list of frames into a record."""
         return cls(
             t=np.array([f.t for f in frames], dtype=np.float64),
@@ -159,7 +160,7 @@ class RunRecord:
             odometry=np.stack([f.odometry for f in frames]).astype(np.float64, copy=False),
             truth=np.stack([f.truth for f in frames]).astype(np.float64, copy=False),
             stalled=np.array([f.stalled for f in frames], dtype=bool),
-            laser=dict(laser),
+            laser=laser,
             metadata=dict(metadata or {}),
         )
 

@@ -8,8 +8,11 @@ registry (:mod:`slamtrials.slam`) and times every call; :func:`write_slam_output
     the estimate, one pose per frame (TUM: ``t x y z qx qy qz qw``, map frame).
 ``trajectory.clf``
     a CARMEN log of the run whose FIRST pose triple is the SLAM estimate and SECOND the recorded
-    odometry (ROBOTLASER1 lines), as SLAM programs of the Freiburg benchmark write their corrected logs;
-    ``slamtrials evaluate --estimate trajectory.clf --relations ...`` evaluates it.
+    odometry (ROBOTLASER1 lines, with the scans): the run as a corrected log, which ``slamtrials
+    evaluate --estimate trajectory.clf --relations ...`` evaluates (its first triple).
+``trajectory.log``
+    the estimate as the Freiburg metricEvaluator's test logs hold one (``FLASER 0`` lines, the estimate in
+    both triples: that program reads the second), for the original tool and for ``slamtrials evaluate``.
 ``map.yaml``, ``map.pgm``, ``map.png``
     the final map in ROS map_server form and as a picture.
 ``timing.csv``
@@ -24,7 +27,6 @@ from __future__ import annotations
 
 import json
 import math
-import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -35,14 +37,15 @@ from numpy.typing import NDArray
 
 from slamtrials.atomicfile import atomic_write_text
 from slamtrials.errors import ConfigError, FormatError
-from slamtrials.record import Frame, RunRecord, Trajectory
-from slamtrials.slam import OccupancyGrid, get_algorithm, resolve_config
+from slamtrials.record import RunRecord, Trajectory
+from slamtrials.slam import OccupancyGrid
+from slamtrials.slam.offline import estimate_per_frame, run_over_recording
 
 __all__ = ["SlamResult", "run_slam", "write_slam_outputs", "load_recording", "OUTPUT_FILES", "SLAM_FILE"]
 
 SLAM_FILE = "slam.json"
 #: Files :func:`write_slam_outputs` writes, in order (``slam.json`` last).
-OUTPUT_FILES = ("trajectory.tum", "trajectory.clf", "map.yaml", "map.pgm", "map.png", "timing.csv", SLAM_FILE)
+OUTPUT_FILES = ("trajectory.tum", "trajectory.clf", "trajectory.log", "map.yaml", "map.pgm", "map.png", "timing.csv", SLAM_FILE)
 
 
 @dataclass(frozen=True, eq=False)
@@ -87,7 +90,8 @@ class SlamResult:
 
 def run_slam(record: RunRecord, algorithm_name: str, *, preset: str | None = None, overrides: dict[str, Any] | None = None,
              seed: int = 0, on_frame: Callable[[int, int], None] | None = None, source: str = "") -> SlamResult:
-    """Process every frame of ``record`` with algorithm ``algorithm_name``.
+    """Process every frame of ``record`` with algorithm ``algorithm_name``
+    (:func:`slamtrials.slam.offline.run_over_recording`).
 
     Parameters
     ----------
@@ -98,7 +102,8 @@ def run_slam(record: RunRecord, algorithm_name: str, *, preset: str | None = Non
     preset, overrides:
         Configuration (see :func:`slamtrials.slam.resolve_config`).
     seed:
-        Seed of the ``numpy.random.Generator`` handed to ``reset``.
+        The run's seed, used as a trial uses it (:mod:`slamtrials.seeding`): on a trial's run folder,
+        the trial's seed gives the trial's own estimate.
     on_frame:
         Called as ``on_frame(index, total)`` after each frame (for progress bars).
     source:
@@ -109,36 +114,10 @@ def run_slam(record: RunRecord, algorithm_name: str, *, preset: str | None = Non
     ConfigError
         Unknown algorithm, preset or parameter, a bad value, a negative seed or an empty record.
     """
-    if seed < 0:
-        raise ConfigError(f"seed must be a non-negative integer, got {seed}")
-    if len(record) == 0:
-        raise ConfigError("the recording has no frames")
-    cls = get_algorithm(algorithm_name)
-    config = resolve_config(cls, preset=preset, overrides=overrides)
-    algorithm = cls(config, dict(record.laser))
-    algorithm.reset(np.random.default_rng(seed))
-    total = len(record)
-    timing = np.empty(total, dtype=np.float64)
-    for k in range(total):
-        frame = Frame(t=float(record.t[k]), ranges=record.scans[k], odometry=record.odometry[k], truth=record.truth[k],
-                      stalled=bool(record.stalled[k]))
-        started = time.perf_counter()
-        algorithm.process(frame)
-        timing[k] = time.perf_counter() - started
-        if on_frame is not None:
-            on_frame(k, total)
-    return SlamResult(algorithm=algorithm_name, preset=preset, config=config.model_dump(mode="json"), seed=seed,
-                      trajectory=algorithm.trajectory(), occupancy=algorithm.occupancy(), timing=timing,
-                      updates=int(algorithm.updates), record=record, source=source)
-
-
-def _estimate_per_frame(result: SlamResult) -> NDArray[np.float64]:
-    """The estimate at each frame of the record (the trajectory must hold one pose per frame)."""
-    trajectory, record = result.trajectory, result.record
-    if len(trajectory) != len(record) or not np.array_equal(trajectory.t, record.t):
-        raise ConfigError(f"SLAM algorithm {result.algorithm!r} returned {len(trajectory)} poses for {len(record)} frames; "
-                          "trajectory() must hold one pose per processed frame")
-    return trajectory.poses
+    run = run_over_recording(record, algorithm_name, preset=preset, overrides=overrides, seed=seed, on_frame=on_frame)
+    return SlamResult(algorithm=algorithm_name, preset=preset, config=run.config.model_dump(mode="json"), seed=run.seed,
+                      trajectory=run.trajectory, occupancy=run.occupancy, timing=run.timing, updates=run.updates,
+                      record=record, source=source)
 
 
 def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bool = False) -> list[Path]:
@@ -149,7 +128,7 @@ def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bo
     ConfigError
         ``out_dir`` already holds SLAM outputs (``slam.json``) and ``overwrite`` is False.
     """
-    from slamtrials.io.carmen import carmen_from_run, write_carmen
+    from slamtrials.io.carmen import carmen_from_run, carmen_from_trajectory, write_carmen
     from slamtrials.io.mapfile import write_map, write_map_png
     from slamtrials.io.tum import write_tum
 
@@ -157,10 +136,11 @@ def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bo
     if (out / SLAM_FILE).exists() and not overwrite:
         raise ConfigError(f"{out}: already holds SLAM outputs; choose another --out or pass --overwrite")
     out.mkdir(parents=True, exist_ok=True)
-    estimate = _estimate_per_frame(result)
+    estimate = estimate_per_frame(result.algorithm, result.trajectory, result.record)
     written = [write_tum(out / "trajectory.tum", result.trajectory)]
     as_run = replace(result.record, truth=estimate, estimate=estimate)  # first CARMEN triple = the estimate
     written.append(write_carmen(out / "trajectory.clf", carmen_from_run(as_run)))
+    written.append(write_carmen(out / "trajectory.log", carmen_from_trajectory(Trajectory(t=result.record.t, poses=estimate))))
     grid = result.occupancy
     written.append(write_map(out / "map.yaml", grid.grid, grid.resolution, grid.origin))
     written.append(out / "map.pgm")
@@ -181,6 +161,7 @@ def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bo
         "ms_per_frame_max": 1000.0 * float(result.timing.max()) if len(result.timing) else math.nan,
         "map": {"shape": list(grid.grid.shape), "resolution": grid.resolution, "origin": [float(v) for v in grid.origin]},
         "trajectory_clf": "first pose triple = SLAM estimate, second = recorded odometry",
+        "trajectory_log": "FLASER 0 lines, SLAM estimate in both pose triples (the Freiburg metricEvaluator's input)",
     }
     atomic_write_text(out / SLAM_FILE, json.dumps(summary, indent=2) + "\n")
     written.append(out / SLAM_FILE)
@@ -188,7 +169,7 @@ def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bo
 
 
 def load_recording(path: str | Path) -> RunRecord:
-    """Read a run folder, a CARMEN log (``.clf``, ``.log``, ``.carmen``, optionally ``.gz``) or a ROS bag.
+    """Read a run folder, a CARMEN log (``.clf``, ``.log``, ``.carmen``, optionally ``.gz``, ``.bz2``) or a ROS bag.
 
     A bag without the ground-truth topic is read without ground truth (NaN), which SLAM does not need.
 
@@ -197,13 +178,13 @@ def load_recording(path: str | Path) -> RunRecord:
     FormatError
         The path does not exist or the file does not parse.
     """
-    from slamtrials.io.runfolder import RUN_FILE, read_run
+    from slamtrials.io.runfolder import RunFolder, read_run
     from slamtrials.io.transfer import detect_recording_format, read_carmen_run
 
     path = Path(path)
     if not path.exists():
         raise FormatError(path, "no such file or folder")
-    if path.is_dir() and (path / RUN_FILE).exists():
+    if path.is_dir() and RunFolder(path).is_complete():
         return read_run(path)
     if detect_recording_format(path) == "carmen":
         return read_carmen_run(path)

@@ -14,12 +14,15 @@ On this project's development machine numpy's functions equal the C library's, s
 bits as numpy's there (``tests/test_stablemath.py`` checks the C library's values themselves).
 
 Each function takes floats or float64 arrays of any shape (broadcast like numpy) and returns a float
-for scalar input, else a float64 array of the broadcast shape.
+for scalar input, else a float64 array of the broadcast shape. (For type checkers, overloads say
+"float in, float out" and "array in, array out"; a 0-d array, which also gives a float, is the one case
+they do not describe.)
 """
 
 from __future__ import annotations
 
 import math
+from typing import Any, overload
 
 import numpy as np
 from numba import njit
@@ -107,26 +110,60 @@ def _binary(kernel, scalar, a: ArrayLike, b: ArrayLike) -> float | NDArray[np.fl
     return out
 
 
+@overload
+def sin(x: float) -> float: ...
+@overload
+def sin(x: NDArray[Any]) -> NDArray[np.float64]: ...
+@overload
+def sin(x: ArrayLike) -> float | NDArray[np.float64]: ...
 def sin(x: ArrayLike) -> float | NDArray[np.float64]:
     """Sine of ``x`` (radians), elementwise, from the C library."""
     return _unary(_sin, _sin1, x)
 
 
+@overload
+def cos(x: float) -> float: ...
+@overload
+def cos(x: NDArray[Any]) -> NDArray[np.float64]: ...
+@overload
+def cos(x: ArrayLike) -> float | NDArray[np.float64]: ...
 def cos(x: ArrayLike) -> float | NDArray[np.float64]:
     """Cosine of ``x`` (radians), elementwise, from the C library."""
     return _unary(_cos, _cos1, x)
 
 
+@overload
+def exp(x: float) -> float: ...
+@overload
+def exp(x: NDArray[Any]) -> NDArray[np.float64]: ...
+@overload
+def exp(x: ArrayLike) -> float | NDArray[np.float64]: ...
 def exp(x: ArrayLike) -> float | NDArray[np.float64]:
     """``e ** x``, elementwise, from the C library."""
     return _unary(_exp, _exp1, x)
 
 
+@overload
+def arctan2(y: float, x: float) -> float: ...
+@overload
+def arctan2(y: NDArray[Any], x: ArrayLike) -> NDArray[np.float64]: ...
+@overload
+def arctan2(y: ArrayLike, x: NDArray[Any]) -> NDArray[np.float64]: ...
+@overload
+def arctan2(y: ArrayLike, x: ArrayLike) -> float | NDArray[np.float64]: ...
 def arctan2(y: ArrayLike, x: ArrayLike) -> float | NDArray[np.float64]:
     """Angle (radians, in [-pi, pi]) of the point (``x``, ``y``), elementwise, from the C library."""
     return _binary(_arctan2, _arctan21, y, x)
 
 
+@overload
+def hypot(x: float, y: float) -> float: ...
+@overload
+def hypot(x: NDArray[Any], y: ArrayLike) -> NDArray[np.float64]: ...
+@overload
+def hypot(x: ArrayLike, y: NDArray[Any]) -> NDArray[np.float64]: ...
+@overload
+def hypot(x: ArrayLike, y: ArrayLike) -> float | NDArray[np.float64]: ...
 def hypot(x: ArrayLike, y: ArrayLike) -> float | NDArray[np.float64]:
     """``sqrt(x**2 + y**2)`` without overflow, elementwise, from the C library."""
     return _binary(_hypot, _hypot1, x, y)

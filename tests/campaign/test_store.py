@@ -8,13 +8,21 @@ import pytest
 
 from slamtrials.campaign import CampaignConfig
 from slamtrials.campaign.folder import campaign_lock, open_campaign, prepare_resume
-from slamtrials.campaign.runfiles import clean_partials, publish_run, remove_unrecorded, run_folder
+from slamtrials.campaign.results import RunDetails, RunDone
+from slamtrials.campaign.runfiles import (
+    clean_partials,
+    publish_run,
+    remove_unrecorded,
+    run_folder,
+)
 from slamtrials.campaign.store import DB_FILE, CampaignStore, WorldInfo
 from slamtrials.errors import ConfigError
 
 WORLDS = [WorldInfo("a", "a", 0, 10.0), WorldInfo("b", "/x/b.yaml", 1, 20.0)]
-RESULT = {"eps_t": 0.25, "eps_r": 0.03, "relations": 12, "termination": "map_converged", "mapped_fraction": 0.97,
-          "sim_duration": 100.0, "wall_time": 2.0, "worker": "w:1", "folder": "runs/a/000", "details": {"frames": 5}}
+RESULT = RunDone(world="a", index=0, eps_t=0.25, eps_r=0.03, relations=12, termination="map_converged",
+                 mapped_fraction=0.97, sim_duration=100.0, wall_time=2.0, worker="w:1", folder="runs/a/000",
+                 details=RunDetails(frames=5, distance_m=3.0, observed_fraction=0.99, slam_updates=7,
+                                    relation_std_t=0.1, relation_std_r=0.01, relations_capped=False))
 
 
 def snapshot(folder):
@@ -115,3 +123,27 @@ def test_resume_removes_partial_and_unrecorded_run_folders(tmp_path):
     assert {r.idx: r.status for r in store.runs("a")} == {0: "done", 1: "pending"}
     store.close()
     assert clean_partials(folder) == [] and remove_unrecorded(folder, {("a", 0)}) == []
+
+
+def test_a_campaign_stored_by_an_earlier_version_loads_and_resumes(tmp_path):
+    """Earlier versions stored explore's robot fields (then overridden by sim.robot) and fewer metric fields."""
+    import hashlib
+    import json
+
+    config = CampaignConfig(worlds=["a", "b"], seed=5)
+    folder = tmp_path / "c"
+    CampaignStore.create(folder, config, WORLDS).close()
+    old = config.model_dump(mode="json")
+    old["explore"].update({"robot_radius": 0.15, "max_linear_speed": 0.7, "control_period": 0.1})
+    for name in ("sides", "min_relations", "max_relations", "squared"):
+        del old["metric"][name]
+    identity = {k: v for k, v in old.items() if k != "output"}
+    old_hash = hashlib.sha256(json.dumps(identity, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
+    with sqlite3.connect(folder / DB_FILE) as conn:
+        conn.execute("UPDATE meta SET value = ? WHERE key = 'config'", (json.dumps(old),))
+        conn.execute("UPDATE meta SET value = ? WHERE key = 'config_hash'", (old_hash,))
+    with CampaignStore.open(folder) as store:
+        assert store.config() == config
+    open_campaign(folder, config, WORLDS, kind="campaign").close()
+    with pytest.raises(ConfigError, match="different config"):
+        open_campaign(folder, CampaignConfig(worlds=["a", "b"], seed=6), WORLDS, kind="campaign")

@@ -14,12 +14,12 @@ from slamtrials.geometry import compose, ominus
 from slamtrials.io.relations import read_relations, write_relations
 from slamtrials.io.runfolder import write_run
 from slamtrials.io.tum import write_tum
-from slamtrials.record import Relations, RunRecord, Trajectory
+from slamtrials.record import LaserGeometry, Relations, RunRecord, Trajectory
 
 runner = CliRunner()
 REPO = Path(__file__).resolve().parents[2]
 DATA = Path(os.environ.get("SLAMTRIALS_SHARED", REPO.parent / "shared")) / "data" / "mit-csail"
-LASER = {"angle_min": -2.356, "angle_increment": 0.0087, "range_min": 0.0, "range_max": 30.0, "mount": [0.0, 0.0, 0.0]}
+LASER = LaserGeometry.from_dict({"angle_min": -2.356, "angle_increment": 0.0087, "range_min": 0.0, "range_max": 30.0, "mount": [0.0, 0.0, 0.0]})
 
 
 def _summary_rows(output: str) -> tuple[list[float], list[float]]:
@@ -194,8 +194,11 @@ def test_pose_indices_map_to_file_lines(tmp_path):
         "ODOM 0 0 0 0 0 0 10.05 h 0\n"
         "FLASER 2 1.0 1.0 0 0 0 0 0 0 10.1 h 0\n"
     )
-    source = _read_trajectory(clf, PoseTriple.second, "odometry")
-    mapped = _with_lines(MetricError("pose 1 is bad", what="odometry", index=1), {"odometry": source}, None)
+    source = _read_trajectory(clf, PoseTriple.second, "estimate")
+    mapped = _with_lines(MetricError("pose 1 is bad", what="estimate", index=1), {"estimate": source}, None)
     assert (mapped.path, mapped.line) == (clf, 4)
+    source = _read_trajectory(clf, PoseTriple.second, "odometry")  # odometry: the ODOM lines, as the Freiburg program
+    mapped = _with_lines(MetricError("pose 0 is bad", what="odometry", index=0), {"odometry": source}, None)
+    assert (mapped.path, mapped.line) == (clf, 3) and "1 ODOM lines" in source.label
     unknown = MetricError("no index")
     assert _with_lines(unknown, {}, None) is unknown

@@ -64,7 +64,7 @@ def test_config_file_sets_the_laser(tmp_path):
     assert runner.invoke(app, args).exit_code == 0
     record = read_run(out)
     assert record.scans.shape[1] == 81  # 80 degrees at 1 degree, as the paper's industrial-hall laser
-    assert record.laser["range_max"] == 20.0
+    assert record.laser.range_max == 20.0
     assert record.scans.max() <= 20.0
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import bz2
 import json
 
 import numpy as np
@@ -41,7 +42,7 @@ def test_slam_writes_every_output_and_evaluate_reads_them(run_folder, tmp_path):
     result = runner.invoke(app, ["slam", "--algorithm", "odometry", "--input", str(folder), "--out", str(out), "--set", "resolution=0.1"])
     assert result.exit_code == 0, result.output
     assert f"{len(record)} frames, {len(record)} updates" in result.output and "ms per frame" in result.output
-    for name in ("trajectory.tum", "trajectory.clf", "map.yaml", "map.pgm", "map.png", "timing.csv", "slam.json"):
+    for name in ("trajectory.tum", "trajectory.clf", "trajectory.log", "map.yaml", "map.pgm", "map.png", "timing.csv", "slam.json"):
         assert (out / name).is_file(), name
     tum = read_tum(out / "trajectory.tum")
     np.testing.assert_allclose(tum.t, record.t, atol=1e-6)
@@ -60,6 +61,9 @@ def test_slam_writes_every_output_and_evaluate_reads_them(run_folder, tmp_path):
     assert "Translational error" in evaluated.output
     from_clf = runner.invoke(app, ["evaluate", str(folder), "--estimate", str(out / "trajectory.clf")])
     assert from_clf.exit_code == 0, from_clf.output
+    test_log = read_carmen(out / "trajectory.log")  # the Freiburg program's input: the estimate in both triples
+    assert test_log.laser.beams == 0 and np.array_equal(test_log.laser.pose, test_log.laser.odometry)
+    np.testing.assert_allclose(test_log.laser.odometry, record.odometry, atol=1e-5)
 
 
 def test_slam_reads_a_carmen_log_and_refuses_to_overwrite(run_folder, tmp_path):
@@ -91,6 +95,23 @@ def test_bad_options_exit_2_with_one_line(run_folder, tmp_path, extra, expected)
     result = runner.invoke(app, ["slam", "--input", str(folder), "--out", str(tmp_path / "o"), *extra])
     assert result.exit_code == 2
     assert expected in result.output and len(result.output.strip().splitlines()) == 1, result.output
+    assert not (tmp_path / "o").exists()
+
+
+def test_slam_reads_a_bzip2_log_and_refuses_a_pose_only_one(run_folder, tmp_path):
+    _, record = run_folder
+    log = tmp_path / "run.clf"
+    export_record(record, log, "carmen")
+    packed = tmp_path / "run.clf.bz2"
+    packed.write_bytes(bz2.compress(log.read_bytes()))
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["slam", "-a", "odometry", "-i", str(packed), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert len(read_tum(out / "trajectory.tum")) == len(record)
+    poses = tmp_path / "poses.log"  # a trajectory as SLAM programs write it for the Freiburg evaluator
+    poses.write_text("".join(f"FLASER 0 {k} 0 0 {k} 0 0 {100.0 + k} h {k}\n" for k in range(5)))
+    refused = runner.invoke(app, ["slam", "-a", "odometry", "-i", str(poses), "-o", str(tmp_path / "o")])
+    assert refused.exit_code == 2 and "pose-only" in refused.output and len(refused.output.strip().splitlines()) == 1
     assert not (tmp_path / "o").exists()
 
 

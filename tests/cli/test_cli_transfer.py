@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import bz2
 import gzip
 import shutil
 from functools import cache
@@ -77,15 +78,16 @@ def test_tum_exports_truth_by_default_and_odometry_on_request(tmp_path, run_fold
         assert np.max(np.abs(_wrapped(trajectory.poses[:, 2] - poses[:, 2]))) < 1e-12
 
 
-@pytest.mark.parametrize("compressed", [False, True])
+@pytest.mark.parametrize("compressed", [None, "gz", "bz2"])
 def test_carmen_export_and_import(tmp_path, run_folder, compressed):
     log = tmp_path / "run.clf"
     result = _invoke("export", run_folder, "--to", "carmen", "--out", log)
     assert result.exit_code == 0, result.output
     if compressed:
-        with open(log, "rb") as source, gzip.open(tmp_path / "run.clf.gz", "wb") as target:
+        opener = gzip.open if compressed == "gz" else bz2.open
+        with open(log, "rb") as source, opener(tmp_path / f"run.clf.{compressed}", "wb") as target:
             shutil.copyfileobj(source, target)
-        log = tmp_path / "run.clf.gz"
+        log = tmp_path / f"run.clf.{compressed}"
     result = _invoke("import", log, "--out", tmp_path / "back")
     assert result.exit_code == 0, result.output
     original, back = read_run(run_folder), read_run(tmp_path / "back")

@@ -68,7 +68,7 @@ def run(world: World, *, seed: int = 0, max_time: float = 10800.0, integrate_eve
         explore: ExploreConfig | None = None, termination: TerminationConfig | None = None) -> HarnessResult:
     started = time.perf_counter()
     sim = Simulator(world, SimConfig(), np.random.default_rng(seed))
-    laser = sim.laser_info
+    laser = sim.laser
     gridmap = GridMap(0.05)
     frame = sim.observe()
     gridmap.integrate_frame(frame.truth, frame.ranges, laser)

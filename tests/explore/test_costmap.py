@@ -8,7 +8,8 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 from scipy import ndimage
 
-from slamtrials.explore import ExploreConfig, build_costmap
+from slamtrials.explore import ExploreConfig, RobotLimits, build_costmap
+from slamtrials.explore.config import lethal_distance
 from slamtrials.explore.costmap import (
     LETHAL,
     OCCUPIED,
@@ -35,9 +36,9 @@ def single_obstacle(n=41, value=0):
 
 
 def test_lethal_radius_around_one_obstacle():
-    cfg = ExploreConfig(robot_radius=0.15, inflation_margin=0.05)  # lethal below 0.20 m from the cell's edge
+    cfg = ExploreConfig(inflation_margin=0.05)  # with a 0.15 m robot: lethal below 0.20 m from the cell's edge
     res = 0.05
-    costmap = build_costmap(single_obstacle(), res, cfg)
+    costmap = build_costmap(single_obstacle(), res, cfg, RobotLimits(radius=0.15))
     c = 20
     assert costmap.kind[c, c] == OCCUPIED
     # clearance = centre distance - half a cell: 4 cells -> 0.175 m (lethal), 5 cells -> 0.225 m (free)
@@ -48,7 +49,7 @@ def test_lethal_radius_around_one_obstacle():
     assert np.isclose(costmap.clearance[c, c + 5], 5 * res - res / 2)
     rows, cols = np.nonzero(costmap.kind == LETHAL)
     dist = np.hypot(rows - c, cols - c) * res - res / 2
-    assert dist.max() < cfg.lethal_distance
+    assert dist.max() < lethal_distance(cfg, RobotLimits(radius=0.15))
     assert np.isinf(costmap.cost[costmap.kind != PASSABLE]).all()
 
 

@@ -8,9 +8,10 @@ from types import SimpleNamespace
 import numpy as np
 
 from slamtrials.explore import ExploreConfig, Explorer
+from slamtrials.record import LaserGeometry
 
-LASER = {"angle_min": -math.radians(135), "angle_increment": math.radians(0.5), "range_min": 0.0,
-         "range_max": 30.0, "mount": [0.0, 0.0, 0.0]}
+LASER = LaserGeometry.from_dict({"angle_min": -math.radians(135), "angle_increment": math.radians(0.5), "range_min": 0.0,
+         "range_max": 30.0, "mount": [0.0, 0.0, 0.0]})
 SCAN = np.full(541, 30.0, dtype=np.float32)
 RES = 0.05
 

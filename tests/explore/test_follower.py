@@ -2,16 +2,19 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 import pytest
 
-from slamtrials.explore import ExploreConfig, PathFollower
+from slamtrials.explore import ExploreConfig, PathFollower, RobotLimits
 from slamtrials.explore.follower import free_travel, scan_points, turn_rate
+from slamtrials.record import LaserGeometry
 
-LASER = {"angle_min": -math.radians(135), "angle_increment": math.radians(0.5), "range_min": 0.0,
-         "range_max": 30.0, "mount": [0.0, 0.0, 0.0]}
+ROBOT = RobotLimits()  # the defaults: the paper's robot, which the followers below drive
+LASER = LaserGeometry.from_dict({"angle_min": -math.radians(135), "angle_increment": math.radians(0.5), "range_min": 0.0,
+         "range_max": 30.0, "mount": [0.0, 0.0, 0.0]})
 BEAMS = 541
 
 
@@ -21,14 +24,14 @@ def empty_scan():
 
 def wall_scan(distance):
     """A wall across the robot's path, ``distance`` m ahead (robot frame x = distance)."""
-    angles = LASER["angle_min"] + LASER["angle_increment"] * np.arange(BEAMS)
+    angles = LASER.angle_min + LASER.angle_increment * np.arange(BEAMS)
     with np.errstate(divide="ignore"):
         r = np.where(np.cos(angles) > 1e-6, distance / np.cos(angles), 30.0)
     return np.minimum(r, 30.0).astype(np.float32)
 
 
 def test_scan_points_use_the_mount_and_drop_max_range():
-    laser = dict(LASER, mount=[0.1, 0.0, math.pi / 2])
+    laser = dataclasses.replace(LASER, mount=(0.1, 0.0, math.pi / 2))
     r = empty_scan()
     r[270] = 2.0  # the middle beam: straight ahead of the laser, which looks left
     pts = scan_points(r, laser)
@@ -64,10 +67,10 @@ def test_follows_a_straight_path_within_the_limits():
     v_prev = 0.0
     for _ in range(30):
         out = follower.command([0.0, 0.0, 0.0], empty_scan(), LASER)
-        assert abs(out.w) < 1e-9 and out.v <= cfg.max_linear_speed + 1e-12
-        assert out.v - v_prev <= cfg.max_linear_accel * cfg.control_period + 1e-12
+        assert abs(out.w) < 1e-9 and out.v <= ROBOT.max_linear_speed + 1e-12
+        assert out.v - v_prev <= ROBOT.max_linear_accel * ROBOT.control_period + 1e-12
         v_prev = out.v
-    assert math.isclose(v_prev, cfg.max_linear_speed)
+    assert math.isclose(v_prev, ROBOT.max_linear_speed)
 
 
 def test_turns_in_place_towards_a_path_behind_when_not_backing_out():
@@ -108,7 +111,7 @@ def test_backs_out_of_a_dead_end_instead_of_turning_round():
     v = commands[:, 0]
     assert v.min() >= -cfg.reverse_speed - 1e-12 and v.min() < -0.5 * cfg.reverse_speed
     speed = np.abs(np.concatenate([[0.0], v]))
-    assert np.all(np.diff(speed) <= cfg.max_linear_accel * cfg.control_period + 1e-12)  # braking is the robot's
+    assert np.all(np.diff(speed) <= ROBOT.max_linear_accel * ROBOT.control_period + 1e-12)  # braking is the robot's
     assert not np.any((v[1:] < 0.0) & (v[:-1] > 0.0))  # never from forward straight to backward
     backed = poses[1:][v < 0.0]
     assert backed[:, 0].min() > -2.5 and np.all(np.abs(backed[:, 1]) < 0.6)  # only along the first leg
@@ -159,14 +162,14 @@ def test_slows_down_and_stops_for_obstacles_in_the_scan(distance, expect):
     cfg = ExploreConfig()
     follower = PathFollower(cfg)
     follower.set_path(np.column_stack([np.linspace(0, 5, 101), np.zeros(101)]))
-    follower.remember(cfg.max_linear_speed, 0.0)
+    follower.remember(ROBOT.max_linear_speed, 0.0)
     out = follower.command([0.0, 0.0, 0.0], wall_scan(distance), LASER)
     if expect == "full":
-        assert math.isclose(out.v, cfg.max_linear_speed)
+        assert math.isclose(out.v, ROBOT.max_linear_speed)
     elif expect == "slow":
-        assert 0.0 < out.v < cfg.max_linear_speed
-        room = distance - cfg.robot_radius - cfg.obstacle_margin - cfg.stop_distance
-        assert out.v <= math.sqrt(2 * cfg.max_linear_accel * room) + 1e-6
+        assert 0.0 < out.v < ROBOT.max_linear_speed
+        room = distance - ROBOT.radius - cfg.obstacle_margin - cfg.stop_distance
+        assert out.v <= math.sqrt(2 * ROBOT.max_linear_accel * room) + 1e-6
     elif expect == "creep":  # too close for the normal margins: inch on slowly
         assert 0.0 < out.v <= 0.15 and not out.blocked
     else:

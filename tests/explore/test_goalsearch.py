@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from slamtrials.explore import ExploreConfig
+from slamtrials.explore import RobotLimits
 from slamtrials.explore.costmap import influence_distance
 from slamtrials.explore.goalsearch import GoalSearch
 
@@ -34,7 +35,7 @@ def windows(occ, pose, cfg):
     rows = occ.grid.shape[0]
     row, col = rows - 1 - int(pose[1] / RES), int(pose[0] / RES)
     half = math.ceil(cfg.local_radius / RES)
-    rim = math.ceil(influence_distance(cfg, RES) / RES) + 1
+    rim = math.ceil(influence_distance(cfg, RobotLimits(), RES) / RES) + 1
     local = (row - half - rim, row + half + rim + 1, col - half - rim, col + half + rim + 1)
     inner = (rim, local[1] - local[0] - rim, rim, local[3] - local[2] - rim)
     return search, whole, local, inner

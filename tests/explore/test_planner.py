@@ -11,7 +11,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from slamtrials.explore import ExploreConfig, build_costmap, dijkstra
+from slamtrials.explore import ExploreConfig, RobotLimits, build_costmap, dijkstra
+from slamtrials.explore.config import lethal_distance
 from slamtrials.explore.costmap import PASSABLE
 
 DIAG = math.sqrt(2.0)
@@ -110,7 +111,7 @@ def test_paths_keep_off_walls_on_a_real_costmap():
     path = result.path_to(50, 10)
     assert len(path) > 0
     assert (costmap.kind[path[:, 0], path[:, 1]] == PASSABLE).all()
-    assert (costmap.clearance[path[:, 0], path[:, 1]] >= ExploreConfig().lethal_distance).all()
+    assert (costmap.clearance[path[:, 0], path[:, 1]] >= lethal_distance(ExploreConfig(), RobotLimits())).all()
     crossing = path[path[:, 0] == 30]
     assert crossing[:, 1].min() >= 45 + 4  # through the gap, away from the wall's end
 

@@ -7,11 +7,12 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from slamtrials.explore import ExploreConfig
+from slamtrials.explore import ExploreConfig, RobotLimits
 from slamtrials.explore.recovery import Recovery, StuckMonitor, open_side, segment_clear
+from slamtrials.record import LaserGeometry
 
-LASER = {"angle_min": -math.radians(135), "angle_increment": math.radians(0.5), "range_min": 0.0,
-         "range_max": 30.0, "mount": [0.0, 0.0, 0.0]}
+LASER = LaserGeometry.from_dict({"angle_min": -math.radians(135), "angle_increment": math.radians(0.5), "range_min": 0.0,
+         "range_max": 30.0, "mount": [0.0, 0.0, 0.0]})
 
 
 def test_not_moving_while_commanded_is_stuck():
@@ -77,7 +78,7 @@ def test_recovery_without_room_behind_only_turns():
 def test_a_robot_touching_an_obstacle_moves_away_from_it():
     cfg = ExploreConfig()
     ranges = np.full(541, 30.0)
-    ranges[270 + 90] = cfg.robot_radius + 0.01  # beam at +45 deg: an obstacle front-left, touching
+    ranges[270 + 90] = RobotLimits().radius + 0.01  # beam at +45 deg: an obstacle front-left, touching
     recovery = Recovery(cfg)
     recovery.start(0.0, [0.0, 0.0, 0.0], ranges, LASER, free_map())
     commands = []

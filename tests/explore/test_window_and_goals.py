@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from slamtrials.explore import ExploreConfig, GridFrame, build_costmap
+from slamtrials.explore import RobotLimits
 from slamtrials.explore.costmap import influence_distance
 from slamtrials.explore.frontiers import frontier_near
 from slamtrials.explore.goals import GoalRecord, exclude_discs
@@ -35,7 +36,7 @@ def test_a_window_costmap_matches_the_whole_map_inside_its_rim():
     whole = build_costmap(grid, res, cfg)
     r0, r1, c0, c1 = 40, 170, 60, 190
     local = build_costmap(crop(grid, r0, r1, c0, c1), res, cfg)
-    rim = math.ceil(influence_distance(cfg, res) / res)
+    rim = math.ceil(influence_distance(cfg, RobotLimits(), res) / res)
     inner = (slice(rim, r1 - r0 - rim), slice(rim, c1 - c0 - rim))
     outer = (slice(r0 + rim, r1 - rim), slice(c0 + rim, c1 - rim))
     assert np.array_equal(local.kind[inner], whole.kind[outer])

@@ -3,6 +3,7 @@ and a FormatError naming file and line for every kind of malformed log."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 from pathlib import Path
@@ -22,7 +23,7 @@ from slamtrials.io.carmen import (
     write_carmen,
 )
 from slamtrials.io.relations import read_relations
-from slamtrials.record import RunRecord
+from slamtrials.record import LaserGeometry, RunRecord
 
 REPO = Path(__file__).resolve().parents[2]
 SHARED = Path(os.environ.get("SLAMTRIALS_SHARED", REPO.parent / "shared"))
@@ -154,7 +155,7 @@ def _record(n: int = 40, beams: int = 541, seed: int = 1) -> RunRecord:
         t=np.arange(n) * 0.1, scans=rng.uniform(0.05, 30, (n, beams)).astype(np.float32),
         odometry=np.cumsum(rng.normal(0, 0.05, (n, 3)), axis=0), truth=np.cumsum(rng.normal(0, 0.05, (n, 3)), axis=0),
         stalled=np.zeros(n, dtype=bool),
-        laser={"angle_min": -0.75 * math.pi, "angle_increment": increment, "range_min": 0.02, "range_max": 30.0, "mount": [0.1, -0.02, 0.01]},
+        laser=LaserGeometry.from_dict({"angle_min": -0.75 * math.pi, "angle_increment": increment, "range_min": 0.02, "range_max": 30.0, "mount": [0.1, -0.02, 0.01]}),
         metadata={"world": "lab"},
     )
 
@@ -169,12 +170,12 @@ def test_run_export_and_import(tmp_path, kind):
     np.testing.assert_array_equal(back.truth, r6(record.truth))
     np.testing.assert_array_equal(back.odometry, r6(record.odometry))
     assert not back.stalled.any()
-    assert back.laser["mount"] == [0.1, -0.02, 0.01] and back.laser["range_min"] == 0.02 and back.laser["range_max"] == 30.0
+    assert back.laser.mount == (0.1, -0.02, 0.01) and back.laser.range_min == 0.02 and back.laser.range_max == 30.0
     if kind == "ROBOTLASER1":
-        assert (back.laser["angle_min"], back.laser["angle_increment"]) == (record.laser["angle_min"], record.laser["angle_increment"])
+        assert (back.laser.angle_min, back.laser.angle_increment) == (record.laser.angle_min, record.laser.angle_increment)
     else:
-        assert back.laser["angle_min"] == pytest.approx(record.laser["angle_min"], rel=1e-15)
-        assert back.laser["angle_increment"] == pytest.approx(record.laser["angle_increment"], rel=1e-15)
+        assert back.laser.angle_min == pytest.approx(record.laser.angle_min, rel=1e-15)
+        assert back.laser.angle_increment == pytest.approx(record.laser.angle_increment, rel=1e-15)
     assert back.metadata["truth_source"] == TRUTH_SOURCE and back.metadata["carmen_kind"] == kind
 
 
@@ -189,7 +190,7 @@ def test_export_writes_odometry_velocities(tmp_path):
 
 def test_flaser_export_refuses_an_off_centre_scan(tmp_path):
     record = _record(n=3, beams=5)
-    record.laser["angle_min"] = -0.1
+    record.laser = dataclasses.replace(record.laser, angle_min=-0.1)
     with pytest.raises(ValueError, match="centred"):
         write_carmen(tmp_path / "run.clf", carmen_from_run(record, kind="FLASER"))
 
@@ -279,20 +280,16 @@ ROBOT = "ROBOTLASER1 0 -1.5 3.0 1.5 30 0.01 0 3 1 2 3 {m} 0 0 0 1 1 1 0 0 0 0 0 
         (_flaser(3, 1.0) + "FLASER 3 1 2 1 2 0.5 1.1 2.1 0.6 2.0 host 3.0\n", 2, "needs 14 fields"),
         (_flaser(3, 1.0) + "FLASER\n", 2, "before num_readings"),
         ("FLASER x 1 2\n", 1, "num_readings"),
-        ("FLASER 0 1 2 0.5 1.1 2.1 0.6 2.0 host 3.0\n", 1, ">= 1"),
-        ("FLASER -3 1 2\n", 1, ">= 1"),
-        (_flaser(3, 1.0, "1 abc 3"), 1, "field 4 (range, pose or ipc_timestamp) is not a number: 'abc'"),
+        ("FLASER -3 1 2\n", 1, ">= 0"),
+        (_flaser(3, 1.0, "1 abc 3"), 1, "field 4 (range) is not a number: 'abc'"),
         (_flaser(3, 1.0, "1 nan 3"), 1, "range 2 is not finite"),
         (_flaser(3, 1.0, "1 1e400 3"), 1, "range 2 is not finite"),
         (_flaser(3, 1.0, "1 1e300 3"), 1, "too large for float32"),
         (_flaser(3, 1.0, "1 -2 3"), 1, "range 2 is negative"),
-        ("FLASER 1 1 1 2 inf 1.1 2.1 0.6 2.0 host 3.0\n", 1, "theta is not finite"),
+        ("FLASER 1 1 1 2 inf 1.1 2.1 0.6 2.0 host 3.0\n", 1, "every FLASER line has a non-finite pose"),
         ("FLASER 1 1 1 2 0 1 2 0 2.0 host x\n", 1, "logger_timestamp) is not a number"),
-        (_flaser(3, 1.0) + _flaser(4, 2.0), 2, "has 4 readings, earlier lines have 3"),
-        (_flaser(3, 2.0) + _flaser(3, 1.0), 2, "strictly increasing"),
-        (_flaser(3, 2.0) + _flaser(3, 2.0), 2, "strictly increasing"),
+        (_flaser(3, 1.0) + _flaser(4, 2.0), 2, "not on the angular grid of line 1"),
         (_flaser(3, 1.0) + ROBOT.format(m=0, t=2.0), 2, "ROBOTLASER1 line in a log of FLASER lines"),
-        (ROBOT.format(m=0, t=1.0) + ROBOT.format(m=0, t=2.0).replace(" 30 ", " 40 "), 2, "differ from line 1"),
         (ROBOT.format(m=2, t=1.0), 1, "needs 29 fields, got 27"),
         (ROBOT.format(m="x", t=1.0), 1, "num_remissions"),
         (ROBOT.format(m=0, t=1.0).replace(" 30 ", " 0 "), 1, "maximum_range must be positive"),
@@ -300,8 +297,6 @@ ROBOT = "ROBOTLASER1 0 -1.5 3.0 1.5 30 0.01 0 3 1 2 3 {m} 0 0 0 1 1 1 0 0 0 0 0 
         ("ROBOTLASER1 0 -1.5 3.0 1.5\n", 1, "before its readings"),
         ("ROBOTLASER1 0 -1.5 3.0 1.5 30 0.01 0 30 1 2 3\n", 1, "before num_remissions"),
         (_flaser(2, 1.0) + "ODOM 1 2 3 0 0 0 1.0 h\n", 2, "expected 10 fields"),
-        (_flaser(2, 1.0) + "ODOM 1 2 3 0 0 0 2.0 h 1\nODOM 1 2 3 0 0 0 1.0 h 1\n", 3, "non-decreasing"),
-        (_flaser(2, 1.0) + "ODOM 1 2 nan 0 0 0 1.0 h 1\n", 2, "ODOM theta is not finite"),
         (_flaser(2, 1.0) + "ODOM 1 2 0 fast 0 0 1.0 h 1\n", 2, "field 5 (tv) is not a number: 'fast'"),
         ("PARAM lonely\n" + _flaser(2, 1.0), 1, "PARAM name value"),
         ("PARAM laser_front_laser_fov wide\n" + _flaser(2, 1.0), 1, "positive number"),

@@ -16,7 +16,7 @@ import yaml
 from slamtrials.errors import ConfigError, FormatError
 from slamtrials.io.rosbag import bag_topics, run_from_bag, write_bag, write_rosbag1, write_rosbag2
 from slamtrials.io.runfolder import read_run, write_run
-from slamtrials.record import RunRecord
+from slamtrials.record import LaserGeometry, RunRecord
 from slamtrials.sim import SimConfig, simulate_waypoints
 from slamtrials.worlds import World
 
@@ -36,7 +36,7 @@ def small_run() -> RunRecord:
     """A fresh copy of a short simulated run that turns (yaw crosses quadrants) with an off-centre laser."""
     run = _simulated()
     return RunRecord(t=run.t.copy(), scans=run.scans.copy(), odometry=run.odometry.copy(), truth=run.truth.copy(),
-                     stalled=run.stalled.copy(), laser=dict(run.laser), metadata=dict(run.metadata))
+                     stalled=run.stalled.copy(), laser=run.laser, metadata=dict(run.metadata))
 
 
 def wrapped(angle):
@@ -70,7 +70,7 @@ def test_round_trip_is_exact(tmp_path, kind):
     assert back.metadata["truth_available"] is True
     assert back.metadata["ros_bag"]["ros"] == (1 if kind == "ros1" else 2)
     assert back.metadata["ros_bag"]["dropped_scans"] == 0
-    assert back.laser["mount"] == MOUNT
+    assert back.laser.mount == tuple(MOUNT)
 
 
 @pytest.mark.parametrize("kind", ["ros1", "ros2"])
@@ -218,10 +218,10 @@ def test_ros1_reader_sees_the_stage_layout(tmp_path):
         assert msg["header"]["frame_id"] == "base_laser_link"
         np.testing.assert_array_equal(np.array(msg["ranges"], dtype=np.float32), record.scans[k])
         assert msg["intensities"] == []
-        assert msg["angle_min"] == np.float32(laser["angle_min"])
-        assert msg["angle_increment"] == np.float32(laser["angle_increment"])
-        assert msg["angle_max"] == np.float32(laser["angle_min"] + (beams - 1) * laser["angle_increment"])
-        assert msg["range_min"] == np.float32(laser["range_min"]) and msg["range_max"] == np.float32(laser["range_max"])
+        assert msg["angle_min"] == np.float32(laser.angle_min)
+        assert msg["angle_increment"] == np.float32(laser.angle_increment)
+        assert msg["angle_max"] == np.float32(laser.angle_min + (beams - 1) * laser.angle_increment)
+        assert msg["range_min"] == np.float32(laser.range_min) and msg["range_max"] == np.float32(laser.range_max)
         assert msg["time_increment"] == 0.0 and msg["scan_time"] == np.float32(0.1)
 
     for topic, poses, frame in (("/odom", record.odometry, "odom"), ("/base_pose_ground_truth", record.truth, "map")):
@@ -325,8 +325,8 @@ def test_bag_written_by_ros1_itself_is_imported(tmp_path, use_tf):
     np.testing.assert_array_equal(run.scans, [[1.0 + 0.25 * kk + 0.125 * i for i in range(5)] for kk in k])
     # each scan lies halfway between two odometry messages
     np.testing.assert_allclose(run.odometry, np.column_stack([0.05 * (k + 0.5), -0.01 * (k + 0.5), 0.1 * (k + 0.5)]), atol=1e-12)
-    assert run.laser == {"angle_min": -1.0, "angle_increment": 0.5, "range_min": float(np.float32(0.05)),
-                         "range_max": 20.0, "mount": [0.25, 0.0, 0.0]}
+    assert run.laser == LaserGeometry(angle_min=-1.0, angle_increment=0.5, range_min=float(np.float32(0.05)),
+                                      range_max=20.0, mount=(0.25, 0.0, 0.0))
     assert np.isnan(run.truth).all() and run.metadata["ros_bag"]["ros_time_origin_ns"] == 1_600_000_000_050_000_000
 
 
@@ -403,8 +403,8 @@ def test_real_robot_bag_interpolates_odometry_and_has_no_truth(tmp_path, ros):
     np.testing.assert_allclose(wrapped(run.odometry[:, 2] - expected[:, 2]), 0, atol=1e-12)  # yaw crosses +-pi
     assert np.isnan(run.truth).all() and run.metadata["truth_available"] is False
     assert not run.stalled.any()
-    assert run.laser["angle_min"] == np.float32(-1.5) and run.laser["range_max"] == 10.0
-    assert run.laser["mount"][:2] == [0.2, 0.0] and abs(abs(run.laser["mount"][2]) - np.pi) < 1e-12
+    assert run.laser.angle_min == np.float32(-1.5) and run.laser.range_max == 10.0
+    assert run.laser.mount[:2] == (0.2, 0.0) and abs(abs(run.laser.mount[2]) - np.pi) < 1e-12
     assert run.metadata["ros_bag"]["ros_time_origin_ns"] == made["scan_stamps"][0]
     # the run folder keeps the NaN ground truth as it is
     back = read_run(write_run(tmp_path / "folder", run))
@@ -416,7 +416,7 @@ def test_previous_pairing_takes_the_latest_odometry_at_or_before(tmp_path):
     made = _robot_bag(tmp_path / "robot.bag", ros=1, with_mount=False)
     run = run_from_bag(tmp_path / "robot.bag", scan_topic="/scan", truth_topic=None, pairing="previous")
     np.testing.assert_array_equal(run.odometry, made["odom"][::5][:20])
-    assert run.laser["mount"] == [0.0, 0.0, 0.0] and "assumed zero" in run.metadata["ros_bag"]["laser_mount"]
+    assert run.laser.mount == (0.0, 0.0, 0.0) and "assumed zero" in run.metadata["ros_bag"]["laser_mount"]
 
 
 def test_scans_outside_the_odometry_are_dropped(tmp_path):

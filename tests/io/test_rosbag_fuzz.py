@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 
 from slamtrials.errors import FormatError
 from slamtrials.io.rosbag import run_from_bag, write_rosbag1, write_rosbag2
-from slamtrials.record import RunRecord
+from slamtrials.record import LaserGeometry, RunRecord
 
 FUZZ = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
@@ -30,7 +30,7 @@ def _record() -> RunRecord:
         odometry=np.cumsum(rng.normal(0, 0.1, (n, 3)), axis=0),
         truth=np.cumsum(rng.normal(0, 0.1, (n, 3)), axis=0),
         stalled=rng.random(n) < 0.3,
-        laser={"angle_min": -1.0, "angle_increment": 0.1, "range_min": 0.0, "range_max": 30.0, "mount": [0.1, 0.0, 0.2]},
+        laser=LaserGeometry.from_dict({"angle_min": -1.0, "angle_increment": 0.1, "range_min": 0.0, "range_max": 30.0, "mount": [0.1, 0.0, 0.2]}),
         metadata={"seed": 7, "sim_config": {"dt": 0.1}},
     )
 

@@ -8,10 +8,12 @@ import numpy as np
 import pytest
 
 from slamtrials.errors import FormatError
-from slamtrials.io.runfolder import FRAMES_FILE, RUN_FILE, read_run, write_run
-from slamtrials.record import RunRecord
+from slamtrials.io.runfolder import RUN_FORMAT, RunFolder, read_run, write_run
 
-LASER = {"angle_min": -2.356, "angle_increment": 0.0087, "range_min": 0.0, "range_max": 30.0, "mount": [0.1, 0.0, 0.0]}
+FRAMES_FILE, RUN_FILE = RunFolder.FRAMES, RunFolder.RUN
+from slamtrials.record import LaserGeometry, RunRecord
+
+LASER = LaserGeometry.from_dict({"angle_min": -2.356, "angle_increment": 0.0087, "range_min": 0.0, "range_max": 30.0, "mount": [0.1, 0.0, 0.0]})
 
 
 def _record(n: int = 20, beams: int = 11, seed: int = 0) -> RunRecord:
@@ -108,3 +110,15 @@ def test_flipped_bytes_inside_frames_are_a_format_error(tmp_path):
     (tmp_path / FRAMES_FILE).write_bytes(bytes(data))
     with pytest.raises(FormatError, match="frames.npz"):
         read_run(tmp_path)
+
+
+def test_a_run_folder_of_format_version_1_still_reads(tmp_path):
+    record = _record()
+    write_run(tmp_path, record)
+    doc = json.loads((tmp_path / RUN_FILE).read_text())
+    assert doc["format"] == RUN_FORMAT == "slamtrials-run/2"
+    doc["format"] = "slamtrials-run/1"
+    (tmp_path / RUN_FILE).write_text(json.dumps(doc))
+    back = read_run(tmp_path)
+    assert back.laser == record.laser and np.array_equal(back.scans, record.scans)
+    assert RunFolder(tmp_path).is_complete() and RunFolder(tmp_path).frames == tmp_path / "frames.npz"

@@ -3,6 +3,8 @@ is a FormatError naming the file and a line (or byte offset) inside it; whatever
 
 from __future__ import annotations
 
+import bz2
+import gzip
 import math
 from collections.abc import Callable
 from pathlib import Path
@@ -14,6 +16,8 @@ from hypothesis import strategies as st
 
 from slamtrials.errors import FormatError
 from slamtrials.io.carmen import CarmenLog, read_carmen
+from slamtrials.io.carmen_read import TOLERATED
+from slamtrials.io.compressed import read_maybe_compressed
 from slamtrials.io.relations import read_relations
 from slamtrials.io.tum import read_tum
 from slamtrials.record import Relations, Trajectory
@@ -32,6 +36,21 @@ ROBOTLASER_LOG = (
     "ROBOTLASER1 0 -1.5708 3.1416 1.0472 30.0 0.01 0 4 1.0 2.0 3.0 4.0 1 0.5 1 2 0.1 1 2 0.1 0 0 0 0 0 5.0 host 0.1\n"
     "ODOM 1 2 0.1 0 0 0 5.05 host 0.15\n"
     "ROBOTLASER1 0 -1.5708 3.1416 1.0472 30.0 0.01 0 4 1.5 2.5 3.5 4.5 0 1.1 2 0.2 1.1 2 0.2 0.1 0 0 0 0 5.1 host 0.2\n"
+)
+POSE_ONLY_LOG = (  # a Freiburg-evaluator test log: laser lines without readings, odd PARAMs, nan, time going back
+    "PARAM robot_frontlaser_offset 0.0 nohost 0\n"
+    "FLASER 0 1.0 2.0 0.1 1.0 2.0 0.1 100.1 h 0.1\n"
+    "FLASER 0 1.1 2.0 0.1 1.1 2.0 0.1 100.3 h 0.3\n"
+    "FLASER 0 1.05 2.0 0.1 1.05 2.0 0.1 100.2 h 0.2\n"
+    "FLASER 0 nan 2.0 0.1 1.1 2.0 0.1 100.4 h 0.4\n"
+    "FLASER 0 1.2 2.0 0.1 1.2 2.0 0.1 100.5 h"
+)
+CHANGING_LOG = (  # ROBOTLASER1 beam counts changing on one grid, ODOM lines between
+    "ROBOTLASER1 0 -0.5 1.0 0.25 30.0 0.01 0 5 1 2 3 4 5 0 1 2 0.1 1 2 0.1 0 0 0 0 0 5.0 host 0.1\n"
+    "ODOM 1 2 0.1 0 0 0 5.05 host 0.15\n"
+    "ROBOTLASER1 0 -0.25 0.5 0.25 40.0 0.01 0 3 7 8 9 0 1.1 2 0.2 1.1 2 0.2 0.1 0 0 0 0 5.1 host 0.2\n"
+    "ODOM 1 2 0.1 0 0 0 5.02 host 0.15\n"
+    "ROBOTLASER1 0 -0.5 1.25 0.25 30.0 0.01 0 6 1 2 3 4 5 6 0 1.2 2 0.2 1.2 2 0.2 0.1 0 0 0 0 5.2 host 0.3\n"
 )
 TUM_FILE = "# t x y z qx qy qz qw\n1.0 0.5 -0.5 0.0 0.0 0.0 0.3826834323650898 0.9238795325112867\n1.1 0.6 -0.4 0.0 0.0 0.0 0.0 1.0\n"
 RELATIONS_FILE = "1134864645.90321 1134864646.32420 0.31293 0.02935 0.00000  0.00000 0.00000 0.24198\n1 2 0.1 0.2 0 0 0 -0.1\n"
@@ -91,6 +110,8 @@ def _sane_carmen(log: CarmenLog) -> None:
     assert np.all(np.diff(laser.t) > 0) and np.isfinite(laser.pose).all() and np.isfinite(laser.odometry).all()
     assert math.isfinite(laser.angle_min) and math.isfinite(laser.angle_increment) and laser.range_max >= 0
     assert np.all(np.diff(log.odom.t) >= 0) and np.isfinite(log.odom.pose).all()
+    assert set(log.tolerated) <= set(TOLERATED) and all(count > 0 for count in log.tolerated.values())
+    assert laser.line_readings is not None and laser.line_readings.shape == (len(laser),)
 
 
 def _sane_tum(trajectory: Trajectory) -> None:
@@ -102,8 +123,19 @@ def _sane_relations(relations: Relations) -> None:
     assert len(relations) > 0 and np.isfinite(relations.delta).all() and np.isfinite(relations.t1).all()
 
 
+def _read_carmen_poses(path: Path) -> CarmenLog:
+    return read_carmen(path, ranges=False)
+
+
+def _sane_carmen_poses(log: CarmenLog) -> None:
+    assert log.laser.ranges.shape == (len(log.laser), 0)
+    _sane_carmen(log)
+
+
+CARMEN_SEEDS = [FLASER_LOG, ROBOTLASER_LOG, POSE_ONLY_LOG, CHANGING_LOG]
 READERS: dict[str, tuple[Callable, Callable, list[str]]] = {
-    "carmen": (read_carmen, _sane_carmen, [FLASER_LOG, ROBOTLASER_LOG]),
+    "carmen": (read_carmen, _sane_carmen, CARMEN_SEEDS),
+    "carmen_poses": (_read_carmen_poses, _sane_carmen_poses, CARMEN_SEEDS),
     "tum": (read_tum, _sane_tum, [TUM_FILE]),
     "relations": (read_relations, _sane_relations, [RELATIONS_FILE]),
 }
@@ -123,7 +155,8 @@ def _only_format_errors(name: str, path: Path, data: bytes) -> None:
         assert exc.path == path and str(path) in str(exc)
         assert exc.line is not None or exc.offset is not None, str(exc)
         if exc.line is not None:
-            assert 1 <= exc.line <= data.count(b"\n") + 1, str(exc)
+            text = read_maybe_compressed(path)  # line numbers count the decompressed text's lines
+            assert 1 <= exc.line <= text.count(b"\n") + 1, str(exc)
             assert f"{path}:{exc.line}:" in str(exc)
     else:
         sane(result)
@@ -174,7 +207,7 @@ def test_extreme_numbers_in_every_field(folder, name, value):
         lines = seed.split("\n")
         for row, line in enumerate(lines):
             tokens = line.split()
-            for at in range(1 if name == "carmen" else 0, len(tokens)):
+            for at in range(1 if name.startswith("carmen") else 0, len(tokens)):
                 edited = list(lines)
                 edited[row] = " ".join(tokens[:at] + [value] + tokens[at + 1 :])
                 _only_format_errors(name, folder / f"extreme-{name}-{s}", "\n".join(edited).encode())
@@ -187,3 +220,18 @@ def test_empty_file(folder, name):
     with pytest.raises(FormatError) as info:
         READERS[name][0](path)
     assert info.value.line == 1
+
+
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize("compress", [gzip.compress, bz2.compress])
+@settings(max_examples=100, deadline=None)
+@given(data=st.data())
+def test_mutated_compressed_logs_raise_only_format_errors(folder, compress, data):
+    """A compressed log with edited, inserted or cut bytes: a FormatError (line or byte offset), or a sane log."""
+    seed = data.draw(st.sampled_from(CARMEN_SEEDS))
+    packed = compress(seed.encode())
+    edits = data.draw(st.lists(st.tuples(st.integers(min_value=0, max_value=len(packed) - 1), st.integers(0, 255)), max_size=3))
+    for at, value in edits:
+        packed = packed[:at] + bytes([value]) + packed[at + 1 :]
+    cut = data.draw(st.integers(min_value=0, max_value=len(packed)))
+    _only_format_errors("carmen", folder / f"packed-{compress.__module__}", packed[:cut])

@@ -6,10 +6,18 @@ import math
 
 import numpy as np
 import pytest
+from pydantic import ValidationError
 
 from slamtrials.errors import MetricError
 from slamtrials.geometry import compose
-from slamtrials.metric import critical_value, draw_pairs, evaluate_relations, sample_relations, sample_size
+from slamtrials.metric import (
+    SamplingRule,
+    critical_value,
+    draw_pairs,
+    evaluate_relations,
+    sample_relations,
+    sample_size,
+)
 from slamtrials.metric.kernels import relative_poses
 from slamtrials.metric.relerrors import relative_pose_errors
 from slamtrials.record import Trajectory
@@ -81,21 +89,21 @@ def test_sampling_follows_the_rule_and_is_seeded():
 
 def test_sampling_options_cap_and_bad_input():
     truth, estimate = _drive(300, seed=2)
-    capped = sample_relations(truth, estimate, rng=0, margin_t=1e-4, max_relations=1000)
+    capped = sample_relations(truth, estimate, rng=0, rule=SamplingRule(margin_t=1e-4, max_relations=1000))
     assert capped.capped and capped.count == 1000
     perfect = sample_relations(truth, truth, rng=0)
     assert perfect.count == 2 and perfect.needed_t == 0 and np.allclose(perfect.errors.translational, 0.0, atol=1e-12)
-    t_based = sample_relations(truth, estimate, rng=0, distribution="t", sides=1, confidence=0.99)
+    t_based = sample_relations(truth, estimate, rng=0, rule=SamplingRule(distribution="t", sides=1, confidence=0.99))
     assert t_based.critical == pytest.approx(2.334, abs=1e-3)
-    squared = sample_relations(truth, estimate, rng=0, squared=True, margin_t=1e-3, margin_r=1e-3)
+    squared = sample_relations(truth, estimate, rng=0, rule=SamplingRule(squared=True, margin_t=1e-3, margin_r=1e-3))
     assert squared.errors.squared
     far = Trajectory(t=truth.t + 1000.0, poses=truth.poses)
     with pytest.raises(MetricError, match="covers 0 of the 300"):
         sample_relations(truth, far, rng=0)
-    with pytest.raises(MetricError, match="pilot"):
-        sample_relations(truth, estimate, rng=0, pilot=1)
-    with pytest.raises(MetricError, match="min_relations"):
-        sample_relations(truth, estimate, rng=0, min_relations=10, max_relations=5)
+    with pytest.raises(ValidationError, match="pilot"):
+        SamplingRule(pilot=1)
+    with pytest.raises(ValidationError, match="min_relations"):
+        SamplingRule(min_relations=10, max_relations=5)
 
 
 @pytest.mark.parametrize(("confidence", "binding"), [(0.99, "t"), (0.95, "t"), (0.99, "r")])
@@ -116,7 +124,7 @@ def test_sampled_mean_falls_within_the_margin_at_the_stated_confidence(confidenc
     margins = {"margin_t": margin, "margin_r": 10.0} if binding == "t" else {"margin_t": 100.0, "margin_r": margin}
     means, counts = [], []
     for seed in range(400):
-        sampled = sample_relations(truth, estimate, rng=seed, confidence=confidence, **margins)
+        sampled = sample_relations(truth, estimate, rng=seed, rule=SamplingRule(confidence=confidence, **margins))
         errors = sampled.errors.translational if binding == "t" else sampled.errors.rotational
         means.append(errors.mean())
         counts.append(sampled.count)

@@ -14,6 +14,7 @@ from matplotlib.figure import Figure
 from scipy import stats
 
 from slamtrials.geometry import compose
+from slamtrials.metric.rule import SamplingRule
 from slamtrials.metric.sampling import sample_relations
 from slamtrials.metric.stats import environment_stats
 from slamtrials.record import OccupancyGrid, Trajectory
@@ -124,7 +125,7 @@ def _run_trajectories() -> tuple[Trajectory, Trajectory]:
 
 def test_repeated_sampling_means_uses_spawned_seeds() -> None:
     truth, estimate = _run_trajectories()
-    options = {"pilot": 100, "margin_t": 0.01}
+    options = {"rule": SamplingRule(pilot=100, margin_t=0.01)}
     means = cf.repeated_sampling_means(truth, estimate, 12, 7, **options)
     assert means.shape == (12,) and np.isfinite(means).all() and np.unique(means).size == 12
     children = np.random.SeedSequence(7).spawn(12)

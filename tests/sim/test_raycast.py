@@ -51,9 +51,9 @@ def test_laser_geometry_of_the_paper():
     assert angles[0] == pytest.approx(-math.radians(135.0), abs=1e-12)
     assert angles[-1] == pytest.approx(math.radians(135.0), abs=1e-12)
     assert np.allclose(np.diff(angles), math.radians(0.5), atol=1e-12)
-    info = cfg.laser_info()
-    assert set(info) == {"angle_min", "angle_increment", "range_min", "range_max", "mount"}
-    assert info["range_max"] == 30.0 and info["mount"] == [0.0, 0.0, 0.0]
+    info = cfg.geometry()
+    assert (info.angle_min, info.angle_increment) == (cfg.angle_min, cfg.angle_increment)
+    assert info.range_max == 30.0 and info.mount == (0.0, 0.0, 0.0)
 
 
 @pytest.mark.parametrize("origin", [(0.0, 0.0, 0.0), (-3.0, 2.0, 0.0)])

@@ -30,7 +30,7 @@ COMMANDS = [(0.5, 0.2)] * 30 + [(0.7, -0.4)] * 30 + [(0.0, 1.0)] * 10 + [(0.4, 0
 def run(seed, config: SimConfig | None = None, commands=COMMANDS) -> RunRecord:
     sim = Simulator(room_world(), config or SimConfig(), np.random.default_rng(seed))
     frames = [sim.observe()] + [sim.step(c) for c in commands]
-    return RunRecord.from_frames(frames, sim.laser_info, sim.metadata)
+    return RunRecord.from_frames(frames, sim.laser, sim.metadata)
 
 
 def test_first_frame():
@@ -89,10 +89,10 @@ def test_metadata_and_laser_info():
     assert set(meta["bias"]) == {"linear", "angular"}
     assert abs(meta["bias"]["linear"]) <= 0.005 and abs(meta["bias"]["angular"]) <= math.radians(1)
     assert SimConfig.model_validate(meta["sim_config"]) == sim.config
-    info = sim.laser_info
-    assert info["angle_min"] == pytest.approx(-math.radians(135))
-    assert info["angle_increment"] == pytest.approx(math.radians(0.5))
-    assert info["range_max"] == 30.0 and info["range_min"] == 0.0
+    info = sim.laser
+    assert info.angle_min == pytest.approx(-math.radians(135))
+    assert info.angle_increment == pytest.approx(math.radians(0.5))
+    assert info.range_max == 30.0 and info.range_min == 0.0
 
 
 def test_accessors_return_copies():

@@ -10,7 +10,7 @@ from pydantic import BaseModel, Field
 
 import slamtrials.slam.base as base
 from slamtrials.errors import ConfigError
-from slamtrials.record import Frame, RunRecord, Trajectory
+from slamtrials.record import Frame, LaserGeometry, RunRecord, Trajectory
 from slamtrials.slam import (
     ALGORITHMS,
     OccupancyGrid,
@@ -22,7 +22,7 @@ from slamtrials.slam import (
 )
 from slamtrials.slamrun import run_slam
 
-LASER = {"angle_min": -1.0, "angle_increment": 0.5, "range_min": 0.0, "range_max": 10.0, "mount": [0.0, 0.0, 0.0]}
+LASER = LaserGeometry.from_dict({"angle_min": -1.0, "angle_increment": 0.5, "range_min": 0.0, "range_max": 10.0, "mount": [0.0, 0.0, 0.0]})
 
 
 class ShiftedOdometry:

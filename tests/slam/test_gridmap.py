@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from slamtrials.slam.gridmap import GridMap, beam_endpoints
+from slamtrials.record import LaserGeometry
 
 RES = 0.05
 HALF = 2.025  # walls through cell centres (cells are anchored at the origin), so no endpoint lies on a cell edge
@@ -94,8 +95,8 @@ def test_growing_keeps_world_coordinates():
 
 def test_mount_and_pose_are_applied():
     ranges, angles = _room_scan(720)
-    laser = {"angle_min": float(angles[0]), "angle_increment": float(angles[1] - angles[0]), "range_min": 0.0,
-             "range_max": 30.0, "mount": [0.3, 0.0, 0.0]}
+    laser = LaserGeometry.from_dict({"angle_min": float(angles[0]), "angle_increment": float(angles[1] - angles[0]), "range_min": 0.0,
+             "range_max": 30.0, "mount": [0.3, 0.0, 0.0]})
     gmap = GridMap(RES)
     # the base at (LASER_XY - (0, 0.3)) facing +y puts the laser at LASER_XY, turned by pi/2
     gmap.integrate_frame([LASER_XY[0], LASER_XY[1] - 0.3, np.pi / 2], np.roll(ranges, -180), laser)

@@ -9,7 +9,7 @@ from slamtrials.errors import ConfigError
 from slamtrials.geometry import compose, inverse
 from slamtrials.io.runfolder import read_run, write_run
 from slamtrials.record import OCCUPIED, UNKNOWN
-from slamtrials.trial import TrialConfig, run_trial
+from slamtrials.trial import TrialConfig, TrialSummary, run_trial
 from slamtrials.trial.coverage import mapped_fraction
 from slamtrials.worlds import World
 
@@ -113,8 +113,29 @@ def test_the_run_folder_keeps_estimate_and_map(record, tmp_path):
     back = read_run(tmp_path / "run")
     assert np.array_equal(back.estimate, record.estimate)
     assert np.array_equal(back.map.grid, record.map.grid)
-    assert back.metadata["trial"]["termination_reason"] == record.metadata["trial"]["termination_reason"]
+    summary = TrialSummary.of(back)
+    assert summary == TrialSummary.of(record) and summary.termination_reason in ("no_frontiers", "map_converged")
+    assert back.metadata["trial"] == summary.to_dict()  # run.json keeps the summary's JSON form
+    assert 0.0 < summary.mapped_fraction <= 1.0 and summary.slam_updates > 0 and summary.duration_s > 0.0
     assert (tmp_path / "run" / "estimate.tum").is_file() and (tmp_path / "run" / "map.png").is_file()
+
+
+def test_slam_over_the_run_folder_with_the_trial_seed_gives_the_trial_estimate(record, tmp_path):
+    from typer.testing import CliRunner
+
+    from slamtrials.cli.main import app
+    from slamtrials.io.tum import read_tum
+
+    write_run(tmp_path / "run", record)
+    runner = CliRunner()
+    args = ["slam", "--algorithm", "gmapping", "--preset", "paper", "--input", str(tmp_path / "run")]
+    same = runner.invoke(app, [*args, "--seed", "4", "--out", str(tmp_path / "s4")])
+    assert same.exit_code == 0, same.output
+    assert (tmp_path / "s4" / "trajectory.tum").read_bytes() == (tmp_path / "run" / "estimate.tum").read_bytes()
+    assert np.array_equal(read_tum(tmp_path / "s4" / "trajectory.tum").poses[:, :2], record.estimate[:, :2])
+    other = runner.invoke(app, [*args, "--seed", "5", "--out", str(tmp_path / "s5")])
+    assert other.exit_code == 0, other.output
+    assert (tmp_path / "s5" / "trajectory.tum").read_bytes() != (tmp_path / "run" / "estimate.tum").read_bytes()
 
 
 def test_bad_input_is_a_config_error(world):

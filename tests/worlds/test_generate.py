@@ -227,6 +227,23 @@ def test_start_pose_is_in_a_corridor_near_the_centre():
     assert w.start[2] in (0.0, pytest.approx(np.pi / 2))
 
 
+def test_start_pose_ties_are_broken_by_a_fixed_rule():
+    """A hall whose centre falls half-way between four sampled cells: the tie goes to the cell nearest the centre at
+    full resolution, then to the first in row-major order; never to whichever one a sort puts first (numpy's
+    default sort orders equal keys differently on AVX-512 CPUs)."""
+    from slamtrials.worlds.generate.build import _start_pose
+    from slamtrials.worlds.generate.raster import CIRCULATION, Grid
+
+    grid = Grid(rows=84, cols=84, resolution=0.05, margin=1.0)
+    labels = np.zeros((84, 84), dtype=np.int32)
+    labels[4:81, 3:83] = CIRCULATION  # sampled every 4th cell: centre (10.5, 10.5), ties at rows 10/11 and cols 10/11
+    # full resolution: rows 40 and 44 are as near the centre row 42 (row-major picks 40), column 44 is nearer than
+    # 40 to the centre column 42.5
+    start = _start_pose(labels == 0, labels, grid)
+    assert start is not None
+    np.testing.assert_array_equal(start, [*grid.cell_centre(40, 44), 0.0])
+
+
 def test_metadata_describes_the_world():
     w = world("lab", 300, 4)
     meta = w.metadata

@@ -12,6 +12,7 @@ name the file, the field path and the bad value. ``slamtrials config dump`` prin
 
 from __future__ import annotations
 
+import copy
 import hashlib
 import json
 from pathlib import Path
@@ -21,8 +22,10 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from slamtrials.errors import ConfigError, FormatError, validation_problems
 from slamtrials.explore import ExploreConfig, TerminationConfig
+from slamtrials.explore.config import ROBOT_FIELDS
 from slamtrials.metric.runcount import DEFAULT_MIN_RUNS
-from slamtrials.metric.sampling import DEFAULT_CONFIDENCE, DEFAULT_MARGIN_R, DEFAULT_MARGIN_T, DEFAULT_PILOT
+from slamtrials.metric.matching import RUN_TOLERANCE
+from slamtrials.metric.rule import SamplingRule
 from slamtrials.sim import SimConfig
 from slamtrials.trial import SlamSettings, TrialConfig
 
@@ -32,28 +35,24 @@ _MODEL_CONFIG = ConfigDict(extra="forbid", frozen=True)
 
 #: Default cap on the runs of one world.
 DEFAULT_MAX_RUNS = 60
-#: Matching tolerance (s) of a run's estimate to its ground truth: they share the simulator's clock, so
-#: only the same frame's pose is taken directly (as ``slamtrials evaluate RUN`` does).
-RUN_TOLERANCE = 0.001
 #: Largest root seed (seeds are stored as SQLite 64-bit signed integers).
 MAX_SEED = 2**63 - 1
 
 
-class MetricSettings(BaseModel):
-    """Relation sampling of each run (IROS 2018 rule): pilot, then ``N = ceil(z^2 s^2 / d^2)`` relations.
+class MetricSettings(SamplingRule):
+    """Relation sampling of each run: the :class:`~slamtrials.metric.rule.SamplingRule` (IROS 2018 rule:
+    pilot, then ``N = ceil(z^2 s^2 / d^2)`` relations) and the matching tolerance.
 
     A run's ``eps_t`` and ``eps_r`` are the mean translational (m) and rotational (rad) errors of its
     estimate over the sampled relations (:func:`slamtrials.metric.sample_relations`).
     """
 
-    model_config = _MODEL_CONFIG
-
-    confidence: float = Field(DEFAULT_CONFIDENCE, gt=0.0, lt=1.0, description="confidence level of a run's relation sampling")
-    margin_t: float = Field(DEFAULT_MARGIN_T, gt=0.0, le=100.0, description="margin of error of a run's mean translational error (m)")
-    margin_r: float = Field(DEFAULT_MARGIN_R, gt=0.0, le=3.2, description="margin of error of a run's mean rotational error (rad)")
-    pilot: int = Field(DEFAULT_PILOT, ge=2, le=1_000_000, description="pairs of the pilot sample that estimates the error spread")
-    distribution: Literal["normal", "t"] = Field("normal", description="quantile of the confidence level: normal or t")
     tolerance: float = Field(RUN_TOLERANCE, gt=0.0, le=10.0, description="matching tolerance of estimate to ground-truth timestamps (s)")
+
+    @property
+    def rule(self) -> SamplingRule:
+        """The sampling rule alone (without the matching tolerance)."""
+        return SamplingRule(**self.model_dump(exclude={"tolerance"}))
 
 
 class RunSettings(BaseModel):
@@ -88,6 +87,16 @@ def _beside(folder: Path, entry: Any) -> Any:
         return entry
     candidate = folder / entry
     return str(candidate.resolve()) if candidate.exists() else entry
+
+
+def upgrade_stored_config(doc: dict[str, Any]) -> dict[str, Any]:
+    """A stored campaign config's JSON form, as this version writes it (a copy; ``doc`` is not changed)."""
+    doc = copy.deepcopy(doc)
+    explore = doc.get("explore")
+    if isinstance(explore, dict):
+        for name in ROBOT_FIELDS:
+            explore.pop(name, None)
+    return doc
 
 
 class CampaignConfig(BaseModel):
@@ -146,6 +155,15 @@ class CampaignConfig(BaseModel):
         """SHA-256 (hex) of :meth:`identity`, canonical JSON: a stored campaign only resumes with an equal one."""
         text = json.dumps(self.identity(), sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+    @classmethod
+    def from_stored(cls, doc: dict[str, Any]) -> "CampaignConfig":
+        """The config of a stored campaign (its JSON form), written by this or an earlier version.
+
+        Campaigns stored before the explore section lost its robot fields (:data:`ROBOT_FIELDS`) carry
+        them; those versions replaced them by ``sim.robot``'s values anyway, so they are dropped.
+        """
+        return cls.model_validate(upgrade_stored_config(doc))
 
     @classmethod
     def from_dict(cls, data: Any, *, source: str = "campaign config") -> "CampaignConfig":

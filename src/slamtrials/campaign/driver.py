@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from slamtrials.campaign.events import CampaignEvent
+from slamtrials.campaign.results import RunDone, RunFailed, RunResult
 from slamtrials.campaign.store import CampaignStore, WorldInfo
 from slamtrials.metric.runcount import RunCount
 
@@ -125,21 +126,21 @@ def drive(store: CampaignStore, client: Any, worlds: Sequence[WorldInfo], planne
         name, index = futures.pop(future)
         in_flight[name].discard(index)
         try:
-            result = future.result()
+            result: RunResult = future.result()
         except Exception as exc:  # lost after its retries, or a bug: recorded, the other worlds go on
-            result = {"status": "failed", "error": f"{type(exc).__name__}: {exc}"}
+            result = RunFailed(world=name, index=index, error=f"{type(exc).__name__}: {exc}")
         finally:
             future.release()
         world = by_name[name]
-        if result.get("status") == "done":
+        if isinstance(result, RunDone):
             store.record_done(name, index, result)
             counts.done += 1
             results = store.done_results(name)
-            emit(CampaignEvent("run_done", name, targets[name], len(results), index=index, eps_t=result["eps_t"], eps_r=result["eps_r"]))
+            emit(CampaignEvent("run_done", name, targets[name], len(results), index=index, eps_t=result.eps_t, eps_r=result.eps_r))
         else:
-            error = str(result.get("error", "unknown error"))
+            error = result.error
             log.warning("%s run %d failed: %s", name, index, error)
-            store.record_failed(name, index, error, worker=result.get("worker"))
+            store.record_failed(name, index, error, worker=result.worker)
             counts.failed += 1
             failed.setdefault(name, f"run {index} failed: {error}")
             results = store.done_results(name)

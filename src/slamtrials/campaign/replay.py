@@ -23,7 +23,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 
 from slamtrials.campaign.cluster import check_workers, dask_client
 from slamtrials.campaign.config import CampaignConfig, MetricSettings
@@ -32,13 +31,15 @@ from slamtrials.campaign.events import REPLAY_NOTE, CampaignEvent, CampaignResul
 from slamtrials.campaign.execute import result_notes
 from slamtrials.campaign.folder import campaign_lock, check_campaign_folder, open_campaign, prepare_resume
 from slamtrials.campaign.loop import next_step
+from slamtrials.campaign.results import RunResult
 from slamtrials.campaign.runfiles import publish_run
 from slamtrials.campaign.score import score_run
 from slamtrials.campaign.store import CampaignStore, WorldInfo
 from slamtrials.campaign.summary import summarize_store, write_summary_csv
 from slamtrials.campaign.task import failure, outcome, write_scored_run
 from slamtrials.errors import ConfigError, SlamtrialsError
-from slamtrials.record import Frame, RunRecord
+from slamtrials.record import RunRecord
+from slamtrials.slam.offline import run_over_recording
 from slamtrials.trial import SlamSettings
 
 __all__ = ["replay_campaign", "ReplayTask", "replay_one", "replay_slam"]
@@ -75,36 +76,25 @@ class ReplayTask:
 
 
 def replay_slam(record: RunRecord, slam: SlamSettings, seed: int) -> RunRecord:
-    """Run ``slam`` over every frame of ``record``; return the record with the new ``estimate`` and ``map``.
+    """``record`` with the estimate and map of ``slam`` run over its frames with the run's ``seed``.
 
-    The algorithm's random stream is the second child of ``SeedSequence(seed)``, as in
-    :func:`slamtrials.trial.run_trial`.
+    The algorithm runs through :func:`slamtrials.slam.offline.run_over_recording`, seeded as in
+    :func:`slamtrials.trial.run_trial` (:mod:`slamtrials.seeding`).
 
     Raises
     ------
     ConfigError
         A bad configuration, or an algorithm whose trajectory does not hold one pose per frame.
     """
-    from slamtrials.slam import get_algorithm
-
-    config = slam.resolved()
-    algorithm = get_algorithm(slam.algorithm)(config, dict(record.laser))
-    sequence = np.random.SeedSequence(int(seed))
-    _, slam_seed = sequence.spawn(2)
-    algorithm.reset(np.random.default_rng(slam_seed))
-    for k in range(len(record)):
-        algorithm.process(Frame(t=float(record.t[k]), ranges=record.scans[k], odometry=record.odometry[k],
-                                truth=record.truth[k], stalled=bool(record.stalled[k])))
-    trajectory = algorithm.trajectory()
-    if len(trajectory) != len(record) or not np.array_equal(trajectory.t, record.t):
-        raise ConfigError(f"SLAM algorithm {slam.algorithm!r} returned {len(trajectory)} poses for {len(record)} frames")
+    result = run_over_recording(record, slam.algorithm, preset=slam.preset, overrides=slam.params, seed=seed)
+    estimate = result.estimate_per_frame(record)
     metadata = dict(record.metadata)
-    metadata["slam_config"] = config.model_dump(mode="json")
+    metadata["slam_config"] = result.config.model_dump(mode="json")
     return RunRecord(t=record.t, scans=record.scans, odometry=record.odometry, truth=record.truth, stalled=record.stalled,
-                     laser=record.laser, metadata=metadata, estimate=trajectory.poses, map=algorithm.occupancy())
+                     laser=record.laser, metadata=metadata, estimate=estimate, map=result.occupancy)
 
 
-def replay_one(task: ReplayTask) -> dict[str, Any]:
+def replay_one(task: ReplayTask) -> RunResult:
     """Re-evaluate one recorded run (see the module docstring); return what the driver records."""
     from slamtrials.io.runfolder import read_run
 
@@ -155,14 +145,14 @@ class ReplayPlanner:
 
 def _recorded_runs(store: CampaignStore) -> dict[str, dict[int, tuple[int, str]]]:
     """``{world: {index: (seed, folder)}}`` of the source's done runs, each checked to be complete."""
-    from slamtrials.io.runfolder import RUN_FILE
+    from slamtrials.io.layout import RunFolder
 
     recorded: dict[str, dict[int, tuple[int, str]]] = {w.name: {} for w in store.worlds()}
     for run in store.runs():
         if run.status != "done":
             continue
         folder = run.folder or f"runs/{run.world}/{run.idx:03d}"
-        if not (store.folder / folder / RUN_FILE).is_file():
+        if not RunFolder(store.folder / folder).is_complete():
             raise ConfigError(f"{store.folder / folder}: recorded run {run.world} #{run.idx} is missing its run folder")
         recorded[run.world][run.idx] = (run.seed, folder)
     return recorded

@@ -51,8 +51,6 @@ def score_run(record: RunRecord, seed: int, metric: MetricSettings) -> RunScore:
     truth = Trajectory(t=record.t, poses=record.truth)
     estimate = Trajectory(t=record.t, poses=np.asarray(record.estimate, dtype=np.float64))
     odometry = Trajectory(t=record.t, poses=record.odometry)
-    sampled = sample_relations(truth, estimate, rng=int(seed), pilot=metric.pilot, confidence=metric.confidence,
-                               margin_t=metric.margin_t, margin_r=metric.margin_r, distribution=metric.distribution,
-                               tolerance=metric.tolerance, odometry=odometry)
+    sampled = sample_relations(truth, estimate, rng=int(seed), rule=metric.rule, tolerance=metric.tolerance, odometry=odometry)
     errors = sampled.errors
     return RunScore(float(np.mean(errors.translational)), float(np.mean(errors.rotational)), sampled)

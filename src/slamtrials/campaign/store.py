@@ -33,13 +33,16 @@ import sqlite3
 import time
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass, fields
+from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 from typing import Any
+
+from pydantic import ValidationError
 
 from slamtrials.__about__ import __version__
 from slamtrials.atomicfile import atomic_write_text
 from slamtrials.campaign.config import CampaignConfig
+from slamtrials.campaign.results import RunDone
 from slamtrials.errors import ConfigError, FormatError
 
 __all__ = ["CampaignStore", "WorldInfo", "WorldRow", "RunRow", "STORE_FORMAT", "DB_FILE", "CONFIG_FILE", "RUNS_DIR",
@@ -274,7 +277,7 @@ class CampaignStore:
 
     def config(self) -> CampaignConfig:
         """The stored campaign config."""
-        return CampaignConfig.model_validate(json.loads(self.meta("config") or "{}"))
+        return CampaignConfig.from_stored(json.loads(self.meta("config") or "{}"))
 
     def check_config(self, config: CampaignConfig) -> None:
         """Raise :class:`ConfigError` (touching nothing) when ``config`` is not the stored campaign's."""
@@ -282,9 +285,19 @@ class CampaignStore:
             return
         stored = json.loads(self.meta("config") or "{}")
         stored.pop("output", None)
+        if self._stored_by_earlier_version_as(stored, config):
+            return
         diff = config_differences(stored, config.identity())
         raise ConfigError(f"{self.folder}: holds a campaign with a different config ({diff}); "
                           "resume it with its own config or choose another folder")
+
+    @staticmethod
+    def _stored_by_earlier_version_as(stored: dict[str, Any], config: CampaignConfig) -> bool:
+        """Whether a config stored by an earlier version (other fields, other digest) is ``config``."""
+        try:
+            return CampaignConfig.from_stored(stored).identity() == config.identity()
+        except ValidationError:
+            return False
 
     def worlds(self) -> list[WorldRow]:
         """The worlds, in campaign order."""
@@ -343,15 +356,15 @@ class CampaignStore:
                     "error = NULL", (world, index, seed, now))
             conn.execute("UPDATE worlds SET status = 'running', updated = ? WHERE name = ? AND status = 'pending'", (now, world))
 
-    def record_done(self, world: str, index: int, result: dict[str, Any]) -> None:
-        """Mark a run done with its outcome (a :func:`slamtrials.campaign.task.run_one` result)."""
+    def record_done(self, world: str, index: int, result: RunDone) -> None:
+        """Mark a run done with its outcome (what :func:`slamtrials.campaign.task.run_one` returned)."""
         with self._transaction() as conn:
             conn.execute(
                 "UPDATE runs SET status = 'done', eps_t = ?, eps_r = ?, relations = ?, termination = ?, mapped_fraction = ?, "
                 "sim_duration = ?, wall_time = ?, worker = ?, error = NULL, folder = ?, details = ?, finished = ? WHERE world = ? AND idx = ?",
-                (result["eps_t"], result["eps_r"], result.get("relations"), result.get("termination"), result.get("mapped_fraction"),
-                 result.get("sim_duration"), result.get("wall_time"), result.get("worker"), result.get("folder"),
-                 json.dumps(result.get("details") or {}, sort_keys=True), _now(), world, index))
+                (result.eps_t, result.eps_r, result.relations, result.termination, result.mapped_fraction,
+                 result.sim_duration, result.wall_time, result.worker, result.folder,
+                 json.dumps(asdict(result.details), sort_keys=True), _now(), world, index))
 
     def record_failed(self, world: str, index: int, error: str, *, worker: str | None = None) -> None:
         """Mark a run failed (with its error text) and its world failed."""

@@ -10,9 +10,10 @@ atomically (:func:`slamtrials.campaign.runfiles.publish_run`):
 under ``campaign``, the world, run index, seed, ``eps_t``, ``eps_r`` and the metric settings, besides the
 trial's own metadata (resolved trial config, termination reason, timings).
 
-It returns a plain dict that the driver stores. Errors that are properties of the run (a
-:class:`~slamtrials.errors.SlamtrialsError`, e.g. a start pose in a wall) come back as
-``{"status": "failed", ...}``; anything else (a bug, a lost worker) propagates so that Dask retries it.
+It returns a :class:`~slamtrials.campaign.results.RunDone` that the driver stores. Errors that are
+properties of the run (a :class:`~slamtrials.errors.SlamtrialsError`, e.g. a start pose in a wall) come
+back as a :class:`~slamtrials.campaign.results.RunFailed`; anything else (a bug, a lost worker)
+propagates so that Dask retries it.
 """
 
 from __future__ import annotations
@@ -26,12 +27,13 @@ from pathlib import Path
 from typing import Any
 
 from slamtrials.campaign.config import MetricSettings
+from slamtrials.campaign.results import RunDetails, RunDone, RunFailed, RunResult
 from slamtrials.campaign.runfiles import publish_run, relative_run_folder
 from slamtrials.campaign.score import RunScore, score_run
 from slamtrials.campaign.worldset import load_world_cached
 from slamtrials.errors import SlamtrialsError
 from slamtrials.record import RunRecord
-from slamtrials.trial import TrialConfig
+from slamtrials.trial import TrialConfig, TrialSummary
 from slamtrials.worlds import World
 
 __all__ = ["RunTask", "TrialFn", "run_one", "write_scored_run", "worker_name", "outcome", "failure"]
@@ -81,49 +83,50 @@ def worker_name() -> str:
 def write_scored_run(folder: Path, record: RunRecord, score: RunScore) -> None:
     """Write relations, errors, then the run folder (``run.json`` last) into ``folder``."""
     from slamtrials.io.errorsfile import write_errors
+    from slamtrials.io.layout import RunFolder
     from slamtrials.io.relations import write_relations
     from slamtrials.io.runfolder import write_run
 
-    write_relations(folder / "relations.txt", score.sampled.relations)
-    write_errors(folder / "errors.npz", score.sampled.relations, score.sampled.errors)
+    files = RunFolder(folder)
+    write_relations(files.relations, score.sampled.relations)
+    write_errors(files.errors, score.sampled.relations, score.sampled.errors)
     write_run(folder, record)
 
 
-def outcome(task_world: str, index: int, record: RunRecord, score: RunScore, started: float) -> dict[str, Any]:
-    """The result dict the driver stores for a done run."""
-    trial = record.metadata.get("trial", {}) if isinstance(record.metadata.get("trial"), dict) else {}
+def outcome(task_world: str, index: int, record: RunRecord, score: RunScore, started: float) -> RunDone:
+    """What the driver stores for a done run."""
+    trial = TrialSummary.of(record)
     sampled = score.sampled
-    return {
-        "status": "done",
-        "world": task_world,
-        "index": index,
-        "eps_t": score.eps_t,
-        "eps_r": score.eps_r,
-        "relations": int(sampled.count),
-        "termination": trial.get("termination_reason"),
-        "mapped_fraction": trial.get("mapped_fraction"),
-        "sim_duration": float(record.t[-1] - record.t[0]) if len(record) else 0.0,
-        "wall_time": time.perf_counter() - started,
-        "worker": worker_name(),
-        "folder": relative_run_folder(task_world, index),
-        "details": {
-            "frames": len(record),
-            "distance_m": trial.get("distance_m"),
-            "observed_fraction": trial.get("observed_fraction"),
-            "slam_updates": trial.get("slam_updates"),
-            "relation_std_t": sampled.std_t,
-            "relation_std_r": sampled.std_r,
-            "relations_capped": bool(sampled.capped),
-        },
-    }
+    return RunDone(
+        world=task_world,
+        index=index,
+        eps_t=score.eps_t,
+        eps_r=score.eps_r,
+        relations=int(sampled.count),
+        termination=trial.termination_reason if trial else None,
+        mapped_fraction=trial.mapped_fraction if trial else None,
+        sim_duration=float(record.t[-1] - record.t[0]) if len(record) else 0.0,
+        wall_time=time.perf_counter() - started,
+        worker=worker_name(),
+        folder=relative_run_folder(task_world, index),
+        details=RunDetails(
+            frames=len(record),
+            distance_m=trial.distance_m if trial else None,
+            observed_fraction=trial.observed_fraction if trial else None,
+            slam_updates=trial.slam_updates if trial else None,
+            relation_std_t=sampled.std_t,
+            relation_std_r=sampled.std_r,
+            relations_capped=bool(sampled.capped),
+        ),
+    )
 
 
-def failure(world: str, index: int, exc: BaseException) -> dict[str, Any]:
-    """The result dict of a run that failed for a reason of its own (not retried)."""
-    return {"status": "failed", "world": world, "index": index, "error": f"{type(exc).__name__}: {exc}", "worker": worker_name()}
+def failure(world: str, index: int, exc: BaseException) -> RunFailed:
+    """The result of a run that failed for a reason of its own (not retried)."""
+    return RunFailed(world=world, index=index, error=f"{type(exc).__name__}: {exc}", worker=worker_name())
 
 
-def run_one(task: RunTask) -> dict[str, Any]:
+def run_one(task: RunTask) -> RunResult:
     """Run, evaluate and store one run (see the module docstring); return what the driver records."""
     from slamtrials.trial import run_trial
 

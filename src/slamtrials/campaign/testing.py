@@ -18,11 +18,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from slamtrials.record import OccupancyGrid, RunRecord
+from slamtrials.record import LaserGeometry, OccupancyGrid, RunRecord
+from slamtrials.trial import TrialSummary
 
 __all__ = ["FakeTrial"]
 
-_LASER = {"angle_min": -0.1, "angle_increment": 0.1, "range_min": 0.0, "range_max": 10.0, "mount": [0.0, 0.0, 0.0]}
+_LASER = LaserGeometry(angle_min=-0.1, angle_increment=0.1, range_min=0.0, range_max=10.0)
 
 
 @dataclass(frozen=True)
@@ -59,12 +60,16 @@ class FakeTrial:
         truth = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
         estimate = np.array([[0.0, 0.0, 0.0], [1.0 + e_t, 0.0, e_r]])
         record = RunRecord(t=t, scans=np.full((2, 3), 5.0, dtype=np.float32), odometry=truth.copy(), truth=truth,
-                           stalled=np.zeros(2, dtype=bool), laser=dict(_LASER))
+                           stalled=np.zeros(2, dtype=bool), laser=_LASER)
         record.estimate = estimate
         record.map = OccupancyGrid(np.zeros((4, 4), dtype=np.int8), 0.5, np.zeros(3))
         record.metadata = {
             "world": getattr(world, "name", "world"),
             "seed": int(seed),
-            "trial": {"termination_reason": "fake", "mapped_fraction": 1.0, "duration_s": 1.0, "distance_m": 1.0},
+            "trial": TrialSummary(termination_reason="fake", mapped_fraction=1.0, mapped_fraction_global=1.0,
+                                  observed_fraction=1.0, reachable_area_m2=1.0, mapped_fraction_connected=1.0,
+                                  connected_free_area_m2=1.0, mapped_free_area_m2=1.0, distance_m=1.0, turning_rad=0.0,
+                                  duration_s=1.0, wall_time_s=self.sleep, realtime_factor=1.0, slam_updates=1,
+                                  slam_seconds=0.0, stalled_frames=0).to_dict(),
         }
         return record

@@ -18,7 +18,7 @@ from typing import Annotated
 
 import typer
 
-from slamtrials.cli.common import fmt_number, make_app, make_console, table_one
+from slamtrials.cli.common import fmt_number, make_app, make_console, quiet_dask, table_one
 from slamtrials.errors import ConfigError
 
 __all__ = ["app", "register", "summary_table", "EXIT_INTERRUPTED"]
@@ -29,16 +29,6 @@ EXIT_INTERRUPTED = 130
 
 SchedulerOpt = Annotated[str | None, typer.Option("--scheduler", help="Address of a running Dask scheduler (e.g. tcp://host:8786); default: a local cluster.")]
 WorkersOpt = Annotated[int | None, typer.Option("--workers", "-j", help="Worker processes of the local cluster (default: one per core).")]
-
-
-def _quiet_dask() -> None:
-    """Dask's loggers log at INFO by default; follow the root logger's level instead (``-v`` shows them)."""
-    import distributed  # noqa: F401  (its import applies dask's logging config, which we then override)
-
-    level = logging.getLogger().getEffectiveLevel()
-    if level > logging.INFO:
-        for name in ("distributed", "dask"):
-            logging.getLogger(name).setLevel(level)
 
 
 def summary_table(rows, confidence: float, title: str):
@@ -122,7 +112,7 @@ def run(
             confidence = store.config().runs.confidence
     else:
         confidence = campaign_config.runs.confidence
-    _quiet_dask()
+    quiet_dask()
     console = make_console()
     folder = out or (Path(campaign_config.output) if campaign_config and campaign_config.output else None)
     try:
@@ -180,7 +170,7 @@ def replay(
     params = parse_settings(settings or [])
     with CampaignStore.open(source) as store:
         confidence = store.config().runs.confidence
-    _quiet_dask()
+    quiet_dask()
     console = make_console()
     console.print(f"note: {REPLAY_NOTE}", highlight=False, soft_wrap=True)
     try:

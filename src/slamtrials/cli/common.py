@@ -6,12 +6,14 @@ a command module can be imported on its own without a circular import.
 
 from __future__ import annotations
 
+import logging
+
 import typer
 from typer.core import TyperGroup
 
 from slamtrials.errors import SlamtrialsError
 
-__all__ = ["EXIT_BAD_INPUT", "ErrorReportingGroup", "make_app", "make_console"]
+__all__ = ["EXIT_BAD_INPUT", "ErrorReportingGroup", "make_app", "make_console", "quiet_dask"]
 
 EXIT_BAD_INPUT = 2
 
@@ -64,3 +66,13 @@ def table_one(title: str, confidence: float, last_column: str, last_justify: str
         table.add_column(column, justify="right", no_wrap=True)
     table.add_column(last_column, justify=last_justify)
     return table
+
+
+def quiet_dask() -> None:
+    """Dask's loggers log at INFO by default; follow the root logger's level instead (``-v`` shows them)."""
+    import distributed  # noqa: F401  (its import applies dask's logging config, which we then override)
+
+    level = logging.getLogger().getEffectiveLevel()
+    if level > logging.INFO:
+        for name in ("distributed", "dask"):
+            logging.getLogger(name).setLevel(level)

@@ -11,7 +11,6 @@ import typer
 from slamtrials.cli.common import make_console
 from slamtrials.errors import ConfigError
 
-RUN_PICTURE = "run.png"
 
 
 def simulate(
@@ -26,7 +25,7 @@ def simulate(
     config: Annotated[Path | None, typer.Option("--config", "-c", help="YAML with robot/laser/odometry/dt settings (SI units); default: the paper's.")] = None,
 ) -> None:
     """Simulate the robot driving through WAYPOINTS (or a --tour) and record laser, odometry and ground truth."""
-    from slamtrials.io.runfolder import RUN_FILE, write_run
+    from slamtrials.io.runfolder import RunFolder, write_run
     from slamtrials.io.waypoints import read_waypoints
     from slamtrials.io.yamlfile import read_yaml_mapping
     from slamtrials.report.runplot import save_run_figure
@@ -40,7 +39,7 @@ def simulate(
         raise ConfigError(f"--seed must be a non-negative integer, got {seed}")
     if not (max_time > 0):
         raise ConfigError(f"--max-time must be positive seconds, got {max_time}")
-    if (out / RUN_FILE).exists() and not overwrite:
+    if RunFolder(out).is_complete() and not overwrite:
         raise ConfigError(f"{out}: already holds a run; choose another --out or pass --overwrite")
     sim_config = SimConfig.paper()
     if config is not None:
@@ -56,7 +55,7 @@ def simulate(
     wall = time.perf_counter() - started
     record.metadata.update(world_source=str(world), wall_time_s=round(wall, 3))
     write_run(out, record)
-    save_run_figure(the_world, record, out / RUN_PICTURE, title=f"{the_world.name}, seed {seed}")
+    save_run_figure(the_world, record, RunFolder(out).picture, title=f"{the_world.name}, seed {seed}")
     console = make_console()
     duration = float(record.t[-1] - record.t[0])
     console.print(

@@ -67,7 +67,7 @@ def export_run(
 
 
 def import_run(
-    source: Annotated[Path, typer.Argument(metavar="FILE", help="ROS 1 .bag, ROS 2 bag folder or .mcap, or CARMEN log (.clf, .log, .gz).")],
+    source: Annotated[Path, typer.Argument(metavar="FILE", help="ROS 1 .bag, ROS 2 bag folder or .mcap, or CARMEN log (.clf, .log, .gz, .bz2).")],
     out: Annotated[Path, typer.Option("--out", "-o", help="Run folder to write (frames.npz, run.json).")],
     fmt: Annotated[ImportFormat, typer.Option("--format", "-f", help="Input format; auto: from the name and first bytes.")] = ImportFormat.auto,
     scan_topic: Annotated[str | None, typer.Option("--scan-topic", help="Bag: sensor_msgs/LaserScan topic [default: /base_scan].")] = None,
@@ -79,12 +79,12 @@ def import_run(
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace a run already stored in --out.")] = False,
 ) -> None:
     """Import a ROS bag or a CARMEN log as a run folder, so recordings (also of real robots) can be evaluated."""
-    from slamtrials.io.runfolder import RUN_FILE, write_run
+    from slamtrials.io.runfolder import RunFolder, write_run
     from slamtrials.io.transfer import detect_recording_format, read_carmen_run
 
     if no_truth and truth_topic is not None:
         raise ConfigError("give either --truth-topic or --no-truth, not both")
-    if (out / RUN_FILE).exists() and not overwrite:
+    if RunFolder(out).is_complete() and not overwrite:
         raise ConfigError(f"{out}: already holds a run; choose another --out or pass --overwrite")
     kind = ImportFormat(detect_recording_format(source)) if fmt is ImportFormat.auto else fmt
     if kind is ImportFormat.bag:

@@ -10,9 +10,8 @@ import typer
 from slamtrials.cli.common import make_console
 from slamtrials.errors import ConfigError
 
-__all__ = ["trial", "register", "TRIAL_PICTURE"]
+__all__ = ["trial", "register"]
 
-TRIAL_PICTURE = "run.png"
 
 
 def trial(
@@ -26,15 +25,15 @@ def trial(
     """Let the robot explore WORLD on its own, mapped online by SLAM, until the map stops changing."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from slamtrials.io.runfolder import RUN_FILE, write_run
+    from slamtrials.io.runfolder import RunFolder, write_run
     from slamtrials.io.yamlfile import read_yaml_mapping
     from slamtrials.report.runplot import save_run_figure
-    from slamtrials.trial import TrialConfig, run_trial
+    from slamtrials.trial import TrialConfig, TrialSummary, run_trial
     from slamtrials.worlds import load_world
 
     if seed < 0:
         raise ConfigError(f"--seed must be a non-negative integer, got {seed}")
-    if (out / RUN_FILE).exists() and not overwrite:
+    if RunFolder(out).is_complete() and not overwrite:
         raise ConfigError(f"{out}: already holds a run; choose another --out or pass --overwrite")
     trial_config = TrialConfig()
     if config is not None:
@@ -55,12 +54,13 @@ def trial(
         record = run_trial(the_world, trial_config, seed, on_progress=report)
     record.metadata.update(world_source=str(world))
     write_run(out, record)
-    save_run_figure(the_world, record, out / TRIAL_PICTURE, title=f"{the_world.name}, seed {seed}")
-    info = record.metadata["trial"]
+    save_run_figure(the_world, record, RunFolder(out).picture, title=f"{the_world.name}, seed {seed}")
+    info = TrialSummary.of(record)
+    assert info is not None  # run_trial always stores it
     console.print(
-        f"{out}: {info['termination_reason']} after {info['duration_s']:.0f} s simulated in {info['wall_time_s']:.1f} s "
-        f"({info['realtime_factor']:.0f}x real time); mapped {100 * info['mapped_fraction']:.1f} % of the reachable "
-        f"{info['reachable_area_m2']:.0f} m^2, travelled {info['distance_m']:.0f} m, {info['slam_updates']} SLAM updates",
+        f"{out}: {info.termination_reason} after {info.duration_s:.0f} s simulated in {info.wall_time_s:.1f} s "
+        f"({info.realtime_factor:.0f}x real time); mapped {100 * info.mapped_fraction:.1f} % of the reachable "
+        f"{info.reachable_area_m2:.0f} m^2, travelled {info.distance_m:.0f} m, {info.slam_updates} SLAM updates",
         soft_wrap=True, highlight=False)
 
 

@@ -11,7 +11,7 @@ row 0 at the top), ``resolution`` (m) and ``origin`` (float64 ``[3]``, map-frame
 lower-left corner of the lower-left cell), such as :class:`slamtrials.slam.OccupancyGrid`.
 """
 
-from slamtrials.explore.config import ExploreConfig, TerminationConfig
+from slamtrials.explore.config import ExploreConfig, RobotLimits, TerminationConfig
 from slamtrials.explore.costmap import Costmap, build_costmap
 from slamtrials.explore.explorer import Explorer, ExploreStats
 from slamtrials.explore.follower import FollowCommand, PathFollower
@@ -23,6 +23,7 @@ from slamtrials.explore.termination import SnapshotTermination, snapshot_mse
 __all__ = [
     "Costmap",
     "ExploreConfig",
+    "RobotLimits",
     "ExploreStats",
     "Explorer",
     "FollowCommand",

@@ -13,13 +13,14 @@ the map every 120 s (small buildings) or 600 s (large ones), compared by mean sq
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any, TypeVar
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from slamtrials.errors import ConfigError, validation_problems
 
-__all__ = ["ExploreConfig", "TerminationConfig"]
+__all__ = ["ExploreConfig", "RobotLimits", "TerminationConfig", "lethal_distance"]
 
 _MODEL_CONFIG = ConfigDict(extra="forbid", frozen=True)
 _Model = TypeVar("_Model", bound=BaseModel)
@@ -32,12 +33,57 @@ def _validate(cls: type[_Model], data: dict[str, Any], what: str) -> _Model:
         raise ConfigError(f"{what} config: " + validation_problems(exc)) from None
 
 
+@dataclass(frozen=True)
+class RobotLimits:
+    """The robot the explorer drives: its footprint, motion limits and control period.
+
+    These describe the simulated robot, so a trial takes them from ``sim.robot`` and ``sim.dt``
+    (:meth:`slamtrials.trial.TrialConfig.robot_limits`); the defaults are the paper's robot.
+
+    Attributes
+    ----------
+    radius:
+        Footprint disc radius (m).
+    max_linear_speed, max_angular_speed:
+        Largest forward speed (m/s) and turn rate (rad/s).
+    max_linear_accel, max_angular_accel:
+        Largest linear (m/s^2) and angular (rad/s^2) acceleration.
+    control_period:
+        Time between commands (s).
+    """
+
+    radius: float = 0.15
+    max_linear_speed: float = 0.7
+    max_angular_speed: float = math.radians(70.0)
+    max_linear_accel: float = 0.5
+    max_angular_accel: float = math.radians(100.0)
+    control_period: float = 0.1
+
+    def __post_init__(self) -> None:
+        for name, value in vars(self).items():
+            if not (math.isfinite(value) and value > 0.0):
+                raise ValueError(f"RobotLimits.{name} must be a positive number, got {value!r}")
+
+
+#: Names of the robot's limits that earlier versions took in the explore section; now refused there.
+ROBOT_FIELDS = ("robot_radius", "max_linear_speed", "max_angular_speed", "max_linear_accel", "max_angular_accel",
+                "control_period")
+
+
+def lethal_distance(config: ExploreConfig, robot: RobotLimits) -> float:
+    """Distance (m) from an occupied cell's edge below which a cell is lethal: radius + inflation margin."""
+    return robot.radius + config.inflation_margin
+
+
 class ExploreConfig(BaseModel):
     """Frontier exploration: costmap, frontiers, planner, path follower, goal bookkeeping, recovery.
 
+    The robot itself (footprint, speed and acceleration limits, control period) is not set here but
+    given as :class:`RobotLimits`; a trial takes them from its ``sim.robot`` section.
+
     Costmap (:mod:`slamtrials.explore.costmap`). ``d`` is the distance (m) from a cell's centre to the
-    nearest occupied cell's edge. Cells with ``d < robot_radius + inflation_margin`` are lethal; the
-    others cost ``1 + wall_cost * exp(-(d - robot_radius - inflation_margin) / cost_decay_distance)``
+    nearest occupied cell's edge. Cells with ``d < radius + inflation_margin`` are lethal; the
+    others cost ``1 + wall_cost * exp(-(d - radius - inflation_margin) / cost_decay_distance)``
     per metre travelled, so paths keep to the middle of corridors and doors.
 
     Unknown cells are not traversable by default (``unknown_traversable=False``): frontier goals are
@@ -74,8 +120,7 @@ class ExploreConfig(BaseModel):
 
     model_config = _MODEL_CONFIG
 
-    # --- robot and costmap ---------------------------------------------------------------------------
-    robot_radius: float = Field(0.15, gt=0.0, le=5.0, description="footprint disc radius (m)")
+    # --- costmap ---------------------------------------------------------------------------------
     inflation_margin: float = Field(0.05, ge=0.0, le=5.0, description="lethal margin added to the radius (m)")
     relaxed_margin: float = Field(0.0, ge=0.0, le=5.0, description="lethal margin of the last-resort plan through narrow passages (m)")
     shut_in_share: float = Field(0.5, ge=0.0, le=1.0, description="plan through narrow passages only when the robot reaches less than this share of the passable cells")
@@ -89,12 +134,7 @@ class ExploreConfig(BaseModel):
     min_frontier_length: float = Field(0.5, ge=0.0, le=100.0, description="smallest frontier kept: cells x resolution (m)")
     view_distance: float = Field(0.0, ge=0.0, le=30.0, description="last resort: look at frontiers the robot cannot reach from reachable cells this close (m); 0 = never")
     min_unknown_area: float = Field(3.0, ge=0.0, le=1000.0, description="enclosed unknown pockets smaller than this make no frontier (m^2)")
-    # --- motion limits and follower ------------------------------------------------------------------
-    max_linear_speed: float = Field(0.7, gt=0.0, le=10.0, description="largest forward speed (m/s)")
-    max_angular_speed: float = Field(math.radians(70.0), gt=0.0, le=4.0 * math.pi, description="largest turn rate (rad/s)")
-    max_linear_accel: float = Field(0.5, gt=0.0, le=100.0, description="largest linear acceleration (m/s^2)")
-    max_angular_accel: float = Field(math.radians(100.0), gt=0.0, le=100.0, description="largest angular acceleration (rad/s^2)")
-    control_period: float = Field(0.1, gt=0.0, le=1.0, description="time between commands (s)")
+    # --- path follower ------------------------------------------------------------------------------
     smooth_paths: bool = Field(True, description="straighten the planner's 8-connected paths where that costs no more")
     lookahead_distance: float = Field(1.0, gt=0.0, le=10.0, description="pure-pursuit look-ahead (m)")
     rotate_in_place_angle: float = Field(math.radians(50.0), gt=0.0, le=math.pi, description="heading error above which the robot turns in place (rad)")
@@ -132,16 +172,21 @@ class ExploreConfig(BaseModel):
     recovery_turn: float = Field(math.radians(90.0), ge=0.0, le=2.0 * math.pi, description="turn in place after backing off, when not touching anything (rad)")
     max_recoveries_per_goal: int = Field(2, ge=1, le=100, description="blacklist a goal after this many recoveries on the way")
 
+    @model_validator(mode="before")
+    @classmethod
+    def _no_robot_fields(cls, data: Any) -> Any:
+        if isinstance(data, dict):
+            found = [name for name in ROBOT_FIELDS if name in data]
+            if found:
+                raise ValueError(f"{found[0]} is a property of the robot: set it in sim.robot (radius, speeds, "
+                                 "accelerations) or sim.dt (control period), not in the explore section")
+        return data
+
     @model_validator(mode="after")
     def _consistent(self) -> ExploreConfig:
         if self.min_replan_interval > self.replan_period:
             raise ValueError(f"min_replan_interval ({self.min_replan_interval:g} s) must not exceed replan_period ({self.replan_period:g} s)")
         return self
-
-    @property
-    def lethal_distance(self) -> float:
-        """Distance (m) from an occupied cell's edge below which a cell is lethal."""
-        return self.robot_radius + self.inflation_margin
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> ExploreConfig:

@@ -27,7 +27,7 @@ from numba import njit
 from numpy.typing import NDArray
 
 from slamtrials import stablemath
-from slamtrials.explore.config import ExploreConfig
+from slamtrials.explore.config import ExploreConfig, RobotLimits, lethal_distance
 from slamtrials.explore.gridframe import FREE_BELOW
 
 __all__ = [
@@ -121,11 +121,11 @@ def squared_distance_transform(target):  # pragma: no cover - compiled
 _NEGLIGIBLE = 0.01
 
 
-def influence_distance(config: ExploreConfig, resolution: float) -> float:
+def influence_distance(config: ExploreConfig, robot: RobotLimits, resolution: float) -> float:
     """Distance (m) from an obstacle beyond which it changes no cost: cells farther than this from the
     edge of a window of the map have the same costs in the window's costmap as in the whole map's."""
     cfg = config
-    return cfg.lethal_distance + cfg.cost_decay_distance * max(math.log(max(cfg.wall_cost, 1e-12) / _NEGLIGIBLE), 0.0) + 2 * resolution
+    return lethal_distance(cfg, robot) + cfg.cost_decay_distance * max(math.log(max(cfg.wall_cost, 1e-12) / _NEGLIGIBLE), 0.0) + 2 * resolution
 
 
 def _cost_table(resolution: float, lethal: float, wall_cost: float, decay: float) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
@@ -218,13 +218,14 @@ class Costmap:
     escape: NDArray[np.float32]
 
 
-def build_costmap(grid: NDArray[np.int8], resolution: float, config: ExploreConfig) -> Costmap:
+def build_costmap(grid: NDArray[np.int8], resolution: float, config: ExploreConfig, robot: RobotLimits | None = None) -> Costmap:
     """Costmap of ``grid`` (int8 ``[H, W]``: >= 50 occupied, 0..49 free, < 0 unknown) with cells of ``resolution`` m."""
+    lethal = lethal_distance(config, RobotLimits() if robot is None else robot)
     grid = np.ascontiguousarray(grid, dtype=np.int8)
     d2 = squared_distance_transform(grid >= FREE_BELOW)
-    clear_table, cost_table = _cost_table(float(resolution), float(config.lethal_distance), float(config.wall_cost),
+    clear_table, cost_table = _cost_table(float(resolution), float(lethal), float(config.wall_cost),
                                           float(config.cost_decay_distance))
     cost, kind, clearance, escape = _costs(grid, d2, float(resolution), clear_table, cost_table,
                                            bool(config.unknown_traversable), float(config.unknown_cost), FREE_BELOW,
-                                           float(config.lethal_distance), float(config.escape_cost))
+                                           float(lethal), float(config.escape_cost))
     return Costmap(cost=cost, kind=kind, clearance=clearance, resolution=float(resolution), escape=escape)

@@ -43,7 +43,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from slamtrials import stablemath
-from slamtrials.explore.config import ExploreConfig
+from slamtrials.explore.config import ExploreConfig, RobotLimits
 from slamtrials.explore.costmap import influence_distance
 from slamtrials.explore.follower import PathFollower
 from slamtrials.explore.frontiers import frontier_near
@@ -51,6 +51,7 @@ from slamtrials.explore.goals import GoalRecord
 from slamtrials.explore.goalsearch import Found, GoalSearch
 from slamtrials.explore.gridframe import GridFrame, map_arrays
 from slamtrials.explore.recovery import Recovery, StuckMonitor
+from slamtrials.record import LaserGeometry
 
 __all__ = ["ExploreStats", "Explorer"]
 
@@ -98,6 +99,8 @@ class Explorer:
     ----------
     config:
         Explorer settings; ``None`` means the defaults.
+    robot:
+        The robot's footprint, motion limits and control period; ``None`` means the paper's robot.
 
     Examples
     --------
@@ -106,12 +109,13 @@ class Explorer:
     >>> explorer.done, explorer.reason                                    # doctest: +SKIP
     """
 
-    def __init__(self, config: ExploreConfig | None = None):
+    def __init__(self, config: ExploreConfig | None = None, robot: RobotLimits | None = None):
         self.config = ExploreConfig() if config is None else config
-        self._search = GoalSearch(self.config)
-        self._follower = PathFollower(self.config)
+        self.robot = RobotLimits() if robot is None else robot
+        self._search = GoalSearch(self.config, self.robot)
+        self._follower = PathFollower(self.config, self.robot)
         self._monitor = StuckMonitor(self.config)
-        self._recovery = Recovery(self.config)
+        self._recovery = Recovery(self.config, self.robot)
         self.reset()
 
     # --- state -------------------------------------------------------------------------------------------
@@ -180,7 +184,7 @@ class Explorer:
 
     # --- the control step --------------------------------------------------------------------------------
 
-    def command(self, t: float, pose: ArrayLike, ranges: ArrayLike, laser: dict[str, Any], occupancy: Any, *,
+    def command(self, t: float, pose: ArrayLike, ranges: ArrayLike, laser: LaserGeometry, occupancy: Any, *,
                 stalled: bool = False) -> tuple[float, float]:
         """The velocity command ``(v m/s, w rad/s)`` for the next control period.
 
@@ -193,8 +197,7 @@ class Explorer:
         ranges:
             float32 ``[B]`` the current laser scan (m).
         laser:
-            Laser geometry: ``angle_min``, ``angle_increment`` (rad), ``range_min``, ``range_max`` (m),
-            ``mount`` (laser pose in the base frame).
+            The laser's geometry (beam angles, valid ranges, pose in the base frame).
         occupancy:
             The current map: an object with ``grid`` (int8 ``[H, W]``, 100 occupied, 0 free, -1
             unknown, row 0 at the top), ``resolution`` (m) and ``origin`` (float64 ``[3]``, the map-frame
@@ -207,12 +210,13 @@ class Explorer:
         """
         self._stalls = self._stalls + 1 if stalled else 0
         self._following = False
-        v, w = self._decide(float(t), np.asarray(pose, dtype=np.float64), ranges, laser, occupancy)
+        pose_array = np.asarray(pose, dtype=np.float64)
+        v, w = self._decide(float(t), pose_array, ranges, laser, occupancy)
         self._follower.remember(v, w)
-        self._stuck = self._monitor.update(float(t), pose, v, self.config.control_period, self._following)
+        self._stuck = self._monitor.update(float(t), pose_array, v, self.robot.control_period, self._following)
         return v, w
 
-    def _decide(self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: dict[str, Any],
+    def _decide(self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: LaserGeometry,
                 occupancy: Any) -> tuple[float, float]:
         cfg = self.config
         if self._done:
@@ -282,14 +286,14 @@ class Explorer:
     # --- manoeuvres ----------------------------------------------------------------------------------------
 
     def _start_spin(self, t: float, pose: NDArray[np.float64]) -> None:
-        cfg = self.config
-        self._spin_rate = cfg.max_angular_speed
-        self._spin_until = t + 2.0 * math.pi / cfg.max_angular_speed + cfg.max_angular_speed / cfg.max_angular_accel
+        robot = self.robot
+        self._spin_rate = robot.max_angular_speed
+        self._spin_until = t + 2.0 * math.pi / robot.max_angular_speed + robot.max_angular_speed / robot.max_angular_accel
         self._looked.append(pose[:2].copy())
         self.stats.look_arounds += 1
         self._follower.clear()
 
-    def _start_recovery(self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: dict[str, Any],
+    def _start_recovery(self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: LaserGeometry,
                         occupancy: Any) -> tuple[float, float]:
         self.stats.recoveries += 1
         self._stuck = False
@@ -337,7 +341,7 @@ class Explorer:
             return
         row, col = (int(v) for v in GridFrame.of(occupancy).to_cell(pose[:2]))
         half = math.ceil(cfg.local_radius / resolution)
-        rim = math.ceil(influence_distance(cfg, resolution) / resolution) + 1
+        rim = math.ceil(influence_distance(cfg, self.robot, resolution) / resolution) + 1
         local = (row - half - rim, row + half + rim + 1, col - half - rim, col + half + rim + 1)
         if local[0] <= whole[0] and local[1] >= whole[1] and local[2] <= whole[2] and local[3] >= whole[3]:
             outcome = self._try(t, pose, occupancy, grid, whole, None)  # the window holds the whole map
@@ -395,7 +399,8 @@ class Explorer:
     def _take(self, t: float, found: Found) -> None:
         """Make ``found`` the goal and follow its path."""
         path = found.path
-        length = float(stablemath.hypot(*np.diff(path, axis=0).T).sum()) if len(path) > 1 else 0.0
+        step = np.diff(path, axis=0)
+        length = float(stablemath.hypot(step[:, 0], step[:, 1]).sum()) if len(path) > 1 else 0.0
         goal_xy = found.goal.copy()
         if self._goal is not None and (found.kept or math.dist(goal_xy, self._goal.xy) <= self.config.blacklist_radius):
             self._goal.xy = goal_xy

@@ -46,14 +46,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from slamtrials import stablemath
-from slamtrials.explore.config import ExploreConfig
+from slamtrials.explore.config import ExploreConfig, RobotLimits, lethal_distance
+from slamtrials.geometry import Pose1Like
+from slamtrials.record import LaserGeometry
 
 __all__ = ["FollowCommand", "PathFollower", "free_travel", "scan_points", "turn_rate"]
 
@@ -84,10 +85,10 @@ def turn_rate(error: float, max_rate: float, max_accel: float) -> float:
 _ANGLE_CACHE: dict[tuple[int, float, float, float], tuple[NDArray[np.float64], NDArray[np.float64]]] = {}
 
 
-def _beam_directions(beams: int, laser: dict[str, Any]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def _beam_directions(beams: int, laser: LaserGeometry) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """(cos, sin) of every beam's direction in the base frame, cached per laser geometry."""
-    mth = float(laser.get("mount", (0.0, 0.0, 0.0))[2])
-    key = (beams, float(laser["angle_min"]), float(laser["angle_increment"]), mth)
+    mth = laser.mount[2]
+    key = (beams, laser.angle_min, laser.angle_increment, mth)
     found = _ANGLE_CACHE.get(key)
     if found is None:
         angles = key[1] + key[2] * np.arange(beams) + mth
@@ -111,17 +112,14 @@ def _scan_points(ranges, cos, sin, mx, my, range_min, range_max):  # pragma: no 
     return out[:k]
 
 
-def scan_points(ranges: ArrayLike, laser: dict[str, Any]) -> NDArray[np.float64]:
+def scan_points(ranges: ArrayLike, laser: LaserGeometry) -> NDArray[np.float64]:
     """float64 ``[K, 2]`` scan returns in the robot base frame (m).
 
-    Beams with NaN, ``r <= range_min`` or ``r >= range_max`` (no return) are left out. ``laser`` is the
-    geometry dict (``angle_min``, ``angle_increment``, ``range_min``, ``range_max``, optional ``mount``).
+    Beams with NaN, ``r <= range_min`` or ``r >= range_max`` (no return) are left out.
     """
     r = np.ascontiguousarray(ranges, dtype=np.float64)
     cos, sin = _beam_directions(r.shape[0], laser)
-    mount = laser.get("mount", (0.0, 0.0, 0.0))
-    return _scan_points(r, cos, sin, float(mount[0]), float(mount[1]), float(laser.get("range_min", 0.0)),
-                        float(laser["range_max"]))
+    return _scan_points(r, cos, sin, laser.mount[0], laser.mount[1], laser.range_min, laser.range_max)
 
 
 @njit(cache=True, nogil=True)
@@ -204,11 +202,14 @@ class PathFollower:
     Parameters
     ----------
     config:
-        Speed and acceleration limits, look-ahead, clearances.
+        Look-ahead, clearances, narrow-passage speed.
+    robot:
+        Footprint, speed and acceleration limits, control period.
     """
 
-    def __init__(self, config: ExploreConfig):
+    def __init__(self, config: ExploreConfig, robot: RobotLimits | None = None):
         self.config = config
+        self.robot = RobotLimits() if robot is None else robot
         self._path = np.zeros((0, 2))
         self._clearance: NDArray[np.float64] | None = None
         self._remaining = np.zeros(0)
@@ -242,7 +243,8 @@ class PathFollower:
         points = np.asarray(path, dtype=np.float64).reshape(-1, 2)
         self._path = points
         self._clearance = None if clearance is None else np.asarray(clearance, dtype=np.float64).reshape(-1)
-        seg = stablemath.hypot(*np.diff(points, axis=0).T) if len(points) > 1 else np.zeros(0)
+        step = np.diff(points, axis=0)
+        seg = stablemath.hypot(step[:, 0], step[:, 1]) if len(points) > 1 else np.zeros(0)
         self._remaining = np.concatenate([np.cumsum(seg[::-1])[::-1], [0.0]]) if len(points) else np.zeros(0)
         # for each point, the index of the last point within _NARROW_AHEAD and _TARGET_WINDOW along the path
         along = self._remaining[0] - self._remaining if len(points) else np.zeros(0)
@@ -273,12 +275,12 @@ class PathFollower:
         self._v = 0.0
         self._w = 0.0
 
-    def remaining(self, pose: ArrayLike) -> float:
+    def remaining(self, pose: Pose1Like) -> float:
         """Path length (m) still ahead: from ``pose`` to the nearest path point (searched forward from the
         current one), then along the path; ``inf`` without a path."""
         if not self.has_path:
             return math.inf
-        x, y = float(pose[0]), float(pose[1])  # type: ignore[index]
+        x, y = float(pose[0]), float(pose[1])
         stop = min(self._index + _SEARCH_AHEAD, len(self._path))
         d = stablemath.hypot(self._path[self._index:stop, 0] - x, self._path[self._index:stop, 1] - y)
         k = int(np.argmin(d))
@@ -288,9 +290,9 @@ class PathFollower:
         """Record a command given by someone else (e.g. a recovery), for the acceleration limits."""
         self._v, self._w = float(v), float(w)
 
-    def command(self, pose: ArrayLike, ranges: ArrayLike, laser: dict[str, Any]) -> FollowCommand:
+    def command(self, pose: ArrayLike, ranges: ArrayLike, laser: LaserGeometry) -> FollowCommand:
         """Velocity command towards the path from ``pose`` (float64 ``[3]``, map frame) given the current scan."""
-        cfg = self.config
+        cfg, robot = self.config, self.robot
         x, y, theta = (float(v) for v in np.asarray(pose, dtype=np.float64)[:3])
         if not self.has_path:
             return self._limited(0.0, 0.0, finished=True)
@@ -304,7 +306,7 @@ class PathFollower:
             return self._limited(0.0, 0.0, finished=True)
         points = scan_points(ranges, laser)
         speed = math.inf if self._previous is None else math.hypot(x - self._previous[0],
-                                                                  y - self._previous[1]) / cfg.control_period
+                                                                  y - self._previous[1]) / robot.control_period
         self._previous = (x, y)
         backing_out = self._backing_out(x, y, theta, speed)
         if backing_out is None:
@@ -321,14 +323,14 @@ class PathFollower:
         while level < len(lookaheads):
             error, curvature, v_scan = self._arc(x, y, theta, 0.0, self._target(x, y, lookaheads[level]), points)
             if abs(error) > cfg.rotate_in_place_angle:
-                return self._limited(0.0, turn_rate(error, cfg.max_angular_speed, cfg.max_angular_accel))
+                return self._limited(0.0, turn_rate(error, robot.max_angular_speed, robot.max_angular_accel))
             if v_scan >= _BLOCKED_SPEED:
                 break
             level += 1
             self._tight = (level, x, y)
         if level >= len(lookaheads):
             return self._creep(x, y, theta, points, to_end)
-        v = self._arc_speed(cfg.max_linear_speed, v_scan, to_end, curvature)
+        v = self._arc_speed(robot.max_linear_speed, v_scan, to_end, curvature)
         return self._limited(v, curvature * v, pure_pursuit=True, curvature=curvature)
 
     def _arc(self, x: float, y: float, theta: float, offset: float, target: tuple[float, float],
@@ -336,21 +338,21 @@ class PathFollower:
         """Pure pursuit towards ``target`` with the heading ``theta + offset`` (``offset`` pi: backwards,
         ``points`` then mirrored): heading error (rad), curvature (1/m) and the largest speed (m/s) at which
         the robot can still stop before the scan's points on that arc."""
-        cfg = self.config
+        cfg, robot = self.config, self.robot
         tx, ty = target
         error = math.remainder(math.atan2(ty - y, tx - x) - theta - offset, 2.0 * math.pi)
         dist = max(math.hypot(tx - x, ty - y), 1e-6)
         curvature = 2.0 * math.sin(error) / dist
-        free = free_travel(points, curvature, cfg.robot_radius + cfg.obstacle_margin)
-        return error, curvature, math.sqrt(2.0 * cfg.max_linear_accel * max(free - cfg.stop_distance, 0.0))
+        free = free_travel(points, curvature, robot.radius + cfg.obstacle_margin)
+        return error, curvature, math.sqrt(2.0 * robot.max_linear_accel * max(free - cfg.stop_distance, 0.0))
 
     def _arc_speed(self, limit: float, v_scan: float, to_end: float, curvature: float) -> float:
         """Speed (m/s) on the arc: ``limit``, the scan's ``v_scan``, stopping at the path's end, the
         narrow-path limit and the turn-rate limit."""
-        cfg = self.config
-        v = min(limit, math.sqrt(2.0 * cfg.max_linear_accel * to_end), v_scan, self._narrow_limit())
+        robot = self.robot
+        v = min(limit, math.sqrt(2.0 * robot.max_linear_accel * to_end), v_scan, self._narrow_limit())
         if abs(curvature) > 1e-9:
-            v = min(v, cfg.max_angular_speed / abs(curvature))
+            v = min(v, robot.max_angular_speed / abs(curvature))
         return v
 
     @property
@@ -431,26 +433,26 @@ class PathFollower:
 
     def _creep(self, x: float, y: float, theta: float, points: NDArray[np.float64], to_end: float) -> FollowCommand:
         """Tight manoeuvring: face the path a few centimetres ahead, then inch straight along it."""
-        cfg = self.config
+        robot = self.robot
         tx, ty = self._target(x, y, _CREEP_LOOKAHEAD)
         error = math.remainder(math.atan2(ty - y, tx - x) - theta, 2.0 * math.pi)
         if abs(error) > _CREEP_ALIGN:
-            return self._limited(0.0, turn_rate(error, cfg.max_angular_speed, cfg.max_angular_accel))
-        free = free_travel(points, 0.0, cfg.robot_radius + _CREEP_MARGIN)
-        v = min(_CREEP_SPEED, math.sqrt(2.0 * cfg.max_linear_accel * max(free - 0.01, 0.0)),
-                math.sqrt(2.0 * cfg.max_linear_accel * to_end))
+            return self._limited(0.0, turn_rate(error, robot.max_angular_speed, robot.max_angular_accel))
+        free = free_travel(points, 0.0, robot.radius + _CREEP_MARGIN)
+        v = min(_CREEP_SPEED, math.sqrt(2.0 * robot.max_linear_accel * max(free - 0.01, 0.0)),
+                math.sqrt(2.0 * robot.max_linear_accel * to_end))
         if v < _BLOCKED_SPEED:
             return self._limited(0.0, 0.0, blocked=True)
         return self._limited(v, 0.0)
 
     def _narrow_limit(self) -> float:
         """Speed limit (m/s) from the smallest clearance of the next metre of path."""
-        cfg = self.config
+        cfg, robot = self.config, self.robot
         if self._clearance is None or self._clearance.shape[0] != self._path.shape[0] or cfg.narrow_clearance <= 0.0:
-            return cfg.max_linear_speed
+            return robot.max_linear_speed
         least = float(self._clearance[self._index:self._narrow_end[self._index] + 1].min())
-        share = min(max((least - cfg.lethal_distance) / cfg.narrow_clearance, 0.0), 1.0)
-        return cfg.narrow_speed + share * (cfg.max_linear_speed - cfg.narrow_speed)
+        share = min(max((least - lethal_distance(cfg, robot)) / cfg.narrow_clearance, 0.0), 1.0)
+        return cfg.narrow_speed + share * (robot.max_linear_speed - cfg.narrow_speed)
 
     def _target(self, x: float, y: float, lookahead: float, last: int | None = None) -> tuple[float, float]:
         """The first path point from the current one at least ``lookahead`` from (x, y), else the last
@@ -466,15 +468,15 @@ class PathFollower:
 
     def _limited(self, v: float, w: float, *, blocked: bool = False, finished: bool = False,
                  pure_pursuit: bool = False, curvature: float = 0.0) -> FollowCommand:
-        cfg = self.config
-        dt = cfg.control_period
+        robot = self.robot
+        dt = robot.control_period
         if v > 0.0:
-            v = min(v, max(self._v, 0.0) + cfg.max_linear_accel * dt)
+            v = min(v, max(self._v, 0.0) + robot.max_linear_accel * dt)
         elif v < 0.0:
-            v = max(v, min(self._v, 0.0) - cfg.max_linear_accel * dt)
+            v = max(v, min(self._v, 0.0) - robot.max_linear_accel * dt)
         if pure_pursuit:
             w = curvature * v  # stay on the arc while speeding up
-        dw = cfg.max_angular_accel * dt
+        dw = robot.max_angular_accel * dt
         w = min(max(w, self._w - dw), self._w + dw)
         self._v, self._w = v, w
         return FollowCommand(v, w, blocked, finished)

@@ -33,7 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from slamtrials import stablemath
-from slamtrials.explore.config import ExploreConfig
+from slamtrials.explore.config import ExploreConfig, RobotLimits
 from slamtrials.explore.costmap import (
     OCCUPIED,
     PASSABLE,
@@ -106,8 +106,9 @@ class GoalSearch:
         reach (small when it is shut in, e.g. by a door frame mapped after it went through).
     """
 
-    def __init__(self, config: ExploreConfig):
+    def __init__(self, config: ExploreConfig, robot: RobotLimits | None = None):
         self.config = config
+        self.robot = RobotLimits() if robot is None else robot
         self._relaxed = config.model_copy(update={"inflation_margin": config.relaxed_margin})
         self.reset()
 
@@ -146,7 +147,7 @@ class GoalSearch:
             window = coarsen(window, coarse)
             resolution *= coarse
             frame = GridFrame(window.shape[0], window.shape[1], resolution, frame.origin)
-        costmap = build_costmap(window, resolution, cfg)
+        costmap = build_costmap(window, resolution, cfg, self.robot)
         frontiers = find_frontiers(window, min_cells=max(1, math.ceil(cfg.min_frontier_length / resolution - 1e-9)),
                                    min_unknown_cells=math.ceil(cfg.min_unknown_area / resolution**2 - 1e-9))
         prepared = Prepared(frame, costmap, frontiers)
@@ -229,6 +230,8 @@ class GoalSearch:
         path[0] = pose[:2]
         target = path[-1].copy()
         if views:
+            if result.goal is None:  # both searches above return only results with a goal
+                raise RuntimeError("goal search: the chosen search result has no goal cell")
             target = _nearest_cell(unreachable, frame, result.goal, cfg.view_distance)
         clearance = costmap.clearance[cells[:, 0], cells[:, 1]].astype(np.float64)
         return outcome, Found(path=path, clearance=clearance, target=target, kept=result.kept)
@@ -305,7 +308,7 @@ class GoalSearch:
         check = inside & far
         kind = prepared.costmap.kind[rows[check], cols[check]]
         clearance = prepared.costmap.clearance[rows[check], cols[check]]
-        blocked = (kind == OCCUPIED) | (kind == UNKNOWN) | (clearance < self.config.robot_radius)
+        blocked = (kind == OCCUPIED) | (kind == UNKNOWN) | (clearance < self.robot.radius)
         return not bool(blocked.any())
 
     def _candidates(self, prepared: Prepared, visited: list[NDArray[np.float64]],

@@ -28,9 +28,11 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from slamtrials import stablemath
-from slamtrials.explore.config import ExploreConfig
+from slamtrials.explore.config import ExploreConfig, RobotLimits
 from slamtrials.explore.follower import scan_points
 from slamtrials.explore.gridframe import FREE_BELOW, GridFrame, map_arrays
+from slamtrials.geometry import Pose1Like
+from slamtrials.record import LaserGeometry
 
 __all__ = ["Recovery", "StuckMonitor", "open_side", "segment_clear"]
 
@@ -54,10 +56,10 @@ class StuckMonitor:
         self._anchor = None
         self._direction = 1.0
 
-    def update(self, t: float, pose: ArrayLike, v_command: float, dt: float, following: bool = True) -> bool:
+    def update(self, t: float, pose: Pose1Like, v_command: float, dt: float, following: bool = True) -> bool:
         """Record that at time ``t`` (s) the robot was at ``pose`` and was then commanded ``v_command``
         (m/s) for ``dt`` s, while following a path or not; return whether it is stuck."""
-        x, y = float(pose[0]), float(pose[1])  # type: ignore[index]
+        x, y = float(pose[0]), float(pose[1])
         if not following:
             self._anchor = None
         elif self._anchor is None or math.hypot(x - self._anchor[1], y - self._anchor[2]) >= self.config.idle_distance:
@@ -88,11 +90,11 @@ class StuckMonitor:
         return math.hypot(x - x0, y - y0) < self.config.stuck_ratio * commanded
 
 
-def open_side(ranges: ArrayLike, laser: dict[str, Any]) -> float:
+def open_side(ranges: ArrayLike, laser: LaserGeometry) -> float:
     """+1.0 if the scan sees more room to the left (beam angle > 0) than to the right, else -1.0."""
     r = np.asarray(ranges, dtype=np.float64)
-    angles = float(laser["angle_min"]) + float(laser["angle_increment"]) * np.arange(r.shape[0])
-    r = np.where(np.isfinite(r), np.minimum(r, float(laser["range_max"])), 0.0)
+    angles = laser.beam_angles(r.shape[0])
+    r = np.where(np.isfinite(r), np.minimum(r, laser.range_max), 0.0)
     r = np.minimum(r, 5.0)  # what matters is the room nearby
     left = float(r[angles > 0.0].sum())
     right = float(r[angles < 0.0].sum())
@@ -123,15 +125,17 @@ def segment_clear(occupancy: Any, a: ArrayLike, b: ArrayLike, radius: float) -> 
     length2 = float(seg[0] * seg[0] + seg[1] * seg[1])
     along = (centres[:, 0] - pa[0]) * seg[0] + (centres[:, 1] - pa[1]) * seg[1]
     s = np.zeros(len(centres)) if length2 == 0.0 else np.clip(along / length2, 0.0, 1.0)
-    gap = stablemath.hypot(*(centres - (pa + s[:, None] * seg)).T)
+    offset = centres - (pa + s[:, None] * seg)
+    gap = stablemath.hypot(offset[:, 0], offset[:, 1])
     return bool(gap.min() >= radius + 0.5 * resolution)
 
 
 class Recovery:
     """The recovery manoeuvre (see the module docstring): open-loop phases timed in simulated seconds."""
 
-    def __init__(self, config: ExploreConfig):
+    def __init__(self, config: ExploreConfig, robot: RobotLimits | None = None):
         self.config = config
+        self.robot = RobotLimits() if robot is None else robot
         self._phases: list[tuple[float, float, float]] = []  # (end time, v, w)
 
     @property
@@ -143,7 +147,7 @@ class Recovery:
         """Abort any manoeuvre."""
         self._phases = []
 
-    def start(self, t: float, pose: ArrayLike, ranges: ArrayLike, laser: dict[str, Any], occupancy: Any) -> None:
+    def start(self, t: float, pose: ArrayLike, ranges: ArrayLike, laser: LaserGeometry, occupancy: Any) -> None:
         """Begin a manoeuvre at time ``t`` (s) from ``pose`` (map frame) with the current scan and map.
 
         If the scan shows an obstacle within ``_CONTACT`` of the robot's edge, the robot turns so
@@ -152,16 +156,16 @@ class Recovery:
         Otherwise it backs off ``backoff_distance`` (if the map shows room behind) and turns
         ``recovery_turn`` towards the side where the scan sees more room.
         """
-        cfg = self.config
+        cfg, robot = self.config, self.robot
         x, y, theta = (float(v) for v in np.asarray(pose, dtype=np.float64)[:3])
-        rate = 0.8 * cfg.max_angular_speed
-        phases: list[tuple[float, float]] = []  # (duration, v, w) without the end times yet
+        rate = 0.8 * robot.max_angular_speed
+        phases: list[tuple[float, float, float]] = []  # (duration, v, w) without the end times yet
         points = scan_points(ranges, laser)
         push = None
         if points.shape[0] and cfg.backoff_distance > 0.0:
             dist = stablemath.hypot(points[:, 0], points[:, 1])
             k = int(np.argmin(dist))
-            if dist[k] < cfg.robot_radius + _CONTACT:
+            if dist[k] < robot.radius + _CONTACT:
                 away = math.atan2(-points[k, 1], -points[k, 0])  # robot frame
                 direction = 1.0 if abs(away) <= 0.5 * math.pi else -1.0
                 turn = away if direction > 0 else math.remainder(away - math.pi, 2.0 * math.pi)
@@ -171,7 +175,7 @@ class Recovery:
                 start = (x + _CONTACT * ux, y + _CONTACT * uy)
                 for share in (1.0, 0.6, 0.3):  # as far as the map shows room for
                     length = share * cfg.backoff_distance
-                    if segment_clear(occupancy, start, (x + length * ux, y + length * uy), cfg.robot_radius - _CONTACT):
+                    if segment_clear(occupancy, start, (x + length * ux, y + length * uy), robot.radius - _CONTACT):
                         push = (turn, direction, length)
                         break
         if push is not None:
@@ -180,7 +184,7 @@ class Recovery:
             phases.append((length / cfg.backoff_speed, direction * cfg.backoff_speed, 0.0))
         else:
             behind = (x - (cfg.backoff_distance + 0.05) * math.cos(theta), y - (cfg.backoff_distance + 0.05) * math.sin(theta))
-            if cfg.backoff_distance > 0.0 and segment_clear(occupancy, (x, y), behind, cfg.robot_radius):
+            if cfg.backoff_distance > 0.0 and segment_clear(occupancy, (x, y), behind, robot.radius):
                 phases.append((cfg.backoff_distance / cfg.backoff_speed, -cfg.backoff_speed, 0.0))
             if cfg.recovery_turn > 0.0:
                 phases.append((cfg.recovery_turn / rate, 0.0, open_side(ranges, laser) * rate))

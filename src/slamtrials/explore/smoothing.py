@@ -143,7 +143,8 @@ def resample_polyline(points: NDArray[np.floating], spacing: float) -> NDArray[n
         return pts.copy()
     if spacing <= 0.0:
         raise ValueError(f"spacing must be positive, got {spacing}")
-    seg = stablemath.hypot(*np.diff(pts, axis=0).T)
+    step = np.diff(pts, axis=0)
+    seg = stablemath.hypot(step[:, 0], step[:, 1])
     parts = np.maximum(np.ceil(seg / spacing).astype(np.int64), 1)
     starts = np.repeat(pts[:-1], parts, axis=0)
     deltas = np.repeat(np.diff(pts, axis=0) / parts[:, None], parts, axis=0)

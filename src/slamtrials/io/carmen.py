@@ -18,6 +18,9 @@ logger's timestamp the seconds since logging started. slamtrials reads and write
 
 Other line types (``RLASER``, ``ROBOTLASER2``, ``RAWLASER1..4``, ``TRUEPOS``, ``SYNC``, ...) are skipped
 and counted. Ranges are written to the millimetre (CARMEN's ``%.3f``), other numbers to 6 decimals.
+Logs may be gzip- or bzip2-compressed. What the reader tolerates in logs of the wild (pose-only
+``FLASER 0`` lines, ``nan`` poses, timestamps going backwards, beam counts that change, a truncated last
+line, PARAM trailers) is listed in :mod:`slamtrials.io.carmen_read` and docs/real-datasets.md.
 
 Which pose is which. Each laser line has two pose triples. In logs of real robots the first is the pose
 of the laser, often corrected afterwards by a SLAM program (in ``mit-csail.clf`` the two are equal),
@@ -42,7 +45,7 @@ from slamtrials.io.carmen_log import LASER_KINDS, ROBOTLASER_EXTRA, CarmenLaser,
 from slamtrials.io.carmen_read import PARAM_MOUNT, PARAM_RANGE_MIN, read_carmen
 from slamtrials.io.carmen_write import write_carmen
 from slamtrials.io.textfile import float_text
-from slamtrials.record import RunRecord
+from slamtrials.record import LaserGeometry, RunRecord, Trajectory
 
 __all__ = [
     "CarmenLaser",
@@ -51,6 +54,7 @@ __all__ = [
     "read_carmen",
     "write_carmen",
     "carmen_from_run",
+    "carmen_from_trajectory",
     "run_from_carmen",
     "TRUTH_SOURCE",
 ]
@@ -101,18 +105,44 @@ def carmen_from_run(record: RunRecord, *, kind: str = "ROBOTLASER1", hostname: s
     if kind == "ROBOTLASER1":
         extra = np.zeros((len(t), len(ROBOTLASER_EXTRA)))
         extra[:, 0], extra[:, 1] = tv, rv
-    mount = [float(v) for v in laser.get("mount", (0.0, 0.0, 0.0))]
-    params = {name: float_text(value) for name, value in zip(PARAM_MOUNT, mount)}
-    params[PARAM_RANGE_MIN] = float_text(laser.get("range_min", 0.0))
+    params = {name: float_text(value) for name, value in zip(PARAM_MOUNT, laser.mount)}
+    params[PARAM_RANGE_MIN] = float_text(laser.range_min)
     return CarmenLog(
         laser=CarmenLaser(kind=kind, t=t.copy(), logger_t=logger_t, hostname=hostname,
                           ranges=np.asarray(record.scans, dtype=np.float32), pose=np.asarray(record.truth, dtype=np.float64),
-                          odometry=odometry, angle_min=float(laser["angle_min"]), angle_increment=float(laser["angle_increment"]),
-                          range_max=float(laser["range_max"]), extra=extra),
+                          odometry=odometry, angle_min=laser.angle_min, angle_increment=laser.angle_increment,
+                          range_max=laser.range_max, extra=extra),
         odom=CarmenOdometry(t=t.copy(), logger_t=logger_t.copy(), hostname=hostname, pose=odometry.copy(),
                             tv=tv, rv=rv, accel=np.zeros(len(t))),
         params=params,
     )
+
+
+def carmen_from_trajectory(trajectory: Trajectory, *, hostname: str = "slamtrials") -> CarmenLog:
+    """A trajectory as the Freiburg evaluator's test logs hold one: ``FLASER 0 x y th x y th ts host ts``.
+
+    Both pose triples are the trajectory's pose (the metricEvaluator reads the second, slamtrials'
+    ``evaluate`` either), ``logger_t`` is the time since the first pose, and there are no ODOM lines.
+
+    Parameters
+    ----------
+    trajectory:
+        Poses ``[N, 3]`` (m, m, rad) at strictly increasing times (s).
+    hostname:
+        ``ipc_hostname`` of every line.
+    """
+    t = np.asarray(trajectory.t, dtype=np.float64)
+    poses = np.asarray(trajectory.poses, dtype=np.float64)
+    laser = CarmenLaser(kind="FLASER", t=t.copy(), logger_t=t - t[0] if len(t) else t.copy(), hostname=hostname,
+                        ranges=np.zeros((len(t), 0), dtype=np.float32), pose=poses.copy(), odometry=poses.copy(),
+                        angle_min=0.0, angle_increment=0.0, range_max=0.0)
+    return CarmenLog(laser=laser)
+
+
+def _param_float(params: dict[str, str], name: str) -> float:
+    """A numeric PARAM as :func:`read_carmen` checked it (its value's first token), 0 when absent."""
+    words = params.get(name, "0").split()
+    return float(words[0]) if words else 0.0
 
 
 def run_from_carmen(log: CarmenLog) -> RunRecord:
@@ -123,16 +153,14 @@ def run_from_carmen(log: CarmenLog) -> RunRecord:
     pose triple and ``stalled`` all False. A CARMEN log has no ground truth: ``truth`` is only as good as
     the pose its first triple holds, and ``metadata["truth_source"]`` says so (:data:`TRUTH_SOURCE`).
     The laser mounting and minimum range come from the PARAMs :data:`~slamtrials.io.carmen_read.PARAM_MOUNT`
-    and ``slamtrials_laser_range_min`` when present, else zero.
+    and ``slamtrials_laser_range_min`` when present, else zero. ``metadata["carmen_tolerated"]`` keeps
+    what the reader tolerated (:attr:`CarmenLog.tolerated`).
     """
     laser, params = log.laser, log.params
-    geometry: dict[str, Any] = {
-        "angle_min": float(laser.angle_min),
-        "angle_increment": float(laser.angle_increment),
-        "range_min": float(params.get(PARAM_RANGE_MIN, 0.0)),
-        "range_max": float(laser.range_max),
-        "mount": [float(params.get(name, 0.0)) for name in PARAM_MOUNT],
-    }
+    mount = [_param_float(params, name) for name in PARAM_MOUNT]
+    geometry = LaserGeometry(angle_min=float(laser.angle_min), angle_increment=float(laser.angle_increment),
+                             range_min=_param_float(params, PARAM_RANGE_MIN), range_max=float(laser.range_max),
+                             mount=(mount[0], mount[1], mount[2]))
     hosts = sorted(set(laser.hostnames()))
     metadata: dict[str, Any] = {
         "source_format": "carmen",
@@ -142,7 +170,8 @@ def run_from_carmen(log: CarmenLog) -> RunRecord:
         "carmen_odom_lines": len(log.odom),
         "carmen_params": dict(params),
         "carmen_skipped": dict(log.skipped),
-        "field_of_view_deg": math.degrees(laser.angle_increment * (laser.beams - 1)),
+        "carmen_tolerated": dict(log.tolerated),
+        "field_of_view_deg": math.degrees(laser.angle_increment * max(laser.beams - 1, 0)),
     }
     n = len(laser)
     return RunRecord(t=laser.t.copy(), scans=laser.ranges.astype(np.float32, copy=True), odometry=laser.odometry.copy(),

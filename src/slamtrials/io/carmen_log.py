@@ -68,6 +68,9 @@ class CarmenLaser:
     extra:
         float64 ``[N, 5]`` ROBOTLASER1's ``laser_tv laser_rv forward_safety_dist side_safety_dist
         turn_axis`` (m/s, rad/s, m, m, m), or None (FLASER, or not known: written as zeros).
+    line_readings:
+        int64 ``[N]`` number of readings each line held in the file (set by the reader: the scans may
+        have been padded to a common grid, or not read at all), or None (then ``B`` for every line).
     """
 
     kind: str
@@ -84,6 +87,7 @@ class CarmenLaser:
     accuracy: float = 0.0
     remission_mode: int = 0
     extra: NDArray[np.float64] | None = None
+    line_readings: NDArray[np.int64] | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in LASER_KINDS:
@@ -95,6 +99,8 @@ class CarmenLaser:
                   "pose": (self.pose, (n, 3)), "odometry": (self.odometry, (n, 3))}
         if self.extra is not None:
             shapes["extra"] = (self.extra, (n, len(ROBOTLASER_EXTRA)))
+        if self.line_readings is not None:
+            shapes["line_readings"] = (self.line_readings, (n,))
         _check("CarmenLaser", shapes)
         _check_host("CarmenLaser", self.hostname, n)
 
@@ -109,6 +115,13 @@ class CarmenLaser:
     def hostnames(self) -> list[str]:
         """The ``ipc_hostname`` of every line, a list of ``N`` strings."""
         return _hostnames(self.hostname, len(self))
+
+    @property
+    def pose_only(self) -> bool:
+        """No line held a reading: a trajectory written as laser lines (``FLASER 0 x y th x y th ...``)."""
+        if self.line_readings is not None:
+            return not bool(np.any(self.line_readings))
+        return self.beams == 0
 
 
 @dataclass(eq=False)
@@ -174,9 +187,14 @@ class CarmenLog:
     skipped:
         Line types read past without being interpreted (e.g. ``RLASER``, ``RAWLASER1``, ``TRUEPOS``,
         ``SYNC``) -> number of such lines. Never written back.
+    tolerated:
+        Oddities the reader tolerated -> number of lines (keys and meanings in
+        :data:`slamtrials.io.carmen_read.TOLERATED`: lines with non-finite poses skipped, timestamps
+        reordered, a truncated last line, scans padded, ...). Never written back.
     """
 
     laser: CarmenLaser
     odom: CarmenOdometry = field(default_factory=CarmenOdometry.empty)
     params: dict[str, str] = field(default_factory=dict)
     skipped: dict[str, int] = field(default_factory=dict)
+    tolerated: dict[str, int] = field(default_factory=dict)

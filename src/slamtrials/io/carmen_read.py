@@ -1,7 +1,26 @@
-"""Reading CARMEN logs: :func:`read_carmen` (the format is described in :mod:`slamtrials.io.carmen`)."""
+"""Reading CARMEN logs: :func:`read_carmen` (the format is described in :mod:`slamtrials.io.carmen`).
+
+What logs in the wild hold, and what the Freiburg evaluation program reads, is tolerated; each kind of
+oddity is counted in :attr:`CarmenLog.tolerated` and logged once, as one warning line:
+
+* a laser or ODOM line with a non-finite pose or timestamp (``nan``, ``inf``): skipped;
+* laser or ODOM timestamps that go backwards: the lines are ordered by timestamp (stable sort);
+* laser lines that repeat an earlier line's timestamp: the first in the file is kept;
+* a last line cut short (no newline at the end of the file, and the line does not parse): skipped;
+* laser lines with zero readings (``FLASER 0 x y th x y th ts host ts``, a pose-only trajectory as SLAM
+  programs write them for the Freiburg tool): read, with ``ranges`` ``[N, 0]`` if every line has none;
+* a beam count or geometry that changes between laser lines: the scans are stacked on their common
+  angular grid, padded with no-return readings (:mod:`slamtrials.io.carmen_grid`), or refused at the
+  first line on another grid. ``read_carmen(path, ranges=False)`` reads only the poses, whatever the
+  readings (what evaluation needs);
+* PARAM lines with any trailing fields (a numeric PARAM is its value's first token).
+
+A line broken anywhere else is a FormatError naming the file and the line.
+"""
 
 from __future__ import annotations
 
+import logging
 import math
 from collections import Counter
 from pathlib import Path
@@ -10,10 +29,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from slamtrials.errors import FormatError
+from slamtrials.io.carmen_grid import common_grid
+from slamtrials.io.carmen_lines import CONFIG, EXTRA, LaserLine, param_number, parse_flaser, parse_odom, parse_param, parse_robotlaser
 from slamtrials.io.carmen_log import LASER_KINDS, CarmenLaser, CarmenLog, CarmenOdometry
-from slamtrials.io.textfile import data_lines, first_bad_row, last_line, parse_floats, parse_int, read_lines
+from slamtrials.io.textfile import data_lines, first_bad_row, last_line, read_lines
 
-__all__ = ["read_carmen", "PARAM_RANGE_MAX", "PARAM_FOV", "PARAM_RESOLUTION", "PARAM_MOUNT", "PARAM_RANGE_MIN"]
+__all__ = ["read_carmen", "PARAM_RANGE_MAX", "PARAM_FOV", "PARAM_RESOLUTION", "PARAM_MOUNT", "PARAM_RANGE_MIN", "TOLERATED"]
+
+log = logging.getLogger(__name__)
+
+_FLOAT32_MAX = float(np.finfo(np.float32).max)
 
 #: PARAM names that give an old-format (FLASER) laser's geometry: metres, degrees, degrees.
 PARAM_RANGE_MAX = "robot_front_laser_max"
@@ -24,148 +49,123 @@ PARAM_MOUNT = ("robot_frontlaser_offset", "robot_frontlaser_side_offset", "robot
 #: Not a CARMEN parameter: the minimum range (m) of a laser simulated by slamtrials.
 PARAM_RANGE_MIN = "slamtrials_laser_range_min"
 
-_POSES = ("x", "y", "theta", "odom_x", "odom_y", "odom_theta")
-_ROBOT_POSES = ("laser_pose_x", "laser_pose_y", "laser_pose_theta", "robot_pose_x", "robot_pose_y", "robot_pose_theta")
-_EXTRA = ("laser_tv", "laser_rv", "forward_safety_dist", "side_safety_dist", "turn_axis")
-_CONFIG = ("start_angle", "field_of_view", "angular_resolution", "maximum_range", "accuracy")
-_ODOM = ("x", "y", "theta", "tv", "rv", "accel", "ipc_timestamp", "logger_timestamp")
+#: Keys of :attr:`CarmenLog.tolerated` -> what the warning says about the lines counted ({kind}: the
+#: line type).
+TOLERATED = {
+    "laser_nonfinite": "{kind} lines with a non-finite pose, velocity or timestamp skipped",
+    "laser_reordered": "{kind} lines with a timestamp earlier than a line before them: laser lines ordered by timestamp (stable)",
+    "laser_duplicate": "{kind} lines repeat an earlier line's timestamp: the first in the file kept",
+    "laser_padded": "{kind} lines with fewer readings than the common grid padded with no-return readings",
+    "laser_range_raised": "{kind} lines with a shorter maximum range: their no-return readings raised to the common one",
+    "odom_nonfinite": "ODOM lines with a non-finite pose, velocity or timestamp skipped",
+    "odom_reordered": "ODOM lines with a timestamp earlier than a line before them: ODOM lines ordered by timestamp (stable)",
+    "truncated_last_line": "the last line is cut short (no newline at the end of the file): skipped",
+}
 
 
-def _flaser(path: Path, line: int, tokens: list[str]) -> tuple[NDArray[np.float64], int]:
-    """``FLASER n r_1..r_n x y theta odom_x odom_y odom_theta ipc_timestamp ipc_hostname logger_timestamp``
-    -> ``[r_1..r_n, x..odom_theta, ipc_timestamp, logger_timestamp]``."""
-    if len(tokens) < 2:
-        raise FormatError(path, "FLASER line ends before num_readings", line=line)
-    n = parse_int(path, line, tokens[1], 2, "num_readings", minimum=1)
-    if len(tokens) != n + 11:
-        raise FormatError(path, f"FLASER with num_readings {n} needs {n + 11} fields (FLASER n, {n} ranges, "
-                          f"6 pose numbers, ipc_timestamp ipc_hostname logger_timestamp), got {len(tokens)}", line=line)
-    values = parse_floats(path, line, tokens[2 : n + 9], 3, "range, pose or ipc_timestamp")
-    values += parse_floats(path, line, tokens[-1:], n + 11, "logger_timestamp")
-    return np.array(values), n
+class _Tally:
+    """Counts of tolerated oddities, the first line of each, and one warning per kind."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self.counts: dict[str, int] = {}
+        self.first: dict[str, int] = {}
+
+    def add(self, key: str, lines: list[int] | NDArray[np.int64]) -> None:
+        lines = [int(v) for v in lines]
+        if lines:
+            self.counts[key] = self.counts.get(key, 0) + len(lines)
+            self.first[key] = min(self.first.get(key, lines[0]), min(lines))
+
+    def warn(self, kind: str, detail: dict[str, str]) -> None:
+        for key, count in self.counts.items():
+            what = TOLERATED[key].format(kind=kind) + detail.get(key, "")
+            if key == "truncated_last_line":
+                log.warning("%s:%d: %s", self.path, self.first[key], what)
+            else:
+                log.warning("%s: %d %s (first: line %d)", self.path, count, what, self.first[key])
 
 
-def _robotlaser(path: Path, line: int, tokens: list[str]) -> tuple[NDArray[np.float64], int, tuple[int, int]]:
-    """``ROBOTLASER1 laser_type start_angle field_of_view angular_resolution maximum_range accuracy
-    remission_mode n r_1..r_n m e_1..e_m laser_pose(3) robot_pose(3) laser_tv laser_rv
-    forward_safety_dist side_safety_dist turn_axis ipc_timestamp ipc_hostname logger_timestamp``
-    -> ``[start_angle..accuracy, r_1..r_n, laser_pose, robot_pose, laser_tv..turn_axis, ipc_timestamp,
-    logger_timestamp]`` (remissions are checked to be numbers, then dropped) and the two integers."""
-    if len(tokens) < 10:
-        raise FormatError(path, f"ROBOTLASER1 line ends after {len(tokens)} fields, before its readings", line=line)
-    laser_type = parse_int(path, line, tokens[1], 2, "laser_type")
-    remission_mode = parse_int(path, line, tokens[7], 8, "remission_mode")
-    n = parse_int(path, line, tokens[8], 9, "num_readings", minimum=1)
-    if len(tokens) < n + 10:
-        raise FormatError(path, f"ROBOTLASER1 with num_readings {n} ends after {len(tokens)} fields, before num_remissions",
-                          line=line)
-    m = parse_int(path, line, tokens[n + 9], n + 10, "num_remissions")
-    if len(tokens) != n + m + 24:
-        raise FormatError(path, f"ROBOTLASER1 with num_readings {n} and num_remissions {m} needs {n + m + 24} fields, "
-                          f"got {len(tokens)}", line=line)
-    values = parse_floats(path, line, tokens[2:7], 3, "laser configuration")
-    values += parse_floats(path, line, tokens[9 : n + 9], 10, "range")
-    parse_floats(path, line, tokens[n + 10 : n + m + 10], n + 11, "remission")
-    values += parse_floats(path, line, tokens[n + m + 10 : n + m + 22], n + m + 11, "pose, velocity, distance or ipc_timestamp")
-    values += parse_floats(path, line, tokens[-1:], n + m + 24, "logger_timestamp")
-    return np.array(values), n, (laser_type, remission_mode)
-
-
-def _param(path: Path, line: int, tokens: list[str]) -> tuple[str, str]:
-    """``PARAM name value [ipc_timestamp ipc_hostname logger_timestamp]``; a value may hold spaces."""
-    if len(tokens) < 3:
-        raise FormatError(path, "expected 'PARAM name value [ipc_timestamp ipc_hostname logger_timestamp]'", line=line)
-    stamped = len(tokens) >= 6
-    if stamped:
-        try:
-            float(tokens[-3]), float(tokens[-1])
-        except ValueError:
-            stamped = False
-    return tokens[1], " ".join(tokens[2:-3] if stamped else tokens[2:])
-
-
-def _check_rows(path: Path, rows: NDArray[np.float64], numbers: list[int], names: list[str], what: str) -> None:
-    """Every value finite; report the first bad one by line and field name."""
-    bad = first_bad_row(~np.isfinite(rows))
-    if bad is not None:
-        row, col = bad
-        raise FormatError(path, f"{what} {names[col]} is not finite: {rows[row, col]}", line=numbers[row])
-
-
-def _check_times(path: Path, t: NDArray[np.float64], numbers: list[int], what: str, strict: bool) -> None:
-    steps = np.diff(t)
-    back = np.flatnonzero(steps <= 0 if strict else steps < 0)
-    if back.size:
-        i = int(back[0])
-        order = "strictly increasing" if strict else "non-decreasing"
-        raise FormatError(path, f"{what} ipc_timestamps must be {order}: {t[i + 1]!r} after {t[i]!r} (line {numbers[i]})",
-                          line=numbers[i + 1])
-
-
-def _param_number(path: Path, params: dict[str, str], where: dict[str, int], name: str, positive: bool = True) -> float | None:
-    """The numeric PARAM ``name`` (None if absent); FormatError at its line if it is not a (positive) number."""
-    if name not in params:
-        return None
-    try:
-        value = float(params[name])
-    except ValueError:
-        value = math.nan
-    if not math.isfinite(value) or (positive and value <= 0):
-        kind = "a positive number" if positive else "a finite number"
-        raise FormatError(path, f"PARAM {name} must be {kind}, got {params[name][:40]!r}", line=where[name])
-    return value
-
-
-def _flaser_geometry(path: Path, params: dict[str, str], where: dict[str, int], beams: int,
-                     ranges: NDArray[np.float32]) -> tuple[float, float, float]:
-    """angle_min, angle_increment, range_max of an old-format laser, from PARAMs or CARMEN's defaults."""
-    resolution = _param_number(path, params, where, PARAM_RESOLUTION)
-    fov = _param_number(path, params, where, PARAM_FOV)
+def _flaser_geometry(path: Path, params: dict[str, str], where: dict[str, int], beams: int) -> tuple[float, float]:
+    """angle_min and angle_increment (rad) of an old-format laser of ``beams`` beams, from PARAMs or
+    CARMEN's default (180 degrees spread over the beams), centred on the heading."""
+    resolution = param_number(path, params, where, PARAM_RESOLUTION)
+    fov = param_number(path, params, where, PARAM_FOV)
     if resolution is not None:
         increment = math.radians(resolution)
     else:
         spread = math.radians(fov) if fov is not None else math.pi
         increment = spread / (beams - 1) if beams > 1 else 0.0
-    range_max = _param_number(path, params, where, PARAM_RANGE_MAX)
-    if range_max is None:
-        range_max = float(str(ranges.max()))  # shortest decimal of the float32 maximum: 81.91, not 81.910004
-    return -increment * (beams - 1) / 2.0, increment, range_max
+    return -increment * (beams - 1) / 2.0 if beams > 0 else 0.0, increment
 
 
-def read_carmen(path: str | Path) -> CarmenLog:
+def _check_ranges(path: Path, kind: str, ranges: list[NDArray[np.float64]], numbers: list[int]) -> None:
+    """Every reading a finite, non-negative float32 number; FormatError at the first that is not."""
+    for row, values in enumerate(ranges):
+        bad = ~np.isfinite(values) | (values < 0) | (values > _FLOAT32_MAX)
+        if bad.any():
+            col = int(np.argmax(bad))
+            value = values[col]
+            problem = "is not finite" if not np.isfinite(value) else "is negative" if value < 0 else "is too large for float32"
+            raise FormatError(path, f"{kind} range {col + 1} {problem}: {value}", line=numbers[row])
+
+
+def _order(t: NDArray[np.float64], numbers: NDArray[np.int64], tally: _Tally, what: str, unique: bool) -> NDArray[np.int64]:
+    """Indices that put ``t`` in order (stable); with ``unique``, the first of equal timestamps only."""
+    late = np.flatnonzero(t[1:] < np.maximum.accumulate(t)[:-1]) + 1
+    tally.add(f"{what}_reordered", numbers[late])
+    order = np.argsort(t, kind="stable")
+    if unique and len(order) > 1:
+        repeat = np.concatenate([[False], np.diff(t[order]) == 0])
+        tally.add(f"{what}_duplicate", np.sort(numbers[order[repeat]], kind="stable"))
+        order = order[~repeat]
+    return order
+
+
+def read_carmen(path: str | Path, *, ranges: bool = True) -> CarmenLog:
     """Read the front laser (FLASER or ROBOTLASER1), ODOM and PARAM lines of a CARMEN log.
 
     Other line types (``RLASER``, ``ROBOTLASER2``, ``RAWLASER1``, ``TRUEPOS``, ``SYNC``, ...) are
-    skipped and counted in :attr:`CarmenLog.skipped`; ``#`` lines and blank lines are ignored.
+    skipped and counted in :attr:`CarmenLog.skipped`; ``#`` lines and blank lines are ignored. What is
+    tolerated (and counted in :attr:`CarmenLog.tolerated`, and logged once per kind) is listed in the
+    module docstring.
 
     Parameters
     ----------
     path:
-        The log file (plain text; compressed logs must be decompressed first).
+        The log file: plain text, or gzip- or bzip2-compressed (recognised by its first bytes).
+    ranges:
+        Read the readings. False reads only the poses and timestamps (``ranges`` ``[N, 0]``): readings
+        are neither checked nor stacked, so a log whose beam count or geometry changes is read whatever
+        its grids; the geometry is then that of the first line.
 
     Returns
     -------
     CarmenLog
-        Laser lines stacked in file order (``ranges`` float32 [N, B] in metres), the ODOM lines and the
+        Laser lines in timestamp order (``ranges`` float32 [N, B] in metres), the ODOM lines and the
         PARAMs. ROBOTLASER1 lines give their own geometry; FLASER lines take it from the PARAMs
         ``laser_front_laser_resolution`` (deg), ``laser_front_laser_fov`` (deg) and
         ``robot_front_laser_max`` (m), else 180 degrees spread over the beams, centred on the heading
-        (``angle_min = -pi/2``), and the largest range in the log as ``range_max``.
+        (``angle_min = -pi/2``), and the largest range in the log as ``range_max`` (0 without readings).
+        The odometry of a frame is its laser line's own second pose triple; ODOM lines are returned
+        separately, not merged into the frames.
 
     Raises
     ------
     FormatError
         Naming the file and line: a wrong field count (``num_readings`` disagreeing with the fields), a
-        field that is not a (finite) number, a negative range, laser timestamps not strictly increasing
-        or ODOM timestamps decreasing, FLASER and ROBOTLASER1 lines in one log, lines with different beam
-        counts or (ROBOTLASER1) different laser geometry, or no laser line at all.
+        field that is not a number, a reading that is negative or not finite, FLASER and ROBOTLASER1
+        lines in one log, lines whose beams are not on one angular grid (with ``ranges``), a
+        non-positive ROBOTLASER1 maximum range, or no usable laser line at all.
     """
     path = Path(path)
     lines = read_lines(path)
-    rows: list[NDArray[np.float64]] = []
+    cut_short = bool(lines) and lines[-1].strip() != ""  # no newline after the last line
+    final = last_line(lines)
+    tally = _Tally(path)
+    laser_lines: list[LaserLine] = []
     numbers: list[int] = []
     hosts: list[str] = []
-    integers: list[tuple[int, int]] = []
     odom_rows: list[list[float]] = []
     odom_numbers: list[int] = []
     odom_hosts: list[str] = []
@@ -173,100 +173,125 @@ def read_carmen(path: str | Path) -> CarmenLog:
     param_lines: dict[str, int] = {}
     skipped: Counter[str] = Counter()
     kind: str | None = None
-    beams = 0
     for number, tokens in data_lines(lines):
         name = tokens[0]
-        if name in LASER_KINDS:
-            if kind is None:
+        if name in LASER_KINDS and kind is not None and name != kind:
+            raise FormatError(path, f"{name} line in a log of {kind} lines (line {numbers[0]}); slamtrials reads one front laser",
+                              line=number)
+        try:
+            if name in LASER_KINDS:
+                parsed = parse_flaser(path, number, tokens) if name == "FLASER" else parse_robotlaser(path, number, tokens)
                 kind = name
-            elif name != kind:
-                raise FormatError(path, f"{name} line in a log of {kind} lines (line {numbers[0]}); slamtrials reads one front laser",
-                                  line=number)
-            if name == "FLASER":
-                row, n = _flaser(path, number, tokens)
+                laser_lines.append(parsed)
+                numbers.append(number)
+                hosts.append(tokens[-2])
+            elif name == "ODOM":
+                odom_rows.append(parse_odom(path, number, tokens))
+                odom_numbers.append(number)
+                odom_hosts.append(tokens[8])
+            elif name == "PARAM":
+                key, value = parse_param(path, number, tokens)
+                params[key] = value
+                param_lines[key] = number
             else:
-                row, n, ints = _robotlaser(path, number, tokens)
-                integers.append(ints)
-            if rows and n != beams:
-                raise FormatError(path, f"{name} has {n} readings, earlier lines have {beams}", line=number)
-            beams = n
-            rows.append(row)
-            numbers.append(number)
-            hosts.append(tokens[-2])
-        elif name == "ODOM":
-            if len(tokens) != 10:
-                raise FormatError(path, "expected 10 fields 'ODOM x y theta tv rv accel ipc_timestamp ipc_hostname logger_timestamp', "
-                                  f"got {len(tokens)}", line=number)
-            odom_rows.append(parse_floats(path, number, tokens[1:8], 2, _ODOM[:7])
-                             + parse_floats(path, number, tokens[9:], 10, "logger_timestamp"))
-            odom_numbers.append(number)
-            odom_hosts.append(tokens[8])
-        elif name == "PARAM":
-            key, value = _param(path, number, tokens)
-            params[key] = value
-            param_lines[key] = number
-        else:
-            skipped[name] += 1
+                skipped[name] += 1
+        except FormatError:
+            if not (cut_short and number == final):
+                raise
+            tally.add("truncated_last_line", [number])
     for key in (*PARAM_MOUNT, PARAM_RANGE_MIN):
-        _param_number(path, params, param_lines, key, positive=False)
+        param_number(path, params, param_lines, key, positive=False)
     if kind is None:
-        raise FormatError(path, "no FLASER or ROBOTLASER1 line: not a CARMEN log with a front laser", line=last_line(lines))
-    laser = _laser(path, kind, np.stack(rows), numbers, hosts, integers, beams, params, param_lines)
-    return CarmenLog(laser=laser, odom=_odometry(path, odom_rows, odom_numbers, odom_hosts), params=params, skipped=dict(skipped))
+        rear = f" ({skipped['RLASER']} RLASER lines: slamtrials reads the front laser, as the Freiburg evaluator does)" if skipped["RLASER"] else ""
+        raise FormatError(path, f"no FLASER or ROBOTLASER1 line: not a CARMEN log with a front laser{rear}", line=final)
+    laser = _laser(path, kind, laser_lines, numbers, hosts, params, param_lines, tally, ranges)
+    odom = _odometry(path, odom_rows, odom_numbers, odom_hosts, tally)
+    tally.warn(kind, {"laser_padded": f" to {laser.beams} beams ({laser.range_max:g} m)",
+                      "laser_range_raised": f" ({laser.range_max:g} m)"})
+    return CarmenLog(laser=laser, odom=odom, params=params, skipped=dict(skipped), tolerated=dict(tally.counts))
 
 
 def _one_or_all(hosts: list[str]) -> str | list[str]:
     return hosts[0] if hosts and hosts.count(hosts[0]) == len(hosts) else hosts
 
 
-def _laser(path: Path, kind: str, rows: NDArray[np.float64], numbers: list[int], hosts: list[str],
-           integers: list[tuple[int, int]], beams: int, params: dict[str, str], param_lines: dict[str, int]) -> CarmenLaser:
-    ranges_names = [f"range {i + 1}" for i in range(beams)]
-    if kind == "FLASER":
-        names = ranges_names + list(_POSES) + ["ipc_timestamp", "logger_timestamp"]
-        first = 0
+def _geometry(path: Path, kind: str, kept: list[LaserLine], numbers: list[int], params: dict[str, str],
+              where: dict[str, int]) -> NDArray[np.float64]:
+    """float64 ``[N, 3]`` angle of the first beam, increment (rad) and maximum range (m) of each line."""
+    n = len(kept)
+    geometry = np.empty((n, 3))
+    if kind == "ROBOTLASER1":
+        config = np.stack([line.config if line.config is not None else np.full(len(CONFIG), np.nan) for line in kept])
+        bad = first_bad_row(~np.isfinite(config))
+        if bad is not None:
+            raise FormatError(path, f"ROBOTLASER1 {CONFIG[bad[1]]} is not finite: {config[bad]}", line=numbers[bad[0]])
+        small = np.flatnonzero(~((config[:, 3] > 0) & (config[:, 3] <= _FLOAT32_MAX)))
+        if small.size:
+            i = int(small[0])
+            raise FormatError(path, f"ROBOTLASER1 maximum_range must be positive (and a float32), got {config[i, 3]}", line=numbers[i])
+        geometry[:, 0], geometry[:, 1], geometry[:, 2] = config[:, 0], config[:, 2], config[:, 3]
+        return geometry
+    counts = [len(line.ranges) for line in kept]
+    range_max = param_number(path, params, where, PARAM_RANGE_MAX)
+    if range_max is not None and range_max > _FLOAT32_MAX:
+        raise FormatError(path, f"PARAM {PARAM_RANGE_MAX} is too large for float32: {range_max}", line=where[PARAM_RANGE_MAX])
+    if range_max is None:
+        usable = [line.ranges[np.isfinite(line.ranges) & (line.ranges <= _FLOAT32_MAX)] for line in kept]
+        top = max((float(r.max()) for r in usable if len(r)), default=0.0)
+        range_max = float(str(np.float32(top)))  # shortest decimal of the float32 maximum: 81.91, not 81.910004
+    by_count = {count: _flaser_geometry(path, params, where, count) for count in sorted(set(counts))}
+    for i, count in enumerate(counts):
+        geometry[i] = (*by_count[count], range_max)
+    return geometry
+
+
+def _laser(path: Path, kind: str, parsed: list[LaserLine], numbers_list: list[int], hosts: list[str],
+           params: dict[str, str], where: dict[str, int], tally: _Tally, with_ranges: bool) -> CarmenLaser:
+    numbers = np.asarray(numbers_list, dtype=np.int64)
+    stamps = np.stack([line.stamps for line in parsed])
+    finite = np.isfinite(stamps).all(axis=1)
+    tally.add("laser_nonfinite", numbers[~finite])
+    keep = np.flatnonzero(finite)
+    if keep.size == 0:
+        raise FormatError(path, f"every {kind} line has a non-finite pose or timestamp", line=int(numbers[0]))
+    order = keep[_order(stamps[keep, -2], numbers[keep], tally, "laser", unique=True)]
+    kept = [parsed[i] for i in order.tolist()]
+    kept_numbers = numbers[order].tolist()
+    readings = [line.ranges for line in kept]
+    if with_ranges:
+        _check_ranges(path, kind, readings, kept_numbers)
+    geometry = _geometry(path, kind, kept, kept_numbers, params, where)
+    if with_ranges:
+        grid = common_grid(path, kind, kept_numbers, readings, geometry)
+        tally.add("laser_padded", np.asarray(kept_numbers)[grid.padded])
+        tally.add("laser_range_raised", np.asarray(kept_numbers)[grid.raised])
+        scans, angle_min, increment, range_max = grid.ranges, grid.angle_min, grid.angle_increment, grid.range_max
     else:
-        names = list(_CONFIG) + ranges_names + list(_ROBOT_POSES) + list(_EXTRA) + ["ipc_timestamp", "logger_timestamp"]
-        first = len(_CONFIG)
-    _check_rows(path, rows, numbers, names, kind)
-    ranges = rows[:, first : first + beams]
-    negative = first_bad_row(ranges < 0)
-    if negative is not None:
-        row, col = negative
-        raise FormatError(path, f"{kind} range {col + 1} is negative: {ranges[row, col]}", line=numbers[row])
-    huge = first_bad_row(ranges > np.finfo(np.float32).max)
-    if huge is not None:
-        row, col = huge
-        raise FormatError(path, f"{kind} range {col + 1} is too large for float32: {ranges[row, col]}", line=numbers[row])
-    ranges = ranges.astype(np.float32)
-    poses = rows[:, first + beams : first + beams + 6]
-    t, logger_t = rows[:, -2].copy(), rows[:, -1].copy()
-    _check_times(path, t, numbers, kind, strict=True)
-    common = dict(kind=kind, t=t, logger_t=logger_t, hostname=_one_or_all(hosts), ranges=ranges,
-                  pose=poses[:, :3].copy(), odometry=poses[:, 3:].copy())
-    if kind == "FLASER":
-        angle_min, increment, range_max = _flaser_geometry(path, params, param_lines, beams, ranges)
-        return CarmenLaser(**common, angle_min=angle_min, angle_increment=increment, range_max=range_max)
-    config = rows[:, :4]
-    differ = np.flatnonzero((config != config[0]).any(axis=1))
-    if differ.size:
-        i = int(differ[0])
-        raise FormatError(path, "ROBOTLASER1 start_angle, field_of_view, angular_resolution or maximum_range differ "
-                          f"from line {numbers[0]}", line=numbers[i])
-    if not config[0, 3] > 0:
-        raise FormatError(path, f"ROBOTLASER1 maximum_range must be positive, got {config[0, 3]}", line=numbers[0])
-    return CarmenLaser(**common, angle_min=float(config[0, 0]), angle_increment=float(config[0, 2]),
-                       range_max=float(config[0, 3]),
-                       laser_type=integers[0][0], accuracy=float(rows[0, 4]), remission_mode=integers[0][1],
-                       extra=rows[:, first + beams + 6 : first + beams + 11].copy())
+        scans = np.zeros((len(kept), 0), dtype=np.float32)
+        angle_min, increment, range_max = (float(v) for v in geometry[0])
+    rows = stamps[order]
+    first = kept[0]
+    integers = first.integers if first.integers is not None else (0, 0)  # ROBOTLASER1's laser_type, remission_mode
+    return CarmenLaser(kind=kind, t=rows[:, -2].copy(), logger_t=rows[:, -1].copy(),
+                       hostname=_one_or_all([hosts[i] for i in order.tolist()]), ranges=scans, pose=rows[:, :3].copy(),
+                       odometry=rows[:, 3:6].copy(), angle_min=angle_min, angle_increment=increment, range_max=range_max,
+                       laser_type=integers[0], accuracy=float(first.config[4]) if first.config is not None else 0.0,
+                       remission_mode=integers[1], extra=rows[:, 6 : 6 + len(EXTRA)].copy() if kind == "ROBOTLASER1" else None,
+                       line_readings=np.array([len(r) for r in readings], dtype=np.int64))
 
 
-def _odometry(path: Path, rows: list[list[float]], numbers: list[int], hosts: list[str]) -> CarmenOdometry:
+def _odometry(path: Path, rows: list[list[float]], numbers_list: list[int], hosts: list[str], tally: _Tally) -> CarmenOdometry:
     if not rows:
         return CarmenOdometry.empty()
     values = np.array(rows, dtype=np.float64)
-    _check_rows(path, values, numbers, list(_ODOM), "ODOM")
-    _check_times(path, values[:, 6], numbers, "ODOM", strict=False)
-    return CarmenOdometry(t=values[:, 6].copy(), logger_t=values[:, 7].copy(), hostname=_one_or_all(hosts),
-                          pose=values[:, :3].copy(),
-                          tv=values[:, 3].copy(), rv=values[:, 4].copy(), accel=values[:, 5].copy())
+    numbers = np.asarray(numbers_list, dtype=np.int64)
+    finite = np.isfinite(values).all(axis=1)
+    tally.add("odom_nonfinite", numbers[~finite])
+    keep = np.flatnonzero(finite)
+    if keep.size == 0:
+        return CarmenOdometry.empty()
+    order = keep[_order(values[keep, 6], numbers[keep], tally, "odom", unique=False)]
+    values = values[order]
+    return CarmenOdometry(t=values[:, 6].copy(), logger_t=values[:, 7].copy(), hostname=_one_or_all([hosts[i] for i in order.tolist()]),
+                          pose=values[:, :3].copy(), tv=values[:, 3].copy(), rv=values[:, 4].copy(), accel=values[:, 5].copy())
+

@@ -61,6 +61,8 @@ def _stamps(name: str, t: NDArray[np.float64], strict: bool) -> tuple[list[str],
 def _geometry_params(laser: CarmenLaser) -> dict[str, str]:
     """The PARAMs that give a FLASER laser its geometry; the scan must be centred on the heading."""
     beams, increment = laser.beams, float(laser.angle_increment)
+    if beams == 0:  # a pose-only trajectory: no laser to describe
+        return {}
     params = {PARAM_RANGE_MAX: float_text(laser.range_max)}
     if beams > 1:
         if not increment > 0 or not math.isclose(laser.angle_min, -increment * (beams - 1) / 2, rel_tol=1e-12, abs_tol=1e-12):
@@ -82,13 +84,13 @@ def _check(log: CarmenLog) -> None:
         _finite("laser.extra", laser.extra)
     for name in ("angle_min", "angle_increment", "range_max", "accuracy"):
         _finite(f"laser.{name}", np.asarray(getattr(laser, name), dtype=np.float64))
-    if not laser.range_max > 0:
+    if laser.beams and not laser.range_max > 0:
         raise ValueError(f"write_carmen: laser.range_max must be positive, got {laser.range_max}")
     if (laser.ranges < 0).any():
         raise ValueError("write_carmen: laser.ranges holds negative ranges")
     for name in ("t", "logger_t", "pose", "tv", "rv", "accel"):
         _finite(f"odom.{name}", getattr(odom, name))
-    for host in set(laser.hostnames()) | set(odom.hostnames()):
+    for host in sorted(set(laser.hostnames()) | set(odom.hostnames())):  # sorted: the same host named first on every run
         _token("hostname", host)
     for key, value in log.params.items():
         _token("PARAM name", key)

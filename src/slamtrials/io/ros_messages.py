@@ -16,7 +16,7 @@ topic                           type                         content
 ``/tf_static`` (ROS 2 only)     ``tf2_msgs/TFMessage``       ``base_link -> base_laser_link`` once,
                                                              transient-local QoS
 ``/stall``                      ``std_msgs/Int8``            ``record.stalled`` (1 when stalled)
-``/slamtrials/run``             ``std_msgs/String``          JSON: time origin, laser dict, metadata
+``/slamtrials/run``             ``std_msgs/String``          JSON: time origin, laser geometry, metadata
 ==============================  ===========================  ==========================================
 
 Frames (REP 105): the ground truth is in ``map``, the fixed frame whose coordinates are those of the
@@ -183,12 +183,12 @@ def scan_period(record: Any) -> float:
 
 
 def run_info_json(record: Any, time_origin_ns: int) -> str:
-    """The JSON document of ``/slamtrials/run``: format, time origin (ns), frames, laser dict, metadata."""
+    """The JSON document of ``/slamtrials/run``: format, time origin (ns), frames, laser geometry, metadata."""
     doc = {
         "format": RUN_INFO_FORMAT,
         "time_origin_ns": int(time_origin_ns),
         "frames": len(record.t),
-        "laser": record.laser,
+        "laser": record.laser.to_dict(),
         "metadata": record.metadata,
     }
     return json.dumps(doc, default=json_default)

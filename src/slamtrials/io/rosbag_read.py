@@ -2,7 +2,7 @@
 
 Works on the bags :mod:`slamtrials.io.rosbag_write` writes, exactly: float32 scans identical, x and y
 bit for bit, yaw to about 1e-15 rad (it passes through a quaternion and comes back wrapped into
-(-pi, pi]), ``t`` to the nanosecond, and the laser dict, stall flags and metadata restored. And on
+(-pi, pi]), ``t`` to the nanosecond, and the laser geometry, stall flags and metadata restored. And on
 recordings of real robots: any bag with a ``sensor_msgs/LaserScan`` topic, odometry as
 ``nav_msgs/Odometry`` (or as ``odom -> base_link`` transforms on ``/tf``) and, optionally, ground truth
 as ``nav_msgs/Odometry``.
@@ -36,7 +36,7 @@ from slamtrials.errors import FormatError
 from slamtrials.geometry import interpolate
 from slamtrials.io import ros_messages as rm
 from slamtrials.io.rosbag_source import DECODE_ERRORS, BagSource, open_bag
-from slamtrials.record import RunRecord
+from slamtrials.record import LaserGeometry, RunRecord
 
 __all__ = ["run_from_bag", "bag_topics"]
 
@@ -300,6 +300,14 @@ def _parse_run_info(bag: BagSource, text: str | None) -> dict[str, Any] | None:
     return doc
 
 
+def _info_laser(bag: BagSource, info: dict[str, Any]) -> LaserGeometry:
+    """The laser geometry of a checked ``/slamtrials/run`` document."""
+    try:
+        return LaserGeometry.from_dict(info["laser"])
+    except ValueError as exc:
+        raise FormatError(bag.path, f"{rm.RUN_INFO_TOPIC}: laser: {exc}") from None
+
+
 def _scans(bag: BagSource, topic: str, ranges: list[np.ndarray]) -> np.ndarray:
     if not ranges:
         raise FormatError(bag.path, f"topic {topic} has no messages")
@@ -309,25 +317,22 @@ def _scans(bag: BagSource, topic: str, ranges: list[np.ndarray]) -> np.ndarray:
     return np.stack(ranges).astype(np.float32, copy=False)
 
 
-def _laser_from_scans(bag: BagSource, want: _Wanted, data: _Collected, notes: dict[str, Any]) -> dict[str, Any]:
+def _laser_from_scans(bag: BagSource, want: _Wanted, data: _Collected, notes: dict[str, Any]) -> LaserGeometry:
     scan = data.first_scan
-    laser = {
-        "angle_min": float(scan.angle_min),
-        "angle_increment": float(scan.angle_increment),
-        "range_min": float(scan.range_min),
-        "range_max": float(scan.range_max),
-    }
     frame = scan.header.frame_id.lstrip("/")
-    mount = _find_mount(bag, want, frame, data)
-    if mount is None:
-        laser["mount"] = [0.0, 0.0, 0.0]
+    found = _find_mount(bag, want, frame, data)
+    if found is None:
+        mount = (0.0, 0.0, 0.0)
         notes["laser_mount"] = f"no transform {want.base_frame} -> {frame} in the bag; assumed zero"
         log.warning("%s: no transform %s -> %s; assuming the laser sits at the base origin", bag.path, want.base_frame, frame)
     else:
-        yaw = float(rm.quaternion_yaw(np.asarray(mount[2:6])))
-        laser["mount"] = [mount[0], mount[1], yaw]
+        mount = (float(found[0]), float(found[1]), float(rm.quaternion_yaw(np.asarray(found[2:6]))))
         notes["laser_mount"] = f"transform {want.base_frame} -> {frame}"
-    return laser
+    try:
+        return LaserGeometry(angle_min=float(scan.angle_min), angle_increment=float(scan.angle_increment),
+                             range_min=float(scan.range_min), range_max=float(scan.range_max), mount=mount)
+    except ValueError as exc:
+        raise FormatError(bag.path, f"topic {want.scan}: first scan's geometry: {exc}") from None
 
 
 def _assemble(bag: BagSource, data: _Collected, want: _Wanted, pairing: str) -> RunRecord:
@@ -360,7 +365,7 @@ def _assemble(bag: BagSource, data: _Collected, want: _Wanted, pairing: str) -> 
     info = _parse_run_info(bag, data.run_info)
     notes: dict[str, Any] = {}
     if info is not None:
-        laser, metadata, origin = dict(info["laser"]), dict(info["metadata"]), int(info["time_origin_ns"])
+        laser, metadata, origin = _info_laser(bag, info), dict(info["metadata"]), int(info["time_origin_ns"])
     else:
         laser, metadata, origin = _laser_from_scans(bag, want, data, notes), {}, int(scan_stamps[0])
     t = (scan_stamps - origin).astype(np.float64) / 1e9

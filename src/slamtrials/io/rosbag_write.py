@@ -261,11 +261,11 @@ def _messages(record: RunRecord, stamps: np.ndarray, origin: int, *, ros: int) -
     has_truth = np.isfinite(truth).all(axis=1)
     laser = record.laser
     beams = scans.shape[1]
-    angle_min = float(laser["angle_min"])
-    increment = float(laser["angle_increment"])
+    angle_min = laser.angle_min
+    increment = laser.angle_increment
     angle_max = angle_min + (beams - 1) * increment
     period = rm.scan_period(record)
-    mount = np.asarray(laser.get("mount", (0.0, 0.0, 0.0)), dtype=np.float64)
+    mount = np.asarray(laser.mount, dtype=np.float64)
     mount_q = rm.yaw_quaternions(mount[2])
     no_intensities = np.zeros(0, dtype=np.float32)
     stamp_list = [int(s) for s in stamps]
@@ -284,8 +284,8 @@ def _messages(record: RunRecord, stamps: np.ndarray, origin: int, *, ros: int) -
             angle_increment=increment,
             time_increment=0.0,
             scan_time=period,
-            range_min=float(laser["range_min"]),
-            range_max=float(laser["range_max"]),
+            range_min=laser.range_min,
+            range_max=laser.range_max,
             ranges=scans[k],
             intensities=no_intensities,
         )

@@ -27,18 +27,18 @@ import numpy as np
 from slamtrials.__about__ import __version__, source_revision
 from slamtrials.atomicfile import atomic_write, atomic_write_text
 from slamtrials.errors import FormatError
+from slamtrials.io.layout import RunFolder
 from slamtrials.io.mapfile import read_map, write_map, write_map_png
 from slamtrials.io.tum import write_tum
-from slamtrials.record import RunRecord, Trajectory
+from slamtrials.record import LaserGeometry, RunRecord, Trajectory
 
-__all__ = ["write_run", "read_run", "FRAMES_FILE", "RUN_FILE", "RUN_FORMAT", "ESTIMATE_FILE", "MAP_FILE", "MAP_PICTURE"]
+__all__ = ["write_run", "read_run", "RunFolder", "RUN_FORMAT", "RUN_FORMATS_READ"]
 
-FRAMES_FILE = "frames.npz"
-RUN_FILE = "run.json"
-ESTIMATE_FILE = "estimate.tum"
-MAP_FILE = "map.yaml"
-MAP_PICTURE = "map.png"
-RUN_FORMAT = "slamtrials-run/1"
+#: Format tag of run.json as written now. Version 2 (this one): the trial config's ``explore`` section
+#: holds no robot fields (they are ``sim.robot``'s) and ``campaign.metric`` the whole sampling rule.
+RUN_FORMAT = "slamtrials-run/2"
+#: Format tags :func:`read_run` reads: version 1 run folders have the same files and keys.
+RUN_FORMATS_READ = ("slamtrials-run/1", RUN_FORMAT)
 
 _ARRAYS: dict[str, tuple[type, int | None]] = {  # name -> (dtype, size of the last axis or None)
     "t": (np.float64, None),
@@ -73,22 +73,23 @@ def write_run(folder: str | Path, record: RunRecord) -> Path:
     ``frames.npz`` is compressed; ``run.json`` is written last and marks the run complete. An existing
     run in ``folder`` is replaced file by file, each replacement atomic.
     """
-    folder = Path(folder)
+    files = RunFolder(folder)
+    folder = files.path
     folder.mkdir(parents=True, exist_ok=True)
-    (folder / RUN_FILE).unlink(missing_ok=True)  # the folder is incomplete until run.json is back
+    files.run_json.unlink(missing_ok=True)  # the folder is incomplete until run.json is back
     arrays = {name: np.asarray(getattr(record, name), dtype=dtype) for name, (dtype, _) in _ARRAYS.items()}
     if record.estimate is not None:
         arrays["estimate"] = np.asarray(record.estimate, dtype=np.float64).reshape(len(record), 3)
-        write_tum(folder / ESTIMATE_FILE, Trajectory(t=arrays["t"], poses=arrays["estimate"]))
+        write_tum(files.estimate, Trajectory(t=arrays["t"], poses=arrays["estimate"]))
     else:
-        (folder / ESTIMATE_FILE).unlink(missing_ok=True)
+        files.estimate.unlink(missing_ok=True)
     if record.map is not None:
-        write_map(folder / MAP_FILE, record.map.grid, record.map.resolution, record.map.origin)
-        write_map_png(folder / MAP_PICTURE, record.map.grid)
+        write_map(files.map, record.map.grid, record.map.resolution, record.map.origin)
+        write_map_png(files.map_picture, record.map.grid)
     else:
-        for stale in (MAP_FILE, "map.pgm", MAP_PICTURE):
-            (folder / stale).unlink(missing_ok=True)
-    atomic_write(folder / FRAMES_FILE, lambda handle: np.savez_compressed(handle, **arrays))
+        for stale in files.map_files:
+            stale.unlink(missing_ok=True)
+    atomic_write(files.frames, lambda handle: np.savez_compressed(handle, **arrays))
     doc = {
         "format": RUN_FORMAT,
         "versions": {"slamtrials": __version__, **_revision(), "python": platform.python_version(),
@@ -96,10 +97,10 @@ def write_run(folder: str | Path, record: RunRecord) -> Path:
                      "machine": platform.machine()},
         "frames": len(record),
         "beams": int(record.scans.shape[1]) if record.scans.ndim == 2 else 0,
-        "laser": record.laser,
+        "laser": record.laser.to_dict(),
         **record.metadata,
     }
-    atomic_write_text(folder / RUN_FILE, json.dumps(doc, indent=2, default=json_default) + "\n")
+    atomic_write_text(files.run_json, json.dumps(doc, indent=2, default=json_default) + "\n")
     return folder
 
 
@@ -112,8 +113,9 @@ def _read_run_json(path: Path) -> dict[str, Any]:
         raise FormatError(path, f"not valid JSON: {exc.msg}", line=exc.lineno) from None
     except UnicodeDecodeError:
         raise FormatError(path, "not UTF-8 text") from None
-    if not isinstance(doc, dict) or doc.get("format") != RUN_FORMAT:
-        raise FormatError(path, f"expected a JSON object with \"format\": \"{RUN_FORMAT}\"")
+    if not isinstance(doc, dict) or doc.get("format") not in RUN_FORMATS_READ:
+        found = doc.get("format") if isinstance(doc, dict) else None
+        raise FormatError(path, f"expected a JSON object with \"format\" one of {', '.join(RUN_FORMATS_READ)}, got {found!r}")
     laser = doc.get("laser")
     if not isinstance(laser, dict) or any(not isinstance(laser.get(k), (int, float)) for k in _LASER_KEYS):
         raise FormatError(path, f"field 'laser' must be an object with numbers {', '.join(_LASER_KEYS)}")
@@ -153,14 +155,18 @@ def read_run(folder: str | Path) -> RunRecord:
     FormatError
         A file is missing, unreadable, or its arrays have the wrong names, dtypes or shapes.
     """
-    folder = Path(folder)
+    files = RunFolder(folder)
+    folder = files.path
     if not folder.is_dir():
         raise FormatError(folder, "not a run folder (no such directory)")
-    doc = _read_run_json(folder / RUN_FILE)
-    arrays = _read_frames(folder / FRAMES_FILE)
+    doc = _read_run_json(files.run_json)
+    arrays = _read_frames(files.frames)
     if arrays["scans"].shape[1] != doc.get("beams", arrays["scans"].shape[1]):
-        raise FormatError(folder / RUN_FILE, f"says {doc['beams']} beams but frames.npz has {arrays['scans'].shape[1]}")
-    laser = doc.pop("laser")
+        raise FormatError(files.run_json, f"says {doc['beams']} beams but frames.npz has {arrays['scans'].shape[1]}")
+    try:
+        laser = LaserGeometry.from_dict(doc.pop("laser"))
+    except ValueError as exc:
+        raise FormatError(files.run_json, f"field 'laser': {exc}") from None
     metadata = {k: v for k, v in doc.items() if k not in ("format", "frames", "beams")}
-    slam_map = read_map(folder / MAP_FILE) if (folder / MAP_FILE).is_file() else None
+    slam_map = read_map(files.map) if files.map.is_file() else None
     return RunRecord(**arrays, laser=laser, metadata=metadata, map=slam_map)

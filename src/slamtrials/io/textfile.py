@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from slamtrials.errors import FormatError
+from slamtrials.io.compressed import read_maybe_compressed
 
 __all__ = ["read_lines", "data_lines", "parse_floats", "parse_int", "last_line", "first_bad_row", "float_text", "read_number_table"]
 
@@ -20,19 +21,16 @@ __all__ = ["read_lines", "data_lines", "parse_floats", "parse_int", "last_line",
 def read_lines(path: Path) -> list[str]:
     """Read ``path`` as UTF-8 text and split it at ``\\n`` (a trailing ``\\r`` is left to ``str.split``).
 
+    A gzip- or bzip2-compressed file is decompressed first (recognised by its first bytes; see
+    :mod:`slamtrials.io.compressed`); line numbers in messages are those of the decompressed text.
+
     Raises
     ------
     FormatError
-        The file is missing or unreadable, or is not UTF-8 (the message gives the line and byte offset).
+        The file is missing or unreadable, its compressed stream is corrupt, or it is not UTF-8 (the
+        message gives the line and byte offset).
     """
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise FormatError(path, "no such file") from None
-    except IsADirectoryError:
-        raise FormatError(path, "is a directory, expected a text file") from None
-    except OSError as exc:
-        raise FormatError(path, f"cannot read: {exc.strerror or exc}") from None
+    data = read_maybe_compressed(path)
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:

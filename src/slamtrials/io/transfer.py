@@ -2,16 +2,13 @@
 
 Export writes a :class:`~slamtrials.record.RunRecord` as a ROS 1 bag, a ROS 2 bag (MCAP), a CARMEN log
 (first pose triple = ground truth, second = odometry) or a TUM trajectory. Import reads a ROS bag or a
-CARMEN log (plain or gzipped) back into a record. Functions return a one-line description of what they
+CARMEN log (plain, gzip or bzip2) back into a record. Functions return a one-line description of what they
 did for the caller to show; they never print.
 """
 
 from __future__ import annotations
 
-import gzip
 import shutil
-import tempfile
-import zlib
 from pathlib import Path
 
 import numpy as np
@@ -114,7 +111,7 @@ def detect_recording_format(path: str | Path) -> str:
     suffixes = [s.lower() for s in path.suffixes]
     if path.is_dir() or (suffixes and suffixes[-1] in BAG_SUFFIXES):
         return "bag"
-    if suffixes and (suffixes[-1] in CARMEN_SUFFIXES or suffixes[-1] == ".gz"):
+    if suffixes and (suffixes[-1] in CARMEN_SUFFIXES or suffixes[-1] in (".gz", ".bz2")):
         return "carmen"
     if not path.exists():
         raise FormatError(path, "no such file or folder")
@@ -124,22 +121,21 @@ def detect_recording_format(path: str | Path) -> str:
 
 
 def read_carmen_run(path: str | Path) -> RunRecord:
-    """A CARMEN log (plain, or gzipped with a ``.gz`` suffix) as a run record (truth = first pose triple)."""
+    """A CARMEN log (plain, gzip- or bzip2-compressed) as a run record (truth = first pose triple).
+
+    Raises
+    ------
+    FormatError
+        The log does not parse, or its laser lines hold no readings (a pose-only trajectory, which
+        ``slamtrials evaluate`` reads but which has nothing to map or replay).
+    """
     from slamtrials.io.carmen import read_carmen, run_from_carmen
 
-    path = Path(path)
-    if path.suffix.lower() != ".gz":
-        return run_from_carmen(read_carmen(path))
-    with tempfile.TemporaryDirectory(prefix="slamtrials-import-") as tmp:
-        plain = Path(tmp) / path.stem
-        try:
-            with gzip.open(path, "rb") as source, open(plain, "wb") as target:
-                shutil.copyfileobj(source, target)
-        except FileNotFoundError:
-            raise FormatError(path, "no such file") from None
-        except (OSError, EOFError, zlib.error) as exc:
-            raise FormatError(path, f"not a readable gzip file ({exc})") from None
-        try:
-            return run_from_carmen(read_carmen(plain))
-        except FormatError as exc:  # name the file the user gave, with the line in the decompressed log
-            raise FormatError(path, f"(decompressed) {exc.problem}", line=exc.line, offset=exc.offset) from None
+    log = read_carmen(path)
+    if log.laser.beams == 0:
+        raise FormatError(path, f"its {log.laser.kind} lines hold no readings (a pose-only trajectory): nothing to map or "
+                          "replay; evaluate it with slamtrials evaluate --estimate")
+    try:
+        return run_from_carmen(log)
+    except ValueError as exc:  # a geometry LaserGeometry refuses (one beam, a clockwise scan, no positive range)
+        raise FormatError(path, f"its {log.laser.kind} laser geometry cannot be used: {exc}") from None

@@ -7,6 +7,7 @@ Pure functions over arrays and the dataclasses of :mod:`slamtrials.record`; no f
 - :mod:`~slamtrials.metric.relerrors`: per-relation translational / rotational errors (Kuemmerle form).
 - :mod:`~slamtrials.metric.summary`: ``Mean, Std, Min, Max, NumMeasures`` as the Freiburg program prints.
 - :mod:`~slamtrials.metric.quantiles`: critical values of a confidence level.
+- :mod:`~slamtrials.metric.rule`: the relation-sampling rule (:class:`SamplingRule`).
 - :mod:`~slamtrials.metric.sampling`: automatic relation sampling (pilot, ``N = ceil(z^2 s^2 / d^2)``).
 - :mod:`~slamtrials.metric.runcount`: the run-count rule of the paper's Section III-C.
 - :mod:`~slamtrials.metric.stats`: per-environment mean, population and sample std, confidence interval.
@@ -25,6 +26,7 @@ from slamtrials.metric.matching import (
 )
 from slamtrials.metric.quantiles import critical_value
 from slamtrials.metric.relerrors import RelationErrors, evaluate_relations, relative_pose_errors
+from slamtrials.metric.rule import SamplingRule
 from slamtrials.metric.runcount import RunCount, replay_run_count, runs_needed
 from slamtrials.metric.sampling import SampledRelations, draw_pairs, relations_between, sample_relations, sample_size
 from slamtrials.metric.stats import EnvironmentStats, environment_stats
@@ -46,6 +48,7 @@ __all__ = [
     "replay_run_count",
     "runs_needed",
     "SampledRelations",
+    "SamplingRule",
     "draw_pairs",
     "relations_between",
     "sample_relations",

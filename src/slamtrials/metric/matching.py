@@ -27,10 +27,26 @@ from slamtrials.geometry import compose, interpolate as interpolate_poses, ominu
 from slamtrials.metric.kernels import EPS, nearest_indices, relative_poses
 from slamtrials.record import Relations, Trajectory
 
-__all__ = ["DEFAULT_TOLERANCE", "check_trajectory", "check_relations", "PoseLookup", "lookup_poses", "RelationMatch", "match_relations"]
+__all__ = ["DEFAULT_TOLERANCE", "RUN_TOLERANCE", "relations_meet", "check_trajectory", "check_relations", "PoseLookup", "lookup_poses", "RelationMatch", "match_relations"]
 
 #: Largest accepted gap (s) between a relation timestamp and the matched pose: the Freiburg program's 0.1 s.
 DEFAULT_TOLERANCE = 0.1
+#: Matching tolerance (s) of a simulated run's estimate to its ground truth: they share the simulator's
+#: clock (frames every 0.1 s), so only the same frame's pose is taken directly and the odometry fills the rest.
+RUN_TOLERANCE = 0.001
+
+
+def relations_meet(times: NDArray[np.float64], relations: Relations, tolerance: float) -> bool:
+    """Whether any finite timestamp of ``relations`` is within ``tolerance`` (s) of one of ``times``.
+
+    ``times`` ``[N]`` must be strictly increasing. False means the relations and the trajectory do not
+    belong together (another log's relations): every relation would go unmatched.
+    """
+    stamps = np.concatenate([relations.t1, relations.t2])
+    stamps = stamps[np.isfinite(stamps)]
+    if len(times) == 0 or len(stamps) == 0:
+        return False
+    return bool(nearest_indices(np.asarray(times, dtype=np.float64), stamps, tolerance)[2].any())
 
 
 def check_trajectory(trajectory: Trajectory, what: str = "estimate") -> None:

@@ -25,29 +25,18 @@ from numpy.typing import NDArray
 from slamtrials.errors import MetricError
 from slamtrials.geometry import ominus
 from slamtrials.metric.matching import DEFAULT_TOLERANCE, check_trajectory, lookup_poses
-from slamtrials.metric.quantiles import Distribution, critical_value
+from slamtrials.metric.quantiles import critical_value
 from slamtrials.metric.relerrors import RelationErrors, relative_pose_errors
+from slamtrials.metric.rule import SamplingRule
 from slamtrials.record import Relations, Trajectory
 
 __all__ = [
-    "DEFAULT_PILOT",
-    "DEFAULT_CONFIDENCE",
-    "DEFAULT_MARGIN_T",
-    "DEFAULT_MARGIN_R",
-    "DEFAULT_MAX_RELATIONS",
     "sample_size",
     "draw_pairs",
     "relations_between",
     "SampledRelations",
     "sample_relations",
 ]
-
-DEFAULT_PILOT = 500
-DEFAULT_CONFIDENCE = 0.99
-DEFAULT_MARGIN_T = 0.02  # m
-DEFAULT_MARGIN_R = 0.02  # rad
-#: Cap on the relation count, so that a diverging estimate (huge error spread) cannot exhaust memory.
-DEFAULT_MAX_RELATIONS = 1_000_000
 
 
 def sample_size(std: float, margin: float, critical: float) -> int:
@@ -135,8 +124,8 @@ class SampledRelations:
         True when the cap cut the count.
     covered:
         Number of ground-truth poses the estimate covers (the poses pairs were drawn from).
-    confidence, margin_t, margin_r, distribution, sides:
-        The settings used.
+    rule:
+        The sampling rule used.
     """
 
     relations: Relations
@@ -151,11 +140,7 @@ class SampledRelations:
     count: int
     capped: bool
     covered: int
-    confidence: float
-    margin_t: float
-    margin_r: float
-    distribution: str = "normal"
-    sides: int = 2
+    rule: SamplingRule
 
 
 def _errors_for(truth: Trajectory, estimated: NDArray[np.float64], corrected: NDArray[np.bool_], i, j, squared: bool) -> tuple[Relations, RelationErrors]:
@@ -178,18 +163,10 @@ def sample_relations(
     estimate: Trajectory,
     *,
     rng: np.random.Generator | int,
-    pilot: int = DEFAULT_PILOT,
-    confidence: float = DEFAULT_CONFIDENCE,
-    margin_t: float = DEFAULT_MARGIN_T,
-    margin_r: float = DEFAULT_MARGIN_R,
-    distribution: Distribution = "normal",
-    sides: int = 2,
+    rule: SamplingRule = SamplingRule(),
     tolerance: float = DEFAULT_TOLERANCE,
     interpolate: bool = False,
     odometry: Trajectory | None = None,
-    squared: bool = False,
-    min_relations: int = 2,
-    max_relations: int = DEFAULT_MAX_RELATIONS,
 ) -> SampledRelations:
     """Sample relations from ``truth`` by the IROS 2018 rule and evaluate ``estimate`` on them.
 
@@ -201,24 +178,10 @@ def sample_relations(
         Estimated trajectory (any frame), matched to the ground-truth timestamps.
     rng:
         Generator, or an integer seed turned into one.
-    pilot:
-        Pilot size ``n0`` (at least 2).
-    confidence:
-        Confidence level ``1 - alpha`` of the margins.
-    margin_t, margin_r:
-        Margins of error of the mean translational error (m) and rotational error (rad); in squared
-        units when ``squared``.
-    distribution, sides:
-        Quantile: ``"normal"`` (default) or ``"t"`` (with ``pilot - 1`` degrees of freedom), two-sided
-        (default) or one-sided; see :func:`~slamtrials.metric.quantiles.critical_value`.
+    rule:
+        Pilot size, confidence, margins, quantile, floor and cap of the relation count (:class:`SamplingRule`).
     tolerance, interpolate, odometry:
         Matching of the estimate to the ground-truth timestamps (:func:`~slamtrials.metric.matching.lookup_poses`).
-    squared:
-        Work with squared errors (m^2, rad^2).
-    min_relations:
-        Floor on the relation count (a perfect estimate has ``s = 0`` and would need none).
-    max_relations:
-        Cap on the relation count (see ``capped``).
 
     Returns
     -------
@@ -229,13 +192,10 @@ def sample_relations(
     MetricError
         Bad trajectories, bad settings, or an estimate that covers fewer than 2 ground-truth poses.
     """
-    if pilot < 2:
-        raise MetricError(f"the pilot sample needs at least 2 pairs, got {pilot}")
-    if not (1 <= min_relations <= max_relations):
-        raise MetricError(f"need 1 <= min_relations <= max_relations, got {min_relations} and {max_relations}")
     rng = np.random.default_rng(rng)
     check_trajectory(truth, "truth")
-    critical = critical_value(confidence, distribution=distribution, dof=pilot - 1, sides=sides)
+    squared = rule.squared
+    critical = critical_value(rule.confidence, distribution=rule.distribution, dof=rule.pilot - 1, sides=rule.sides)
     found = lookup_poses(estimate, truth.t, tolerance=tolerance, interpolate=interpolate, odometry=odometry)
     covered = np.flatnonzero(found.found)
     if len(covered) < 2:
@@ -247,14 +207,14 @@ def sample_relations(
     estimated = found.poses[covered]
     corrected = found.corrected[covered]
 
-    i, j = draw_pairs(len(covered), pilot, rng)
+    i, j = draw_pairs(len(covered), rule.pilot, rng)
     pilot_relations, pilot_errors = _errors_for(sub_truth, estimated, corrected, i, j, squared)
     std_t = float(np.std(pilot_errors.translational, ddof=1))
     std_r = float(np.std(pilot_errors.rotational, ddof=1))
-    needed_t = sample_size(std_t, margin_t, critical)
-    needed_r = sample_size(std_r, margin_r, critical)
-    wanted = max(needed_t, needed_r, min_relations)
-    count = min(wanted, max_relations)
+    needed_t = sample_size(std_t, rule.margin_t, critical)
+    needed_r = sample_size(std_r, rule.margin_r, critical)
+    wanted = max(needed_t, needed_r, rule.min_relations)
+    count = min(wanted, rule.max_relations)
 
     i, j = draw_pairs(len(covered), count, rng)
     relations, errors = _errors_for(sub_truth, estimated, corrected, i, j, squared)
@@ -269,11 +229,7 @@ def sample_relations(
         needed_t=needed_t,
         needed_r=needed_r,
         count=count,
-        capped=wanted > max_relations,
+        capped=wanted > rule.max_relations,
         covered=len(covered),
-        confidence=confidence,
-        margin_t=margin_t,
-        margin_r=margin_r,
-        distribution=distribution,
-        sides=sides,
+        rule=rule,
     )

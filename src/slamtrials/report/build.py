@@ -44,12 +44,21 @@ import pandas as pd
 
 from slamtrials.__about__ import __version__, source_revision
 from slamtrials.atomicfile import atomic_write_text
+from slamtrials.campaign.config import MetricSettings
 from slamtrials.campaign.events import REPLAY_NOTE
 from slamtrials.errors import ConfigError, SlamtrialsError
 from slamtrials.record import Trajectory
 from slamtrials.report import campaign_figures as cf
 from slamtrials.report import html as h
-from slamtrials.report.compare import A_BETTER, B_BETTER, Comparison, Correction, compare_campaigns, world_pair_traps
+from slamtrials.report.compare import (
+    A_BETTER,
+    B_BETTER,
+    Comparison,
+    Correction,
+    compare_campaigns,
+    world_pair_traps,
+)
+from slamtrials.io.layout import RunFolder
 from slamtrials.report.load import CampaignData, load_campaign
 from slamtrials.report.tables import METRICS, paper_table
 
@@ -367,8 +376,7 @@ def _fig3(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame, chosen: t
     if chosen is None:
         return h.section(title, "<p>No finished run to check.</p>", id="fig-3")
     world, index = chosen
-    metric = data.config.get("metric", {})
-    options = {k: metric[k] for k in ("pilot", "confidence", "margin_t", "margin_r", "distribution", "tolerance") if k in metric}
+    metric = MetricSettings.model_validate(data.config.get("metric", {}))
     try:
         record = _read_record(data, world, index)
         if record.estimate is None:
@@ -378,7 +386,7 @@ def _fig3(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame, chosen: t
         odometry = Trajectory(t=record.t, poses=record.odometry)
         sequence = np.random.SeedSequence(int(seed))
         means = {component: cf.repeated_sampling_means(truth, estimate, repeats, sequence, component=component,
-                                                       odometry=odometry, **options)
+                                                       rule=metric.rule, tolerance=metric.tolerance, odometry=odometry)
                  for component in ("translational", "rotational")}
     except SlamtrialsError as exc:
         log.warning("relation-sampling check of %s/%d: %s", world, index, exc)
@@ -394,11 +402,11 @@ def _fig3(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame, chosen: t
         ax.axvline(float(row[metric_name]), color="black", ls=":", lw=1.2, gid="campaign_value")
         ax.set_title(f"{world} run #{index}: {SYMBOLS[metric_name]} over {repeats} samplings", fontsize=9)
     caption = (f"The paper's Fig. 3 for run #{index} of {world}: the distribution of the run's mean error over {repeats} "
-               f"independent samplings of relations (each by the campaign's rule: pilot {options.get('pilot')}, "
-               f"{_pct(options.get('confidence'))} confidence, margins \u00b1{options.get('margin_t')} m and "
-               f"\u00b1{options.get('margin_r')} rad), with a fitted normal; dotted: the value the campaign recorded "
+               f"independent samplings of relations (each by the campaign's rule: pilot {metric.pilot}, "
+               f"{_pct(metric.confidence)} confidence, margins \u00b1{metric.margin_t:g} m and "
+               f"\u00b1{metric.margin_r:g} rad), with a fitted normal; dotted: the value the campaign recorded "
                f"({row['eps_t']:.4f} m, {row['eps_r']:.4f} rad). Sampling seed {seed}.")
-    spread = [f"{SYMBOLS[m]}: mean {v.mean():.4g}, sd {v.std(ddof=1):.2g} over samplings (margin \u00b1{options.get('margin_' + m[-1])})"
+    spread = [f"{SYMBOLS[m]}: mean {v.mean():.4g}, sd {v.std(ddof=1):.2g} over samplings (margin \u00b1{getattr(metric, 'margin_' + m[-1]):g})"
               for m, v in zip(METRICS, means.values())]
     return h.section(title, figs.save(fig, "fig3_sampling", caption), "<p>" + h.esc("; ".join(spread)) + "</p>", id="fig-3",
                      intro="Is the sampled mean of one run approximately normal with a spread within the margin of error?")
@@ -511,7 +519,7 @@ def _provenance(data: CampaignData) -> str:
     config_text = yaml.safe_dump(data.config, sort_keys=False, default_flow_style=None, width=110)
     seen: Counter = Counter()
     for folder in data.done["folder"]:
-        path = data.folder / str(folder) / "run.json"
+        path = RunFolder(data.folder / str(folder)).run_json
         try:
             doc = json.loads(path.read_text(encoding="utf-8"))
         except (OSError, ValueError):
@@ -660,7 +668,7 @@ def trap_sentences(comparison: Comparison, metric: str = "eps_t") -> list[str]:
     unit = UNITS[metric]
     out = []
     rows = comparison.for_metric(metric)
-    for _, r in rows.sort_values("trap_fraction", ascending=False, na_position="last").iterrows():
+    for _, r in rows.sort_values("trap_fraction", ascending=False, na_position="last", kind="stable").iterrows():
         diff = r["difference"]
         if diff == 0 or not np.sign(r["trap_difference"]) == -np.sign(diff):
             continue
@@ -745,7 +753,7 @@ def compare_report(campaign_a: str | Path, campaign_b: str | Path, out_dir: str 
                                 f"coloured by verdict ({correction} correction); diamonds: the most misleading single-run pair "
                                 "where it contradicts the means; right margin: share of run pairs that reverse the means."))
     trap_rows = comparison.for_metric("eps_t")
-    trap_rows = trap_rows[np.isfinite(trap_rows["trap_fraction"])].sort_values("trap_fraction", ascending=False).head(12)
+    trap_rows = trap_rows[np.isfinite(trap_rows["trap_fraction"])].sort_values("trap_fraction", ascending=False, kind="stable").head(12)
     trap_picture = ""
     if len(trap_rows):
         ncols = min(4, len(trap_rows))

@@ -21,6 +21,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import stats
 
 from slamtrials.geometry import as_poses, compose, inverse
+from slamtrials.metric.matching import DEFAULT_TOLERANCE
+from slamtrials.metric.rule import SamplingRule
 from slamtrials.metric.sampling import sample_relations
 from slamtrials.metric.stats import environment_stats
 from slamtrials.record import OccupancyGrid, Trajectory
@@ -114,7 +116,7 @@ def draw_sorted_errors(ax, runs: pd.DataFrame, worlds: list[str] | None = None, 
     names = sorted(runs["world"].astype(str).unique()) if worlds is None else list(worlds)
     for world in names:
         values, _ = _world_values(runs, world, metric)
-        ax.plot(np.arange(1, len(values) + 1), np.sort(values)[::-1], "o-", ms=3, lw=1.2, label=world, gid=f"world:{world}")
+        ax.plot(np.arange(1, len(values) + 1), np.sort(values, kind="stable")[::-1], "o-", ms=3, lw=1.2, label=world, gid=f"world:{world}")
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("run (largest error first)")
     ax.set_ylabel(METRIC_LABELS[metric])
@@ -169,7 +171,8 @@ def draw_all_runs(ax, runs: pd.DataFrame, metric: str = "eps_t", *, order: str =
 
 def repeated_sampling_means(truth: Trajectory, estimate: Trajectory, repeats: int,
                             rng: np.random.Generator | np.random.SeedSequence | int, *,
-                            component: str = "translational", **sample_relations_options) -> NDArray[np.float64]:
+                            component: str = "translational", rule: SamplingRule = SamplingRule(),
+                            tolerance: float = DEFAULT_TOLERANCE, odometry: Trajectory | None = None) -> NDArray[np.float64]:
     """Mean errors ``[repeats]`` of ``repeats`` independent relation samplings of one run (the paper's Fig. 3).
 
     Each repeat calls :func:`slamtrials.metric.sampling.sample_relations` with its own generator, spawned
@@ -185,8 +188,10 @@ def repeated_sampling_means(truth: Trajectory, estimate: Trajectory, repeats: in
         Generator, SeedSequence or integer seed.
     component:
         ``"translational"`` (m, the default) or ``"rotational"`` (rad).
-    **sample_relations_options:
-        Passed to ``sample_relations`` (``confidence``, ``margin_t``, ``pilot``, ...), except ``rng``.
+    rule:
+        The sampling rule of each repeat.
+    tolerance, odometry:
+        Matching of the estimate to the ground truth (as in ``sample_relations``).
     """
     if repeats < 1:
         raise ValueError(f"repeats must be at least 1, got {repeats}")
@@ -199,7 +204,7 @@ def repeated_sampling_means(truth: Trajectory, estimate: Trajectory, repeats: in
         generators = [np.random.default_rng(child) for child in sequence.spawn(repeats)]
     means = np.empty(repeats)
     for k, generator in enumerate(generators):
-        sampled = sample_relations(truth, estimate, rng=generator, **sample_relations_options)
+        sampled = sample_relations(truth, estimate, rng=generator, rule=rule, tolerance=tolerance, odometry=odometry)
         means[k] = float(np.mean(getattr(sampled.errors, component)))
     return means
 

@@ -191,7 +191,7 @@ def reversal(low: ArrayLike, high: ArrayLike) -> Reversal:
     i, j = int(np.argmax(x)), int(np.argmin(y))
     if x.mean() == y.mean():
         return Reversal(math.nan, i, j, float(x[i] - y[j]))
-    below = np.searchsorted(np.sort(y), x, side="left")  # for each x_i: how many y_j < x_i
+    below = np.searchsorted(np.sort(y, kind="stable"), x, side="left")  # for each x_i: how many y_j < x_i
     return Reversal(float(below.sum()) / (len(x) * len(y)), i, j, float(x[i] - y[j]))
 
 

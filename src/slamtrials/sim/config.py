@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from slamtrials.errors import ConfigError, validation_problems
+from slamtrials.record import LaserGeometry
 
 __all__ = ["RobotConfig", "LaserConfig", "OdometryConfig", "SimConfig"]
 
@@ -146,15 +147,11 @@ class LaserConfig(BaseModel):
         """float64 ``[B]`` beam angles (rad) in the laser frame, counter-clockwise from ``angle_min``."""
         return self.angle_min + np.arange(self.num_beams, dtype=np.float64) * self.angle_increment
 
-    def laser_info(self) -> dict[str, Any]:
-        """The laser geometry in the form :meth:`slamtrials.record.RunRecord.from_frames` expects."""
-        return {
-            "angle_min": self.angle_min,
-            "angle_increment": self.angle_increment,
-            "range_min": self.min_range,
-            "range_max": self.max_range,
-            "mount": [float(v) for v in self.mount],
-        }
+    def geometry(self) -> LaserGeometry:
+        """The laser's geometry as it is recorded with every run."""
+        return LaserGeometry(angle_min=self.angle_min, angle_increment=self.angle_increment,
+                             range_min=self.min_range, range_max=self.max_range,
+                             mount=(float(self.mount[0]), float(self.mount[1]), float(self.mount[2])))
 
 
 class OdometryConfig(BaseModel):

@@ -29,14 +29,14 @@ from __future__ import annotations
 
 import math
 import weakref
-from typing import Any
 
 import numpy as np
 from numba import njit
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
+from slamtrials.record import LaserGeometry
 from slamtrials.sim.config import LaserConfig
-from slamtrials.geometry import compose1
+from slamtrials.geometry import Pose1Like, compose1
 from slamtrials.worlds.world import World, world_to_map
 
 __all__ = ["RaycastMap", "LaserModel", "cast_scan", "cast_scan_dda", "SAFETY_CELLS"]
@@ -135,18 +135,18 @@ def _cast_scan(dist, ox, oy, theta, angles, max_t, resolution, max_range, accele
             out[b] = min(t * resolution, max_range) + 0.0  # + 0.0 turns a -0.0 into 0.0
 
 
-def _run(dist: NDArray[np.float32], origin_uv: ArrayLike, theta: float, angles: NDArray[np.float64], max_range: float,
+def _run(dist: NDArray[np.float32], origin_uv: Pose1Like, theta: float, angles: NDArray[np.float64], max_range: float,
          resolution: float, accelerate: bool, out: NDArray[np.float32] | None) -> NDArray[np.float32]:
     angles = np.ascontiguousarray(angles, dtype=np.float64)
     if out is None:
         out = np.empty(angles.shape[0], dtype=np.float32)
-    ox, oy = float(origin_uv[0]), float(origin_uv[1])  # type: ignore[index]
+    ox, oy = float(origin_uv[0]), float(origin_uv[1])
     max_range = float(max_range)
     _cast_scan(dist, ox, oy, float(theta), angles, max_range / resolution, float(resolution), max_range, accelerate, out)
     return out
 
 
-def cast_scan(dist: NDArray[np.float32], origin_uv: ArrayLike, theta: float, angles: NDArray[np.float64],
+def cast_scan(dist: NDArray[np.float32], origin_uv: Pose1Like, theta: float, angles: NDArray[np.float64],
               max_range: float, resolution: float = 1.0, out: NDArray[np.float32] | None = None) -> NDArray[np.float32]:
     """Ranges of all beams of one scan, with distance-field acceleration.
 
@@ -177,7 +177,7 @@ def cast_scan(dist: NDArray[np.float32], origin_uv: ArrayLike, theta: float, ang
     return _run(dist, origin_uv, theta, angles, max_range, resolution, True, out)
 
 
-def cast_scan_dda(dist: NDArray[np.float32], origin_uv: ArrayLike, theta: float, angles: NDArray[np.float64],
+def cast_scan_dda(dist: NDArray[np.float32], origin_uv: Pose1Like, theta: float, angles: NDArray[np.float64],
                   max_range: float, resolution: float = 1.0, out: NDArray[np.float32] | None = None) -> NDArray[np.float32]:
     """Same as :func:`cast_scan` with the plain cell-by-cell traversal (the reference; slower)."""
     return _run(dist, origin_uv, theta, angles, max_range, resolution, False, out)
@@ -224,7 +224,7 @@ class RaycastMap:
     @property
     def shape(self) -> tuple[int, int]:
         """(H, W) of the grid."""
-        return self.dist.shape  # type: ignore[return-value]
+        return self.dist.shape
 
 
 class LaserModel:
@@ -250,18 +250,18 @@ class LaserModel:
         """Number of beams B."""
         return int(self.angles.shape[0])
 
-    def laser_pose(self, pose: ArrayLike) -> NDArray[np.float64]:
+    def laser_pose(self, pose: Pose1Like) -> NDArray[np.float64]:
         """float64 ``[3]`` world pose of the laser when the robot base is at ``pose`` (world frame)."""
         return compose1(pose, self._mount)
 
-    def true_ranges(self, pose: ArrayLike) -> NDArray[np.float32]:
+    def true_ranges(self, pose: Pose1Like) -> NDArray[np.float32]:
         """Noise-free ranges float32 ``[B]`` (m) seen from robot base pose ``pose`` (world frame, ``[3]``)."""
         lp = self.laser_pose(pose)
         uv = world_to_map(self.world, lp[:2])
         theta = float(lp[2] - self.world.origin[2])
         return cast_scan(self.map.dist, uv, theta, self.angles, self.config.max_range, self.map.resolution)
 
-    def scan(self, pose: ArrayLike, rng: np.random.Generator) -> NDArray[np.float32]:
+    def scan(self, pose: Pose1Like, rng: np.random.Generator) -> NDArray[np.float32]:
         """A laser reading float32 ``[B]`` (m) from robot base pose ``pose`` (world frame).
 
         With ``range_noise_std > 0``, B normal deviates are drawn from ``rng`` (always B, so the stream
@@ -280,6 +280,6 @@ class LaserModel:
             np.maximum(ranges, np.float32(cfg.min_range), out=ranges)
         return ranges
 
-    def info(self) -> dict[str, Any]:
-        """The laser dict for :class:`~slamtrials.record.RunRecord`."""
-        return self.config.laser_info()
+    def geometry(self) -> LaserGeometry:
+        """The laser's geometry, as :class:`~slamtrials.record.RunRecord` records it."""
+        return self.config.geometry()

@@ -18,11 +18,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from slamtrials.errors import SimulationError
-from slamtrials.record import Frame
+from slamtrials.record import Frame, LaserGeometry
 from slamtrials.sim.config import SimConfig
 from slamtrials.sim.odometry import Odometry, draw_bias
 from slamtrials.sim.raycast import LaserModel
-from slamtrials.geometry import ominus1
+from slamtrials.geometry import Pose1Like, ominus1
 from slamtrials.sim.robot import Robot
 from slamtrials.worlds.world import World
 
@@ -124,9 +124,9 @@ class Simulator:
         return dict(self._bias)
 
     @property
-    def laser_info(self) -> dict[str, Any]:
-        """Laser geometry for :meth:`slamtrials.record.RunRecord.from_frames`."""
-        return self._laser.info()
+    def laser(self) -> LaserGeometry:
+        """The laser's geometry, for :meth:`slamtrials.record.RunRecord.from_frames`."""
+        return self._laser.geometry()
 
     @property
     def metadata(self) -> dict[str, Any]:
@@ -153,7 +153,7 @@ class Simulator:
             )
         return self._frame
 
-    def step(self, command: ArrayLike) -> Frame:
+    def step(self, command: Pose1Like) -> Frame:
         """Drive for one ``dt`` towards velocity ``command`` = (v m/s, w rad/s), then sense.
 
         Raises
@@ -162,7 +162,7 @@ class Simulator:
             If the command is not two finite numbers.
         """
         try:
-            v, w = (float(c) for c in command)  # type: ignore[union-attr]
+            v, w = (float(c) for c in command)
         except (TypeError, ValueError):
             raise SimulationError(f"velocity command must be two numbers (v m/s, w rad/s), got {command!r}") from None
         if not (math.isfinite(v) and math.isfinite(w)):

@@ -34,7 +34,9 @@ def _graph(passable: NDArray[np.bool_], block_clearance: NDArray[np.float64], ce
     h, w = passable.shape
     index = np.arange(h * w).reshape(h, w)
     penalty = 1.0 + 0.5 / np.maximum(block_clearance, 1e-3)
-    rows, cols, costs = [], [], []
+    rows: list[NDArray[np.intp]] = []
+    cols: list[NDArray[np.intp]] = []
+    costs: list[NDArray[np.float64]] = []
     for dr, dc, length in _NEIGHBOURS:
         r0, r1 = max(0, -dr), h - max(0, dr)
         c0, c1 = max(0, -dc), w - max(0, dc)
@@ -44,8 +46,8 @@ def _graph(passable: NDArray[np.bool_], block_clearance: NDArray[np.float64], ce
         rows.append(index[a][both])
         cols.append(index[b][both])
         costs.append(length * cell * 0.5 * (penalty[a][both] + penalty[b][both]))
-    rows, cols, costs = np.concatenate(rows), np.concatenate(cols), np.concatenate(costs)
-    return sparse.csr_matrix((costs, (rows, cols)), shape=(h * w, h * w))
+    edges = (np.concatenate(costs), (np.concatenate(rows), np.concatenate(cols)))
+    return sparse.csr_matrix(edges, shape=(h * w, h * w))
 
 
 def tour_waypoints(
@@ -79,6 +81,8 @@ def tour_waypoints(
     passable, block_clearance, factor = _coarse_grid(world, cell, clearance)
     cell = factor * world.resolution
     labels, _ = ndimage.label(passable, structure=np.ones((3, 3)))
+    if world.start is None:  # World.__post_init__ always sets it
+        raise SimulationError(f"world {world.name!r} has no start pose")
     row, col = world_to_cell(world, world.start[:2])
     # The start block may be too close to a wall: use the nearest passable block.
     rows, cols = np.nonzero(passable)
@@ -105,7 +109,7 @@ def tour_waypoints(
     order, remaining = [0], set(range(1, len(goals)))
     while remaining:
         here = order[-1]
-        nxt = min(remaining, key=lambda g: distances[here, goals[g]])
+        nxt = min(remaining, key=lambda g: (distances[here, goals[g]], g))  # equal distances: the lower goal index
         order.append(nxt)
         remaining.remove(nxt)
 

@@ -124,4 +124,4 @@ def simulate_waypoints(world: World, waypoints: ArrayLike, config: SimConfig | N
         "max_time": float(max_time),
         "tolerance": float(tolerance),
     }
-    return RunRecord.from_frames(frames, sim.laser_info, metadata)
+    return RunRecord.from_frames(frames, sim.laser, metadata)

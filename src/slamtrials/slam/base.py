@@ -5,7 +5,7 @@ A SLAM algorithm is a class with
 * ``name``: the registry name (``slamtrials slam --algorithm NAME``);
 * ``Config``: a pydantic model of its parameters (SI units), every field with a default;
 * ``PRESETS``: named parameter sets, ``{preset name: {parameter: value}}`` (may be empty);
-* a constructor ``Algorithm(config, laser)`` taking a validated ``Config`` and the laser geometry dict
+* a constructor ``Algorithm(config, laser)`` taking a validated ``Config`` and the laser geometry
   of :class:`~slamtrials.record.RunRecord` (``angle_min``, ``angle_increment``, ``range_min``,
   ``range_max``, ``mount``);
 * ``reset(rng)``, ``process(frame) -> pose``, ``occupancy()``, ``trajectory()`` and an ``updates``
@@ -20,14 +20,14 @@ and third-party packages publish theirs under the entry-point group ``slamtrials
 from __future__ import annotations
 
 from importlib.metadata import entry_points
-from typing import Any, ClassVar, Protocol, runtime_checkable
+from typing import Any, ClassVar, Protocol, TypeVar, cast, runtime_checkable
 
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ValidationError
 
 from slamtrials.errors import ConfigError
-from slamtrials.record import FREE, OCCUPIED, UNKNOWN, Frame, OccupancyGrid, Trajectory
+from slamtrials.record import FREE, OCCUPIED, UNKNOWN, Frame, LaserGeometry, OccupancyGrid, Trajectory
 
 __all__ = [
     "OccupancyGrid",
@@ -62,13 +62,17 @@ class SlamAlgorithm(Protocol):
         Number of map (or filter) updates done since the last :meth:`reset`.
 
     An instance is built as ``Algorithm(config, laser)`` with a validated ``Config`` and the laser
-    geometry dict of :class:`~slamtrials.record.RunRecord`.
+    geometry (:class:`~slamtrials.record.LaserGeometry`).
     """
 
     name: ClassVar[str]
     Config: ClassVar[type[BaseModel]]
     PRESETS: ClassVar[dict[str, dict[str, Any]]]
     updates: int
+
+    def __init__(self, config: Any, laser: LaserGeometry) -> None:
+        """Build from a validated ``Config`` instance (typed ``Any``: each class takes its own model)."""
+        ...
 
     def reset(self, rng: np.random.Generator) -> None:
         """Forget every processed frame; later random draws come from ``rng``."""
@@ -88,12 +92,15 @@ class SlamAlgorithm(Protocol):
 
 
 #: Built-in (and run-time registered) algorithms: name -> class.
-ALGORITHMS: dict[str, type] = {}
+ALGORITHMS: dict[str, type[SlamAlgorithm]] = {}
 
 _CONTRACT = ("name", "Config", "PRESETS", "reset", "process", "occupancy", "trajectory")
 
+#: Any class may be registered (``type[Any]``: its attributes are unknown until checked below).
+_Class = TypeVar("_Class", bound="type[Any]")
 
-def register_algorithm(cls: type) -> type:
+
+def register_algorithm(cls: _Class) -> _Class:
     """Add ``cls`` to :data:`ALGORITHMS` under ``cls.name`` and return it (usable as a decorator).
 
     Raises
@@ -105,13 +112,15 @@ def register_algorithm(cls: type) -> type:
     missing = [member for member in _CONTRACT if member not in dir(cls)]
     if missing:
         raise ConfigError(f"SLAM algorithm class {cls.__qualname__} lacks {', '.join(missing)} (see slamtrials.slam.SlamAlgorithm)")
-    if not isinstance(cls.name, str) or not cls.name:
-        raise ConfigError(f"SLAM algorithm class {cls.__qualname__}: name must be a non-empty string, got {cls.name!r}")
-    if not (isinstance(cls.Config, type) and issubclass(cls.Config, BaseModel)):
-        raise ConfigError(f"SLAM algorithm {cls.name!r}: Config must be a pydantic BaseModel subclass")
-    if not isinstance(cls.PRESETS, dict) or not all(isinstance(v, dict) for v in cls.PRESETS.values()):
-        raise ConfigError(f"SLAM algorithm {cls.name!r}: PRESETS must map preset names to parameter dicts")
-    ALGORITHMS[cls.name] = cls
+    name, config, presets = cls.name, cls.Config, cls.PRESETS
+    if not isinstance(name, str) or not name:
+        raise ConfigError(f"SLAM algorithm class {cls.__qualname__}: name must be a non-empty string, got {name!r}")
+    if not (isinstance(config, type) and issubclass(config, BaseModel)):
+        raise ConfigError(f"SLAM algorithm {name!r}: Config must be a pydantic BaseModel subclass")
+    if not isinstance(presets, dict) or not all(isinstance(v, dict) for v in presets.values()):
+        raise ConfigError(f"SLAM algorithm {name!r}: PRESETS must map preset names to parameter dicts")
+    # Checked above: the class now meets the SlamAlgorithm contract.
+    ALGORITHMS[name] = cast("type[SlamAlgorithm]", cls)
     return cls
 
 
@@ -124,7 +133,7 @@ def known_algorithms() -> list[str]:
     return sorted(set(ALGORITHMS) | set(_entry_points()))
 
 
-def get_algorithm(name: str) -> type:
+def get_algorithm(name: str) -> type[SlamAlgorithm]:
     """The algorithm class called ``name``: registered, or published under :data:`ENTRY_POINT_GROUP`.
 
     An entry-point class is checked and registered on first use.
@@ -145,7 +154,8 @@ def get_algorithm(name: str) -> type:
         raise ConfigError(f"SLAM algorithm {name!r} (entry point {found.value}) failed to load: {exc}") from None
     if not isinstance(cls, type) or cls.__dict__.get("name", name) != name:
         raise ConfigError(f"entry point {name!r} = {found.value} is not a SLAM algorithm class named {name!r}")
-    return register_algorithm(cls)
+    register_algorithm(cls)
+    return cast("type[SlamAlgorithm]", cls)  # register_algorithm checked the contract
 
 
 def _allowed(model: type[BaseModel], parameter: str) -> str:
@@ -162,7 +172,7 @@ def _allowed(model: type[BaseModel], parameter: str) -> str:
     return f"; allowed: {' and '.join(words)}" if words else ""
 
 
-def resolve_config(cls: type, *, preset: str | None = None, overrides: dict[str, Any] | None = None) -> BaseModel:
+def resolve_config(cls: type[SlamAlgorithm], *, preset: str | None = None, overrides: dict[str, Any] | None = None) -> BaseModel:
     """Validate ``cls.Config`` from the defaults, then preset ``preset``, then ``overrides``.
 
     Raises
@@ -194,7 +204,7 @@ def resolve_config(cls: type, *, preset: str | None = None, overrides: dict[str,
         raise ConfigError(f"SLAM algorithm {cls.name!r}: " + "; ".join(problems)) from None
 
 
-def make_algorithm(name: str, laser: dict[str, Any], *, preset: str | None = None,
+def make_algorithm(name: str, laser: LaserGeometry, *, preset: str | None = None,
                    overrides: dict[str, Any] | None = None) -> SlamAlgorithm:
     """Build algorithm ``name`` for a laser of geometry ``laser`` with a validated configuration.
 
@@ -203,7 +213,7 @@ def make_algorithm(name: str, laser: dict[str, Any], *, preset: str | None = Non
     name:
         Registry or entry-point name.
     laser:
-        Laser geometry dict of :class:`~slamtrials.record.RunRecord`.
+        The laser's geometry (:class:`~slamtrials.record.LaserGeometry`).
     preset:
         Name of one of the class's :data:`PRESETS`, applied over the defaults.
     overrides:
@@ -215,4 +225,4 @@ def make_algorithm(name: str, laser: dict[str, Any], *, preset: str | None = Non
         See :func:`get_algorithm` and :func:`resolve_config`.
     """
     cls = get_algorithm(name)
-    return cls(resolve_config(cls, preset=preset, overrides=overrides), dict(laser))
+    return cls(resolve_config(cls, preset=preset, overrides=overrides), laser)

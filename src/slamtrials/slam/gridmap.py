@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
 
 import numpy as np
 from numba import njit
@@ -41,9 +40,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from slamtrials import stablemath
 from slamtrials.geometry import compose1
+from slamtrials.record import LaserGeometry
 from slamtrials.slam.base import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 
-__all__ = ["GridMap", "scan_endpoints", "beam_endpoints", "beam_angles", "classify", "DEFAULT_CHUNK"]
+__all__ = ["GridMap", "scan_endpoints", "beam_endpoints", "classify", "DEFAULT_CHUNK"]
 
 #: Cells added on a side when a map grows (plus what the scan needs).
 DEFAULT_CHUNK = 64
@@ -120,11 +120,6 @@ def _classify(hits, visits, occ_thresh, flip):  # pragma: no cover - compiled
             else:
                 grid[out, c] = FREE
     return grid
-
-
-def beam_angles(laser: dict[str, Any], beams: int) -> NDArray[np.float64]:
-    """Beam angles (rad) in the laser frame: ``angle_min + k angle_increment``, ``k = 0..beams-1``."""
-    return float(laser["angle_min"]) + float(laser["angle_increment"]) * np.arange(beams, dtype=np.float64)
 
 
 def scan_endpoints(laser_poses: ArrayLike, ranges: ArrayLike, angles: ArrayLike, *, range_min: float,
@@ -279,16 +274,16 @@ class GridMap:
         _integrate_scans(self.hits, self.visits, self.col0, self.row0, ou, ov, eu, ev, usable, hit,
                          np.asarray(weights, dtype=np.int64).reshape(-1))
 
-    def integrate_frame(self, base_pose: ArrayLike, ranges: ArrayLike, laser: dict[str, Any], *,
+    def integrate_frame(self, base_pose: ArrayLike, ranges: ArrayLike, laser: LaserGeometry, *,
                         max_urange: float | None = None) -> None:
         """Trace a scan taken with the robot base at ``base_pose`` (map frame) by a laser of geometry ``laser``.
 
         ``max_urange`` defaults to the laser's ``range_max``.
         """
         r = np.asarray(ranges)
-        laser_pose = compose1(np.asarray(base_pose, dtype=np.float64), np.asarray(laser.get("mount", (0.0, 0.0, 0.0)), dtype=np.float64))
-        range_max = float(laser["range_max"])
-        self.integrate(laser_pose, r, beam_angles(laser, r.shape[0]), range_min=float(laser.get("range_min", 0.0)),
+        laser_pose = compose1(np.asarray(base_pose, dtype=np.float64), np.asarray(laser.mount, dtype=np.float64))
+        range_max = laser.range_max
+        self.integrate(laser_pose, r, laser.beam_angles(r.shape[0]), range_min=laser.range_min,
                        range_max=range_max, max_urange=range_max if max_urange is None else min(float(max_urange), range_max))
 
     def occupancy(self, occ_thresh: float = 0.25) -> OccupancyGrid:

@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from slamtrials.geometry import compose1, ominus1
-from slamtrials.record import Frame, Trajectory
+from slamtrials.record import Frame, LaserGeometry, Trajectory
 from slamtrials.slam.base import OccupancyGrid, register_algorithm
 from slamtrials.slam.gridmap import GridMap
 
@@ -75,7 +75,7 @@ class OdometrySlam:
     config:
         Validated :class:`OdometryConfig`.
     laser:
-        Laser geometry dict of :class:`~slamtrials.record.RunRecord`.
+        The laser's geometry (:class:`~slamtrials.record.LaserGeometry`).
     """
 
     name = "odometry"
@@ -85,9 +85,9 @@ class OdometrySlam:
         "gmapping": {"linear_update": 1.0, "angular_update": 0.5},  # slam_gmapping's update rule
     }
 
-    def __init__(self, config: OdometryConfig, laser: dict[str, Any]):
+    def __init__(self, config: OdometryConfig, laser: LaserGeometry):
         self.config = config
-        self.laser = dict(laser)
+        self.laser = laser
         self.reset(np.random.default_rng(0))
 
     def reset(self, rng: np.random.Generator) -> None:

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 from slamtrials.trial.config import SlamSettings, TrialConfig
 from slamtrials.trial.coverage import mapped_fraction, observed_fraction
-from slamtrials.trial.run import TRIAL_FORMAT, TrialProgress, run_trial
+from slamtrials.trial.run import TrialProgress, run_trial
+from slamtrials.trial.summary import TRIAL_FORMAT, TrialSummary
 
-__all__ = ["run_trial", "TrialConfig", "SlamSettings", "TrialProgress", "TRIAL_FORMAT", "mapped_fraction",
+__all__ = ["run_trial", "TrialConfig", "SlamSettings", "TrialProgress", "TrialSummary", "TRIAL_FORMAT", "mapped_fraction",
            "observed_fraction"]

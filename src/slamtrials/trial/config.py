@@ -2,8 +2,8 @@
 
 ``TrialConfig()`` is the paper's set-up: the paper's robot and laser (:class:`~slamtrials.sim.SimConfig`),
 ``gmapping`` with the ``paper`` preset, frontier exploration and the snapshot termination rule. The
-explorer drives the simulated robot, so its motion limits, footprint and control period are always taken
-from ``sim`` (:meth:`TrialConfig.explore_config`); the ``explore`` section holds the rest.
+explorer drives the simulated robot, so its motion limits, footprint and control period are those of
+``sim`` (:meth:`TrialConfig.robot_limits`); the ``explore`` section holds the rest and refuses robot fields.
 """
 
 from __future__ import annotations
@@ -13,18 +13,13 @@ from typing import Any
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from slamtrials.errors import ConfigError, validation_problems
-from slamtrials.explore import ExploreConfig, TerminationConfig
+from slamtrials.explore import ExploreConfig, RobotLimits, TerminationConfig
 from slamtrials.sim import SimConfig
 from slamtrials.slam import get_algorithm, resolve_config
 
 __all__ = ["SlamSettings", "TrialConfig"]
 
 _MODEL_CONFIG = ConfigDict(extra="forbid", frozen=True)
-
-#: ExploreConfig fields that describe the robot and are copied from SimConfig.
-_ROBOT_FIELDS = ("robot_radius", "max_linear_speed", "max_angular_speed", "max_linear_accel", "max_angular_accel",
-                 "control_period")
-
 
 class SlamSettings(BaseModel):
     """Which SLAM algorithm runs online, and with which parameters.
@@ -60,7 +55,7 @@ class TrialConfig(BaseModel):
     slam:
         The online SLAM algorithm.
     explore:
-        Frontier explorer settings (its robot fields are overridden from ``sim``).
+        Frontier explorer settings (the robot it drives is ``sim``'s: :meth:`robot_limits`).
     termination:
         The paper's snapshot rule and the hard time cap.
     coverage_stride:
@@ -76,14 +71,12 @@ class TrialConfig(BaseModel):
     termination: TerminationConfig = Field(default_factory=TerminationConfig)
     coverage_stride: int = Field(5, ge=1, le=1000, description="frames between scans traced for the observed area, and between poses aligning the mapped area")
 
-    def explore_config(self) -> ExploreConfig:
-        """``explore`` with the robot's footprint, limits and control period taken from ``sim``."""
+    def robot_limits(self) -> RobotLimits:
+        """The explorer's robot: footprint and limits from ``sim.robot``, control period ``sim.dt``."""
         robot = self.sim.robot
-        values = {"robot_radius": robot.radius, "max_linear_speed": robot.max_linear_speed,
-                  "max_angular_speed": robot.max_angular_speed, "max_linear_accel": robot.max_linear_accel,
-                  "max_angular_accel": robot.max_angular_accel, "control_period": self.sim.dt}
-        assert set(values) == set(_ROBOT_FIELDS)
-        return ExploreConfig.from_dict({**self.explore.model_dump(), **values})
+        return RobotLimits(radius=robot.radius, max_linear_speed=robot.max_linear_speed,
+                           max_angular_speed=robot.max_angular_speed, max_linear_accel=robot.max_linear_accel,
+                           max_angular_accel=robot.max_angular_accel, control_period=self.sim.dt)
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> "TrialConfig":

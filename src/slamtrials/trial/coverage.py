@@ -17,14 +17,12 @@ was covered:
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from slamtrials.geometry import compose, compose1, inverse, transform_points
-from slamtrials.record import UNKNOWN, OccupancyGrid
+from slamtrials.record import UNKNOWN, LaserGeometry, OccupancyGrid
 from slamtrials.slam import GridMap
 from slamtrials.worlds import World
 from slamtrials.worlds.world import cell_to_world
@@ -85,7 +83,7 @@ def local_mapped_fraction(world: World, grid: OccupancyGrid, estimate: NDArray[n
     return float(np.mean(_lookup(grid, points) != UNKNOWN))
 
 
-def observed_fraction(world: World, truth: NDArray[np.float64], scans: NDArray[np.float32], laser: dict[str, Any],
+def observed_fraction(world: World, truth: NDArray[np.float64], scans: NDArray[np.float32], laser: LaserGeometry,
                       stride: int, reachable: NDArray[np.bool_] | None = None) -> float:
     """Fraction of the ``reachable`` world cells the laser saw (scans traced at their true poses)."""
     centres = reachable_cell_centres(world, reachable)

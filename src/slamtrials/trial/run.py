@@ -24,12 +24,20 @@ from dataclasses import dataclass
 import numpy as np
 
 from slamtrials import stablemath
+from slamtrials.errors import ConfigError
 from slamtrials.explore import Explorer, SnapshotTermination
 from slamtrials.record import Frame, OccupancyGrid, RunRecord
+from slamtrials.seeding import check_seed, run_streams
 from slamtrials.sim import Simulator
 from slamtrials.slam import get_algorithm
 from slamtrials.trial.config import TrialConfig
-from slamtrials.trial.coverage import known_free_area, local_mapped_fraction, mapped_fraction, observed_fraction
+from slamtrials.trial.coverage import (
+    known_free_area,
+    local_mapped_fraction,
+    mapped_fraction,
+    observed_fraction,
+)
+from slamtrials.trial.summary import TrialSummary
 from slamtrials.worlds import World
 
 __all__ = ["run_trial", "TrialProgress", "TRIAL_FORMAT"]
@@ -108,21 +116,16 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
     SimulationError
         The robot does not fit at the world's start pose.
     """
-    from slamtrials.errors import ConfigError
-
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ConfigError(f"trial seed must be a non-negative integer, got {seed!r}")
+    streams = run_streams(check_seed(seed, "trial seed"))
     config = TrialConfig() if config is None else config
     slam_config = config.slam.resolved()
-    sequence = np.random.SeedSequence(int(seed))
-    sim_seed, slam_seed = sequence.spawn(2)
     started = time.perf_counter()
 
-    sim = Simulator(world, config.sim, np.random.default_rng(sim_seed))
-    laser = sim.laser_info
-    slam = get_algorithm(config.slam.algorithm)(slam_config, dict(laser))
-    slam.reset(np.random.default_rng(slam_seed))
-    explorer = Explorer(config.explore_config())
+    sim = Simulator(world, config.sim, np.random.default_rng(streams.simulator))
+    laser = sim.laser
+    slam = get_algorithm(config.slam.algorithm)(slam_config, laser)
+    slam.reset(np.random.default_rng(streams.slam))
+    explorer = Explorer(config.explore, config.robot_limits())
     reachable = world.reachable_by_disc(config.sim.robot.radius)
     reachable_area = world.area_of(reachable)
     # the paper chose the snapshot period by the building's size, known in advance
@@ -163,32 +166,31 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
     wall = time.perf_counter() - started
     duration = float(record.t[-1] - record.t[0])
     stats = explorer.stats
+    summary = TrialSummary(
+        termination_reason=reason,
+        mapped_fraction=local_mapped_fraction(world, final_map, record.estimate, record.truth, reachable,
+                                              config.coverage_stride),
+        mapped_fraction_global=mapped_fraction(world, final_map, record.estimate[0], record.truth[0], reachable),
+        observed_fraction=observed_fraction(world, record.truth, record.scans, laser, config.coverage_stride, reachable),
+        reachable_area_m2=reachable_area,
+        mapped_fraction_connected=mapped_fraction(world, final_map, record.estimate[0], record.truth[0]),
+        connected_free_area_m2=world.area_of(world.reachable_free()),
+        mapped_free_area_m2=known_free_area(final_map),
+        distance_m=_path_length(record.truth),
+        turning_rad=_turning(record.truth),
+        duration_s=duration,
+        wall_time_s=wall,
+        realtime_factor=duration / max(wall, 1e-9),
+        slam_updates=int(slam.updates),
+        slam_seconds=slam_seconds,
+        stalled_frames=int(np.count_nonzero(record.stalled)),
+        explorer={k: (round(v, 3) if isinstance(v, float) else v) for k, v in vars(stats).items()},
+        snapshots=tuple((round(t, 3), round(mse, 4)) for t, mse in termination.history),
+    )
     record.metadata = {
         **sim.metadata,
         "seed": int(seed),
-        "trial": {
-            "format": TRIAL_FORMAT,
-            "termination_reason": reason,
-            "mapped_fraction": local_mapped_fraction(world, final_map, record.estimate, record.truth, reachable,
-                                                     config.coverage_stride),
-            "mapped_fraction_global": mapped_fraction(world, final_map, record.estimate[0], record.truth[0], reachable),
-            "observed_fraction": observed_fraction(world, record.truth, record.scans, laser, config.coverage_stride,
-                                                   reachable),
-            "reachable_area_m2": reachable_area,
-            "mapped_fraction_connected": mapped_fraction(world, final_map, record.estimate[0], record.truth[0]),
-            "connected_free_area_m2": world.area_of(world.reachable_free()),
-            "mapped_free_area_m2": known_free_area(final_map),
-            "distance_m": _path_length(record.truth),
-            "turning_rad": _turning(record.truth),
-            "duration_s": duration,
-            "wall_time_s": wall,
-            "realtime_factor": duration / max(wall, 1e-9),
-            "slam_updates": int(slam.updates),
-            "slam_seconds": slam_seconds,
-            "stalled_frames": int(np.count_nonzero(record.stalled)),
-            "explorer": {k: (round(v, 3) if isinstance(v, float) else v) for k, v in vars(stats).items()},
-            "snapshots": [[round(t, 3), round(mse, 4)] for t, mse in termination.history],
-        },
+        "trial": summary.to_dict(),
         "config": config.model_dump(mode="json"),
         "slam_config": slam_config.model_dump(mode="json"),
     }

@@ -15,8 +15,9 @@ import pytest
 from slamtrials.errors import ConfigError
 from slamtrials.slam import get_algorithm, make_algorithm, resolve_config
 from slamtrials.slam.gmapping import GMapping, GMappingConfig
+from slamtrials.record import LaserGeometry
 
-LASER = {"angle_min": -2.35, "angle_increment": 0.0087, "range_min": 0.0, "range_max": 30.0, "mount": [0.0, 0.0, 0.0]}
+LASER = LaserGeometry.from_dict({"angle_min": -2.35, "angle_increment": 0.0087, "range_min": 0.0, "range_max": 30.0, "mount": [0.0, 0.0, 0.0]})
 
 #: slam_gmapping's defaults (spec table, column 1); maxUrange / maxRange: the laser's range (None).
 SLAM_GMAPPING_DEFAULTS = {
@@ -44,7 +45,7 @@ def test_defaults_are_slam_gmappings():
     assert config.initial_pose is None
     # maxUrange / maxRange default to the laser's range
     algorithm = make_algorithm("gmapping", LASER)
-    assert algorithm.max_urange == LASER["range_max"] and algorithm.max_range == LASER["range_max"]
+    assert algorithm.max_urange == LASER.range_max and algorithm.max_range == LASER.range_max
 
 
 def test_paper_preset_has_the_spec_values_and_defaults_elsewhere():

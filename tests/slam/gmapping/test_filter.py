@@ -12,28 +12,29 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 
 from slamtrials.geometry import compose, compose1, ominus
-from slamtrials.record import Frame
+from slamtrials.record import Frame, LaserGeometry
 from slamtrials.slam import make_algorithm
 
 BEAMS = 181
-LASER = {"angle_min": -math.pi / 2, "angle_increment": math.pi / (BEAMS - 1), "range_min": 0.02, "range_max": 10.0,
-         "mount": [0.0, 0.0, 0.0]}
+LASER = LaserGeometry.from_dict({"angle_min": -math.pi / 2, "angle_increment": math.pi / (BEAMS - 1), "range_min": 0.02, "range_max": 10.0,
+         "mount": [0.0, 0.0, 0.0]})
 HALF_X, HALF_Y = 4.0, 3.0
 
 
 def box_scan(laser_pose: np.ndarray, laser: dict = LASER) -> np.ndarray:
     x, y, theta = laser_pose
-    heading = theta + laser["angle_min"] + laser["angle_increment"] * np.arange(BEAMS)
+    heading = theta + laser.angle_min + laser.angle_increment * np.arange(BEAMS)
     c, s = np.cos(heading), np.sin(heading)
     with np.errstate(divide="ignore"):
         tx = np.where(c > 0, (HALF_X - x) / c, (-HALF_X - x) / c)
         ty = np.where(s > 0, (HALF_Y - y) / s, (-HALF_Y - y) / s)
-    return np.minimum(np.minimum(np.abs(tx), np.abs(ty)), laser["range_max"]).astype(np.float32)
+    return np.minimum(np.minimum(np.abs(tx), np.abs(ty)), laser.range_max).astype(np.float32)
 
 
 def run(odometry: np.ndarray, times: np.ndarray, *, laser: dict = LASER, seed: int = 0, **overrides):
@@ -42,7 +43,7 @@ def run(odometry: np.ndarray, times: np.ndarray, *, laser: dict = LASER, seed: i
     algorithm = make_algorithm("gmapping", laser, overrides={"particles": 5, **overrides})
     algorithm.reset(np.random.default_rng(seed))
     processed = []
-    mount = np.asarray(laser["mount"], dtype=np.float64)
+    mount = np.asarray(laser.mount, dtype=np.float64)
     for k, (t, pose) in enumerate(zip(times, odometry)):
         before = algorithm.updates
         algorithm.process(Frame(t=float(t), ranges=box_scan(compose1(pose, mount), laser), odometry=pose, truth=pose))
@@ -100,14 +101,14 @@ def test_temporal_update_when_standing_still():
 def test_first_reading_places_every_particle_on_the_first_odometry_pose_and_only_registers():
     """With a laser mount, the particles (laser poses) start at odometry (+) mount; the estimate returned
     is the base pose; nothing is matched (all log weights 0)."""
-    laser = {**LASER, "mount": [0.2, -0.05, 0.1]}
+    laser = dataclasses.replace(LASER, mount=(0.2, -0.05, 0.1))
     start = np.array([0.5, -0.4, 0.3])
     algorithm = make_algorithm("gmapping", laser, overrides={"particles": 4})
     algorithm.reset(np.random.default_rng(0))
-    estimate = algorithm.process(Frame(t=0.0, ranges=box_scan(compose1(start, np.array(laser["mount"])), laser),
+    estimate = algorithm.process(Frame(t=0.0, ranges=box_scan(compose1(start, np.array(laser.mount)), laser),
                                        odometry=start, truth=start))
     np.testing.assert_allclose(estimate, start, atol=1e-12)
-    np.testing.assert_allclose(algorithm.poses, np.tile(compose1(start, np.array(laser["mount"])), (4, 1)), atol=1e-12)
+    np.testing.assert_allclose(algorithm.poses, np.tile(compose1(start, np.array(laser.mount)), (4, 1)), atol=1e-12)
     assert algorithm.updates == 1 and np.all(algorithm.log_weights == 0.0) and algorithm.resamplings == 0
 
 
@@ -125,8 +126,8 @@ def test_only_usable_returns_are_registered():
     ranges[:10] = np.nan
     ranges[10:15] = 0.0
     ranges[15:18] = 0.01  # below range_min
-    ranges[18:25] = LASER["range_max"]
-    usable = (ranges > LASER["range_min"]) & (ranges < LASER["range_max"]) & (ranges <= 4.0)
+    ranges[18:25] = LASER.range_max
+    usable = (ranges > LASER.range_min) & (ranges < LASER.range_max) & (ranges <= 4.0)
     assert 50 < usable.sum() < BEAMS - 25  # some box walls are beyond 4 m
     algorithm.process(Frame(t=0.0, ranges=ranges, odometry=np.zeros(3), truth=np.zeros(3)))
     for p in range(3):

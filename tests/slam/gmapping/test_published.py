@@ -17,11 +17,12 @@ import numpy as np
 import pytest
 
 from slamtrials.slam.gmapping.published import PublishedMap
-from slamtrials.slam.gridmap import GridMap, beam_angles
+from slamtrials.slam.gridmap import GridMap
+from slamtrials.record import LaserGeometry
 
 RES = 0.05
 BEAMS = 181
-LASER = {"angle_min": -math.pi / 2, "angle_increment": math.pi / (BEAMS - 1), "range_min": 0.05, "range_max": 8.0}
+LASER = LaserGeometry.from_dict({"angle_min": -math.pi / 2, "angle_increment": math.pi / (BEAMS - 1), "range_min": 0.05, "range_max": 8.0})
 MAX_URANGE = 5.0
 HALF_X, HALF_Y = 3.1, 2.2  # walls of the room (m)
 
@@ -29,25 +30,25 @@ HALF_X, HALF_Y = 3.1, 2.2  # walls of the room (m)
 def room_scan(pose: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """Exact ranges to the room's walls, some readings replaced by NaN, 0 and no-return (range_max)."""
     x, y, theta = pose
-    heading = theta + beam_angles(LASER, BEAMS)
+    heading = theta + LASER.beam_angles(BEAMS)
     c, s = np.cos(heading), np.sin(heading)
     with np.errstate(divide="ignore"):
         tx = np.where(c > 0, (HALF_X - x) / c, (-HALF_X - x) / c)
         ty = np.where(s > 0, (HALF_Y - y) / s, (-HALF_Y - y) / s)
     r = np.minimum(np.abs(tx), np.abs(ty))
-    r = np.where(r > LASER["range_max"], LASER["range_max"], r)
+    r = np.where(r > LASER.range_max, LASER.range_max, r)
     special = rng.random(BEAMS)
     r[special < 0.03] = np.nan
     r[(special >= 0.03) & (special < 0.05)] = 0.0
-    r[(special >= 0.05) & (special < 0.08)] = LASER["range_max"]
+    r[(special >= 0.05) & (special < 0.08)] = LASER.range_max
     return r.astype(np.float32)
 
 
 def scratch(path: np.ndarray, scans: list[np.ndarray]) -> GridMap:
     grid = GridMap(RES)
     for pose, ranges in zip(path, scans):
-        grid.integrate(pose, ranges, beam_angles(LASER, ranges.shape[0]), range_min=LASER["range_min"],
-                       range_max=LASER["range_max"], max_urange=MAX_URANGE)
+        grid.integrate(pose, ranges, LASER.beam_angles(ranges.shape[0]), range_min=LASER.range_min,
+                       range_max=LASER.range_max, max_urange=MAX_URANGE)
     return grid
 
 

@@ -50,7 +50,7 @@ from numpy.typing import NDArray
 
 from slamtrials import stablemath
 from slamtrials.geometry import compose, compose1, inverse, ominus, wrap_angle1
-from slamtrials.record import Frame, Trajectory
+from slamtrials.record import Frame, LaserGeometry, Trajectory
 from slamtrials.slam.base import OccupancyGrid, register_algorithm
 from slamtrials.slam.gmapping.config import PRESETS, GMappingConfig
 from slamtrials.slam.gmapping.kernels import match_particles
@@ -59,7 +59,6 @@ from slamtrials.slam.gmapping.motion import sample_motion
 from slamtrials.slam.gmapping.published import PublishedMap
 from slamtrials.slam.gmapping.tilemap import TileMaps
 from slamtrials.slam.gmapping.weights import effective_sample_size, normalized_weights, systematic_resample
-from slamtrials.slam.gridmap import beam_angles
 
 __all__ = ["GMapping"]
 
@@ -73,7 +72,7 @@ class GMapping:
     config:
         Validated :class:`~slamtrials.slam.gmapping.config.GMappingConfig`.
     laser:
-        Laser geometry dict of :class:`~slamtrials.record.RunRecord`.
+        The laser's geometry (:class:`~slamtrials.record.LaserGeometry`).
 
     Attributes
     ----------
@@ -89,12 +88,12 @@ class GMapping:
     Config: ClassVar[type[GMappingConfig]] = GMappingConfig
     PRESETS: ClassVar[dict[str, dict[str, Any]]] = PRESETS
 
-    def __init__(self, config: GMappingConfig, laser: dict[str, Any]):
+    def __init__(self, config: GMappingConfig, laser: LaserGeometry):
         self.config = config
-        self.laser = dict(laser)
-        self.mount = np.asarray(self.laser.get("mount", (0.0, 0.0, 0.0)), dtype=np.float64)
-        self.range_min = float(self.laser.get("range_min", 0.0))
-        self.range_max = float(self.laser["range_max"])
+        self.laser = laser
+        self.mount = np.asarray(laser.mount, dtype=np.float64)
+        self.range_min = laser.range_min
+        self.range_max = laser.range_max
         self.max_urange = self.range_max if config.maxUrange is None else float(config.maxUrange)
         self.max_range = self.range_max if config.maxRange is None else float(config.maxRange)
         self.reset(np.random.default_rng(0))
@@ -202,13 +201,14 @@ class GMapping:
         odometry = np.asarray(frame.odometry, dtype=np.float64)
         laser_odometry = compose1(odometry, self.mount)
         if self._angles is None or self._angles.shape[0] != ranges.shape[0]:
-            self._angles = beam_angles(self.laser, ranges.shape[0])
-        first = self._last_laser_odometry is None
-        if first:
+            self._angles = self.laser.beam_angles(ranges.shape[0])
+        previous = self._last_laser_odometry
+        first = previous is None
+        if previous is None:
             start = laser_odometry if c.initial_pose is None else compose1(np.asarray(c.initial_pose), self.mount)
             self.poses[:] = start
         else:
-            self.poses = sample_motion(self.poses, self._last_laser_odometry, laser_odometry, c.srr, c.srt, c.str, c.stt,
+            self.poses = sample_motion(self.poses, previous, laser_odometry, c.srr, c.srt, c.str, c.stt,
                                        self.rng)
         due = self._due(t, laser_odometry)
         self._last_laser_odometry = laser_odometry

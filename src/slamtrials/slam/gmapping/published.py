@@ -9,13 +9,13 @@ same grid a rebuild from scratch would give.
 
 from __future__ import annotations
 
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from slamtrials.slam.base import OccupancyGrid
-from slamtrials.slam.gridmap import GridMap, beam_angles
+from slamtrials.record import LaserGeometry
+from slamtrials.slam.gridmap import GridMap
 
 __all__ = ["PublishedMap"]
 
@@ -28,14 +28,14 @@ class PublishedMap:
     resolution:
         Cell size (m).
     laser:
-        Laser geometry dict (``angle_min``, ``angle_increment``, ``range_min``, ``range_max``).
+        The laser's geometry.
     max_urange:
         Beams longer than this are cut there and mark only free cells (m).
     occ_thresh:
         Occupied where hits / visits exceeds this.
     """
 
-    def __init__(self, resolution: float, laser: dict[str, Any], *, max_urange: float, occ_thresh: float):
+    def __init__(self, resolution: float, laser: LaserGeometry, *, max_urange: float, occ_thresh: float):
         self.grid = GridMap(resolution)
         self.laser = laser
         self.max_urange = float(max_urange)
@@ -53,9 +53,9 @@ class PublishedMap:
             while end < len(scans) and scans[end].shape == scans[start].shape:
                 end += 1
             self.grid.integrate_many(np.array(poses[start:end]), np.stack(scans[start:end]),
-                                     beam_angles(self.laser, scans[start].shape[0]), np.array(weights[start:end]),
-                                     range_min=float(self.laser.get("range_min", 0.0)),
-                                     range_max=float(self.laser["range_max"]), max_urange=self.max_urange)
+                                     self.laser.beam_angles(scans[start].shape[0]), np.array(weights[start:end]),
+                                     range_min=self.laser.range_min,
+                                     range_max=self.laser.range_max, max_urange=self.max_urange)
             start = end
 
     def rebuild(self, path: NDArray[np.float64], scans: list[NDArray[np.float32]]) -> int:

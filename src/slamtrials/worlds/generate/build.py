@@ -81,15 +81,25 @@ def keep_largest_region(occupied: NDArray[np.bool_]) -> int:
 
 
 def _start_pose(occupied: NDArray[np.bool_], labels: NDArray[np.int32], grid: Grid) -> NDArray[np.float64] | None:
-    """A pose in the circulation nearest the building's centre, with START_CLEARANCE, along the corridor."""
+    """A pose in the circulation nearest the building's centre, with START_CLEARANCE, along the corridor.
+
+    The circulation cell nearest the centre is looked for on every ``step``-th row and column. The
+    centre often falls half-way between such cells, so exact ties are common; they are broken by the
+    distance at full resolution, then by row-major order, never by how a sort happens to order equal keys
+    (numpy's default sort orders them differently on AVX-512 CPUs).
+    """
     step = 4
     coarse = labels[::step, ::step]
     rows, cols = np.nonzero(coarse > 0)
     centre_r, centre_c = rows.mean(), cols.mean()
-    rows, cols = np.nonzero(coarse == CIRCULATION)
+    fine_r, fine_c = np.nonzero(labels > 0)
+    fine_centre_r, fine_centre_c = fine_r.mean(), fine_c.mean()
+    rows, cols = np.nonzero(coarse == CIRCULATION)  # row-major order
     if len(rows) == 0:
         return None
-    nearest = np.argsort((rows - centre_r) ** 2 + (cols - centre_c) ** 2)[0]
+    coarse_d2 = (rows - centre_r) ** 2 + (cols - centre_c) ** 2
+    fine_d2 = (rows * step - fine_centre_r) ** 2 + (cols * step - fine_centre_c) ** 2
+    nearest = np.lexsort((fine_d2, coarse_d2))[0]  # lexsort is stable: remaining ties keep row-major order
     centre_r, centre_c = int(rows[nearest]) * step, int(cols[nearest]) * step
     size = 2 * grid.px(START_CLEARANCE) + 1
     # Prefer the circulation near the centre; narrow hallways (houses) may have no such room, and then

@@ -3,8 +3,8 @@
 Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/bench_karto.py [--quick] [--log PATH ...]``. Prints
 Markdown tables; the latest figures are kept in docs/karto.md ("Speed").
 
-1. Real logs (default: the MIT CSAIL log of ``../shared/data``; ``--log`` adds others, ``.bz2`` logs are
-   decompressed to a temporary file first): karto with its defaults over the whole log; wall time per
+1. Real logs (default: the MIT CSAIL log of ``../shared/data``; ``--log`` adds others, also ``.gz`` or
+   ``.bz2``): karto with its defaults over the whole log; wall time per
    frame, per node (matching, linking, loop closing, optimizing; median, 90th percentile, largest),
    loop closures, and every optimizer run's time against the graph's size at that moment.
 2. Optimizer scaling: synthetic pose graphs (a robot lapping a rectangle, one node per 0.5 m, each
@@ -22,10 +22,7 @@ import os
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
-import bz2  # noqa: E402
 import math  # noqa: E402
-import shutil  # noqa: E402
-import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
@@ -47,17 +44,8 @@ def frames(record: RunRecord, stop: int | None = None):
         yield Frame(t=float(record.t[k]), ranges=record.scans[k], odometry=record.odometry[k], truth=record.truth[k])
 
 
-def read_log(path: Path, scratch: Path) -> RunRecord:
-    if path.suffix == ".bz2":
-        plain = scratch / path.stem
-        with bz2.open(path, "rb") as source, open(plain, "wb") as target:
-            shutil.copyfileobj(source, target)
-        path = plain
-    return load_recording(path)
-
-
-def bench_log(path: Path, scratch: Path) -> None:
-    record = read_log(path, scratch)
+def bench_log(path: Path) -> None:
+    record = load_recording(path)
     warm = make_algorithm("karto", record.laser)
     for frame in frames(record, 200):
         warm.process(frame)
@@ -135,12 +123,11 @@ def main() -> None:
     args = parser.parse_args()
     print(f"CPU: {cpu_model()}; NUMBA_NUM_THREADS={os.environ.get('NUMBA_NUM_THREADS')}")
     logs = [SHARED / "data" / "mit-csail" / "mit-csail.clf"] + [Path(p) for p in args.log]
-    with tempfile.TemporaryDirectory() as scratch:
-        for log in logs:
-            if log.exists():
-                bench_log(log, Path(scratch))
-            else:
-                print(f"\n(no {log})")
+    for log in logs:
+        if log.exists():
+            bench_log(log)
+        else:
+            print(f"\n(no {log})")
     bench_optimizer([250, 500, 1000] if args.quick else [250, 500, 1000, 2000, 4000])
 
 

@@ -47,7 +47,7 @@ def _cli(*args: str, cache) -> tuple[int, str, str]:
     leader, follower = pty.openpty()
     try:
         done = subprocess.run([sys.executable, "-c", code, *args], env=env, stdout=subprocess.PIPE, stderr=follower,
-                              text=True, timeout=300)
+                              text=True, timeout=300, check=False)
     finally:
         os.close(follower)
     stderr = b""
@@ -81,7 +81,7 @@ def test_no_notice_when_stderr_is_not_a_terminal(tmp_path):
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba-cache")}
     code = "import sys; from slamtrials.cli.main import main; sys.argv[0] = 'slamtrials'; main()"
     done = subprocess.run([sys.executable, "-c", code, "-v", "worlds", "info", "office_small_01"], env=env,
-                          capture_output=True, text=True, timeout=300)
+                          capture_output=True, text=True, timeout=300, check=False)
     assert done.returncode == 0, done.stderr
     assert COMPILING_NOTICE not in done.stderr
     assert "compiled slamtrials.stablemath." in done.stderr

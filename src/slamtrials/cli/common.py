@@ -9,8 +9,8 @@ from __future__ import annotations
 import logging
 
 import typer
-from typer.core import TyperGroup
 from typer import BadParameter
+from typer.core import TyperGroup
 
 try:  # typer >= 0.20 carries its own copy of click
     from typer._click.exceptions import MissingParameter

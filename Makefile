@@ -1,13 +1,14 @@
 # The two set-up commands of the README:
 #   make demo   create .venv, install slamtrials, run the main job (writes results/demo/)
 #   make test   create .venv, install slamtrials with its test tools, run the whole test suite
+#   make test-fast   the same without the tests marked slow (under 2 minutes on 2 cores)
 PYTHON ?= $(shell command -v python3.11 || command -v python3)
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 OUT    ?= results/demo
 
-.PHONY: demo test bench clean
+.PHONY: demo test test-fast bench clean
 
 $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), "slamtrials needs Python >= 3.11"'
@@ -20,6 +21,9 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
+
+test-fast: $(STAMP)
+	$(BIN)/python -m pytest -q -m "not slow"
 
 bench: $(STAMP)
 	$(BIN)/python bench/run_all.py

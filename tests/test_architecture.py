@@ -10,7 +10,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "src" / "slamtrials"
 
 #: Modules every layer may import: they hold no behaviour of any layer.
-UTILITIES = {"errors", "atomicfile", "__about__", "stablemath", "seeding"}
+UTILITIES = {"errors", "atomicfile", "__about__", "stablemath", "seeding", "compilewatch"}
 
 #: Layer -> the slamtrials layers it may import (DESIGN.md, "Layers").
 ALLOWED = {
@@ -217,3 +217,42 @@ def test_reproducible_layers_order_ties_by_rule_not_by_sort_implementation(path:
 ])
 def test_ordering_guard_flags_unstable_sorts_and_set_iteration(source: str, flagged: bool) -> None:
     assert bool(ordering_problems(ast.parse(source))) == flagged
+
+
+#: numba's decorators that compile a function (an @intrinsic only emits code inside the kernels that call it).
+_NUMBA_COMPILERS = {"njit", "jit", "vectorize", "guvectorize", "cfunc", "generated_jit", "overload", "stencil"}
+
+
+def _numba_compilers_imported(tree: ast.AST) -> set[str]:
+    """The local names of numba's compiling decorators imported with ``from numba... import``."""
+    return {alias.asname or alias.name for node in ast.walk(tree)
+            if isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] == "numba"
+            for alias in node.names if alias.name in _NUMBA_COMPILERS}
+
+
+def _numba_compiler(func: ast.expr, imported: set[str]) -> bool:
+    """``njit`` (from numba), ``numba.njit``, ``numba.core.extending.overload``, ...: not ``np.vectorize``
+    nor ``typing.overload``."""
+    text = ast.unparse(func)
+    return text in imported or (text.startswith("numba.") and text.split(".")[-1] in _NUMBA_COMPILERS)
+
+
+@pytest.mark.parametrize("path", SOURCES, ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_numba_kernels_are_module_level_and_cached(path: Path) -> None:
+    """A kernel compiles once per install, not once per process: cache=True, and at module level (numba
+    cannot cache a closure or a kernel made inside a function, nor one compiled by calling njit(f))."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    imported = _numba_compilers_imported(tree)
+    top_level = {id(node) for node in tree.body}
+    decorators = {id(d) for node in ast.walk(tree) if isinstance(node, ast.FunctionDef) for d in node.decorator_list}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.FunctionDef):
+            for decorator in node.decorator_list:
+                call = decorator if isinstance(decorator, ast.Call) else None
+                if not _numba_compiler(call.func if call else decorator, imported):
+                    continue
+                assert id(node) in top_level, f"{path}:{node.lineno}: kernel {node.name} is not at module level"
+                cached = call is not None and any(k.arg == "cache" and ast.literal_eval(k.value) is True for k in call.keywords)
+                assert cached, f"{path}:{node.lineno}: kernel {node.name} lacks cache=True"
+        elif isinstance(node, ast.Call) and id(node) not in decorators and _numba_compiler(node.func, imported):
+            raise AssertionError(f"{path}:{node.lineno}: {ast.unparse(node)} compiles a kernel outside a decorator")

@@ -38,6 +38,7 @@ def test_the_demo_is_the_small_campaign_with_the_papers_settings(tmp_path):
     assert (config.runs.confidence, config.runs.margin_t, config.runs.margin_r) == (0.99, 0.02, 0.02)
 
 
+@pytest.mark.slow  # two campaigns and two reports; test_demo_command_... below keeps the wiring in the fast lane
 def test_run_demo_runs_the_campaign_writes_the_report_and_resumes(tmp_path, client):
     out = tmp_path / "demo"
     fake = FakeTrial(std_t=0.01, std_r=0.005)

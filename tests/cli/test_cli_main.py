@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pytest
 import typer
 from typer.testing import CliRunner
 
@@ -44,3 +45,55 @@ def test_simulate_needs_exactly_one_path_source(tmp_path):
     result = runner.invoke(app, ["simulate", "--world", "office_small_01", "--out", str(tmp_path / "r")])
     assert result.exit_code == 2
     assert "--path" in result.output and "--tour" in result.output
+
+
+def _help_texts(command, path=()):
+    """(where, text) for the help text of every command and every option and argument under ``command``."""
+    if command.help:
+        yield " ".join(path) or "slamtrials", command.help
+    for param in command.params:
+        if getattr(param, "help", None):
+            yield f"{' '.join(path)} {param.name}", param.help
+    for name, sub in getattr(command, "commands", {}).items():
+        yield from _help_texts(sub, (*path, name))
+
+
+def test_no_help_text_loses_brackets_to_rich_markup():
+    # typer renders help as rich markup: an unescaped "[x, y]" or "[default: ...]" is a style tag and vanishes
+    from rich.text import Text
+
+    texts = list(_help_texts(typer.main.get_command(app)))
+    assert len(texts) > 50
+    for where, text in texts:
+        assert Text.from_markup(text).plain == text.replace("\\[", "["), where
+
+
+def test_simulate_help_shows_the_waypoints_example():
+    result = runner.invoke(app, ["simulate", "--help"], env={"COLUMNS": "200"})
+    assert result.exit_code == 0
+    assert "'waypoints: [[x, y], ...]'" in result.output
+
+
+def test_import_help_shows_the_default_topics():
+    result = runner.invoke(app, ["import", "--help"], env={"COLUMNS": "200"})
+    assert "[default: /base_scan]" in result.output and "[default: /base_pose_ground_truth]" in result.output
+
+
+@pytest.mark.parametrize(("args", "expected"), [
+    (["export", "RUN", "--to", "xyz", "--out", "x.bag"], "error: --to: 'xyz' is not one of 'bag', 'bag2', 'carmen', 'tum'"),
+    (["export", "RUN", "--to", "tum", "--what", "gps", "--out", "x.tum"], "error: --what: 'gps' is not one of 'truth', 'odometry'"),
+    (["import", "x.bag", "--out", "r", "--format", "csv"], "error: --format: 'csv' is not one of 'auto', 'bag', 'carmen'"),
+    (["export-table", "CAMPAIGN", "--format", "xls"], "error: --format: 'xls' is not one of 'csv', 'parquet'"),
+    (["simulate", "--world", "office_small_01", "--tour", "--seed", "three", "--out", "r"], "error: --seed: Input should be a valid integer"),
+])
+def test_a_bad_option_value_is_one_line_and_exit_2(args, expected):
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(expected), result.output
+
+
+def test_a_missing_option_keeps_the_usage_panel():
+    result = runner.invoke(app, ["export", "RUN", "--to", "tum"])
+    assert result.exit_code == 2
+    assert "Missing option '--out'" in result.output and "Usage" in result.output

@@ -11,12 +11,16 @@ from functools import cache
 from pathlib import Path
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from slamtrials.errors import FormatError
 from slamtrials.io.rosbag import run_from_bag, write_rosbag1, write_rosbag2
 from slamtrials.record import LaserGeometry, RunRecord
+
+# Fuzzing runs hundreds of generated files per test: the whole suite runs it, the fast lane does not.
+pytestmark = pytest.mark.slow
 
 FUZZ = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 

@@ -22,6 +22,9 @@ from slamtrials.io.relations import read_relations
 from slamtrials.io.tum import read_tum
 from slamtrials.record import Relations, Trajectory
 
+# Fuzzing runs hundreds of generated files per test: the whole suite runs it, the fast lane does not.
+pytestmark = pytest.mark.slow
+
 FLASER_LOG = (
     "# CARMEN Logfile\n"
     "PARAM robot_front_laser_max 50.0 100.0 b21 0.1\n"

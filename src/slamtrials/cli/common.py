@@ -9,7 +9,13 @@ from __future__ import annotations
 import logging
 
 import typer
+from typer import BadParameter
 from typer.core import TyperGroup
+
+try:  # typer >= 0.20 carries its own copy of click
+    from typer._click.exceptions import MissingParameter
+except ImportError:  # pragma: no cover - older typer on click
+    from click.exceptions import MissingParameter
 
 from slamtrials.errors import SlamtrialsError
 
@@ -19,11 +25,21 @@ EXIT_BAD_INPUT = 2
 
 
 class ErrorReportingGroup(TyperGroup):
-    """A command group that turns expected errors into one line and exit status 2."""
+    """A command group that turns expected errors into one line and exit status 2.
+
+    A bad option or argument value (an unknown choice, a number that does not parse) is one line too,
+    like the values the commands check themselves; usage mistakes (a missing or unknown option) keep
+    typer's usage panel, which points to --help.
+    """
 
     def invoke(self, ctx):  # ctx: typer's (vendored) click Context
         try:
             return super().invoke(ctx)
+        except BadParameter as exc:
+            if isinstance(exc, MissingParameter):
+                raise
+            typer.echo(f"error: {bad_value_line(exc)}", err=True)
+            raise typer.Exit(EXIT_BAD_INPUT) from None
         except SlamtrialsError as exc:
             typer.echo(f"error: {exc}", err=True)
             raise typer.Exit(EXIT_BAD_INPUT) from None
@@ -31,6 +47,20 @@ class ErrorReportingGroup(TyperGroup):
             where = f"{exc.filename}: " if exc.filename else ""
             typer.echo(f"error: {where}{exc.strerror or exc}", err=True)
             raise typer.Exit(EXIT_BAD_INPUT) from None
+
+
+def bad_value_line(exc: BadParameter) -> str:
+    """``--to: 'xyz' is not one of 'bag', 'bag2', 'carmen', 'tum'.``: the option (its long name) or the
+    argument (its metavar) and typer's reason, without the "Value error, " its validation prefixes."""
+    param = exc.param
+    if param is None:
+        name = exc.param_hint if isinstance(exc.param_hint, str) else ""
+    elif param.param_type_name == "option":
+        name = max(param.opts, key=len)
+    else:
+        name = param.human_readable_name
+    reason = " ".join(exc.message.split()).removeprefix("Value error, ").rstrip(".")
+    return f"{name}: {reason}" if name else reason
 
 
 def make_app(**kwargs) -> typer.Typer:

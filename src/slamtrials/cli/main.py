@@ -8,6 +8,7 @@ unreadable file) becomes one line on stderr and exit status 2, never a traceback
 from __future__ import annotations
 
 import logging
+import sys
 from typing import Annotated
 
 import typer
@@ -26,16 +27,29 @@ def _version(value: bool) -> None:
         raise typer.Exit()
 
 
+#: Said once on stderr, when it is a terminal, when a command has to compile numba kernels (not found
+#: in numba's cache); with --verbose every compile is logged too.
+COMPILING_NOTICE = "compiling numerical kernels (first run only, up to a minute)..."
+
+
+def _say_compiling(kernel: str) -> None:
+    typer.echo(COMPILING_NOTICE, err=True)
+
+
 @app.callback()
 def root(
+    ctx: typer.Context,
     version: Annotated[bool, typer.Option("--version", callback=_version, is_eager=True, help="Print the version and exit.")] = False,
     verbose: Annotated[bool, typer.Option("--verbose", "-v", help="Log progress details to stderr.")] = False,
 ) -> None:
     """slamtrials: repeatable SLAM evaluation in simulated buildings."""
     import matplotlib
 
+    from slamtrials.compilewatch import watch_compilation
+
     matplotlib.use("Agg")
     logging.basicConfig(level=logging.INFO if verbose else logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    ctx.call_on_close(watch_compilation(_say_compiling if sys.stderr.isatty() else None))
 
 
 def _register_commands() -> None:

@@ -16,7 +16,7 @@ from slamtrials.errors import ConfigError
 def simulate(
     world: Annotated[str, typer.Option("--world", "-w", help="Bundled world name or floor-plan file.")],
     out: Annotated[Path, typer.Option("--out", "-o", help="Run folder to write (frames.npz, run.json, run.png).")],
-    path: Annotated[Path | None, typer.Option("--path", "-p", help="Waypoint YAML ('waypoints: [[x, y], ...]', metres, world frame).")] = None,
+    path: Annotated[Path | None, typer.Option("--path", "-p", help="Waypoint YAML ('waypoints: [\\[x, y], ...]', metres, world frame).")] = None,
     tour: Annotated[bool, typer.Option("--tour", help="Instead of --path, drive an automatic tour to the far corners of the world.")] = False,
     seed: Annotated[int, typer.Option("--seed", "-s", help="Seed of every random draw of the run (odometry bias, noise).")] = 0,
     max_time: Annotated[float, typer.Option("--max-time", help="Stop after this much simulated time (s).")] = 3600.0,

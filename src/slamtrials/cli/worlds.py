@@ -9,7 +9,6 @@ import typer
 
 from slamtrials.cli.common import make_app, make_console
 from slamtrials.errors import ConfigError
-from slamtrials.sim import SimConfig
 
 app = make_app(help="List, show, describe and generate floor plans.")
 
@@ -67,6 +66,8 @@ def show(
 @app.command("info")
 def info(world: WorldArg, resolution: ResolutionOpt = None) -> None:
     """Describe a floor plan: size, resolution, free and reachable free area, start pose, source."""
+    from slamtrials.sim import SimConfig
+
     the_world = _load(world, resolution)
     width, height = the_world.size_m
     res = the_world.resolution

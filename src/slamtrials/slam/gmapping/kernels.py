@@ -473,6 +473,18 @@ def match_particles(directories, mean, tile_col0, tile_row0, res, poses, lx, ly,
 
 
 @njit(cache=True, nogil=True)
+def _copy_tile(count, mean, source, target):  # pragma: no cover - compiled
+    """``count[target] = count[source]`` and ``mean[target] = mean[source]``, as loops: numba's
+    array-to-array assignment carries the code of its shape-mismatch message, whose string functions
+    took about 2 s of a first run's compile."""
+    for i in range(count.shape[1]):
+        for j in range(count.shape[2]):
+            count[target, i, j] = count[source, i, j]
+            for axis in range(mean.shape[3]):
+                mean[target, i, j, axis] = mean[source, i, j, axis]
+
+
+@njit(cache=True, nogil=True)
 def register_endpoints(directories, count, mean, refs, free_stack, state, tile_col0, tile_row0, res, ex, ey,
                        start):  # pragma: no cover - compiled
     """Add each particle's scan endpoints to its map, copying shared tiles before writing (copy-on-write).
@@ -524,8 +536,7 @@ def register_endpoints(directories, count, mean, refs, free_stack, state, tile_c
                     count[fresh] = 0
                     mean[fresh] = EMPTY
                 else:
-                    count[fresh] = count[tile]
-                    mean[fresh] = mean[tile]
+                    _copy_tile(count, mean, tile, fresh)
                     refs[tile] -= 1
                 refs[fresh] = 1
                 directory[tr, tc] = fresh

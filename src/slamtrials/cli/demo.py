@@ -25,13 +25,14 @@ def demo(
     import matplotlib
 
     from slamtrials.campaign.cluster import check_workers
-    from slamtrials.cli.campaign import EXIT_INTERRUPTED, _Progress, _quiet_dask, summary_table
+    from slamtrials.cli.campaign import EXIT_INTERRUPTED, _Progress, summary_table
+    from slamtrials.cli.common import quiet_dask
     from slamtrials.demo import DEMO_WORLDS, run_demo
 
     matplotlib.use("Agg")
     check_workers(workers)  # a bad --workers is one line before anything starts
     worlds = tuple(world) if world else DEMO_WORLDS
-    _quiet_dask()
+    quiet_dask()
     console = make_console()
     intro = [f"Demo campaign in {out}: {', '.join(worlds)}; per world the runs repeat until its mean error is known "
              "(99 % confidence, +-0.02 m / +-0.02 rad) or the cap of 10 runs."]

@@ -34,7 +34,9 @@ from pathlib import Path  # noqa: E402
 from benchutil import cpu_model  # noqa: E402
 
 
-def run_once(workers: int, folder: Path, initial: int, max_runs: int, seed: int, fake_sleep: float | None = None) -> dict:
+def run_once(
+    workers: int, folder: Path, initial: int, max_runs: int, seed: int, fake_sleep: float | None = None
+) -> dict:
     """One campaign from scratch with ``workers`` local worker processes."""
     from slamtrials.campaign import run_campaign, small_campaign_config
     from slamtrials.campaign.store import CampaignStore
@@ -73,12 +75,21 @@ def run_once(workers: int, folder: Path, initial: int, max_runs: int, seed: int,
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--workers", type=int, nargs="+", default=[1, 2], help="worker counts to compare (first is the baseline)")
+    parser.add_argument(
+        "--workers", type=int, nargs="+", default=[1, 2], help="worker counts to compare (first is the baseline)"
+    )
     parser.add_argument("--initial", type=int, default=5, help="first batch of runs per world")
     parser.add_argument("--max-runs", type=int, default=10, help="cap on the runs per world")
     parser.add_argument("--seed", type=int, default=0, help="root seed")
-    parser.add_argument("--fake-sleep", type=float, default=None, help="runs that sleep this long instead of simulating (orchestration only)")
-    parser.add_argument("--out", type=Path, default=None, help="keep the campaign folders here (default: a temporary folder)")
+    parser.add_argument(
+        "--fake-sleep",
+        type=float,
+        default=None,
+        help="runs that sleep this long instead of simulating (orchestration only)",
+    )
+    parser.add_argument(
+        "--out", type=Path, default=None, help="keep the campaign folders here (default: a temporary folder)"
+    )
     args = parser.parse_args()
 
     base = args.out or Path(tempfile.mkdtemp(prefix="bench_campaign_"))
@@ -99,19 +110,25 @@ def main() -> None:
     print()
     print(f"- Machine: {os.cpu_count()} cores, CPU `{cpu_model()}`; date {time.strftime('%Y-%m-%d')}")
     fake = "" if args.fake_sleep is None else f" with FakeTrial(sleep={args.fake_sleep}) runs (orchestration only)"
-    print(f"- Campaign: small_campaign_config(seed={args.seed}, initial={args.initial}, max_runs={args.max_runs}){fake}; "
-          f"worlds {', '.join(w for w, *_ in rows[0]['summary'])}")
+    print(
+        f"- Campaign: small_campaign_config(seed={args.seed}, initial={args.initial}, max_runs={args.max_runs}){fake}; "
+        f"worlds {', '.join(w for w, *_ in rows[0]['summary'])}"
+    )
     print(f"- Same runs and errors for every worker count: {'yes' if same else 'NO'}")
     print()
-    print("| workers | runs | wall time (s) | cluster start (s) | runs per hour | run time summed (s) | efficiency | speed-up | "
-          "speed-up after start | driver + scheduler CPU (s) | load avg before/after |")
+    print(
+        "| workers | runs | wall time (s) | cluster start (s) | runs per hour | run time summed (s) | efficiency | speed-up | "
+        "speed-up after start | driver + scheduler CPU (s) | load avg before/after |"
+    )
     print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
     for r in rows:
         speedup = rows[0]["wall"] / r["wall"]
         after = (rows[0]["wall"] - rows[0]["startup"]) / (r["wall"] - r["startup"])
-        print(f"| {r['workers']} | {r['runs']} | {r['wall']:.0f} | {r['startup']:.1f} | {r['runs_per_hour']:.0f} | {r['run_seconds']:.0f} | "
-              f"{100 * r['efficiency']:.0f} % | {speedup:.2f}x | {after:.2f}x | {r['driver_cpu']:.1f} | "
-              f"{r['load'][0]:.1f} / {r['load'][1]:.1f} |")
+        print(
+            f"| {r['workers']} | {r['runs']} | {r['wall']:.0f} | {r['startup']:.1f} | {r['runs_per_hour']:.0f} | {r['run_seconds']:.0f} | "
+            f"{100 * r['efficiency']:.0f} % | {speedup:.2f}x | {after:.2f}x | {r['driver_cpu']:.1f} | "
+            f"{r['load'][0]:.1f} / {r['load'][1]:.1f} |"
+        )
     print()
     print("| world | status | runs | eps_t mean (m) | eps_r mean (rad) |")
     print("|---|---|---:|---:|---:|")

@@ -41,7 +41,9 @@ def run(args: list[str], cache: Path) -> tuple[float, float, str]:
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), NUMBA_NUM_THREADS="1", OMP_NUM_THREADS="1")
     cpu = _children_cpu()
     started = time.perf_counter()
-    done = subprocess.run([sys.executable, "-c", CLI, "-v", *args], env=env, capture_output=True, text=True, check=False)
+    done = subprocess.run(
+        [sys.executable, "-c", CLI, "-v", *args], env=env, capture_output=True, text=True, check=False
+    )
     wall = time.perf_counter() - started
     if done.returncode != 0:
         sys.exit(f"slamtrials {' '.join(args)} failed ({done.returncode}):\n{done.stderr}")
@@ -65,11 +67,16 @@ def main() -> None:
             cache = root / f"cache-{repeat}"
             for kind in ("cold", "warm"):
                 out = root / f"trial-{repeat}-{kind}"
-                wall, cpu, stderr = run(["trial", "--world", args.world, "--seed", str(args.seed), "--out", str(out)], cache)
+                wall, cpu, stderr = run(
+                    ["trial", "--world", args.world, "--seed", str(args.seed), "--out", str(out)], cache
+                )
                 trial_wall = json.loads((out / "run.json").read_text())["trial"]["wall_time_s"]
                 compiled = stderr.count("INFO slamtrials.compilewatch: compiled ")
-                print(f"{kind:>6} {wall:7.1f} {cpu:7.1f} {trial_wall:8.1f} {wall - trial_wall:7.1f} {compiled:17d}  "
-                      f"{os.getloadavg()[0]:.1f}", flush=True)
+                print(
+                    f"{kind:>6} {wall:7.1f} {cpu:7.1f} {trial_wall:8.1f} {wall - trial_wall:7.1f} {compiled:17d}  "
+                    f"{os.getloadavg()[0]:.1f}",
+                    flush=True,
+                )
 
 
 if __name__ == "__main__":

@@ -30,6 +30,7 @@ import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from benchutil import cpu_model
 from slamtrials.record import Frame, RunRecord  # noqa: E402
 from slamtrials.sim import SimConfig  # noqa: E402
 from slamtrials.sim.tour import tour_waypoints  # noqa: E402
@@ -37,8 +38,6 @@ from slamtrials.sim.waypoints import simulate_waypoints  # noqa: E402
 from slamtrials.slam import make_algorithm  # noqa: E402
 from slamtrials.slam.gmapping.kernels import TILE  # noqa: E402
 from slamtrials.worlds import load_world  # noqa: E402
-
-from benchutil import cpu_model
 
 SEED = 7
 WORLD = "office_medium_01"
@@ -59,8 +58,9 @@ def frames(record: RunRecord):
         yield Frame(t=float(record.t[k]), ranges=record.scans[k], odometry=record.odometry[k], truth=record.truth[k])
 
 
-def update_times(record: RunRecord, particles: int, *, warm_fraction: float = 0.5, timed: int = 60,
-                 publish: bool = False) -> tuple[np.ndarray, object]:
+def update_times(
+    record: RunRecord, particles: int, *, warm_fraction: float = 0.5, timed: int = 60, publish: bool = False
+) -> tuple[np.ndarray, object]:
     """Seconds of each processed reading after the first ``warm_fraction`` of the run (up to ``timed``)."""
     overrides = {"particles": particles}
     if not publish:
@@ -90,8 +90,10 @@ def single_update(record: RunRecord) -> None:
     print(f"| filter update, mean | {1e3 * times.mean():.1f} |")
     print(f"| filter update, 90th percentile | {1e3 * np.percentile(times, 90):.1f} |")
     print(f"| with the published map rebuilt every 5 s, mean | {1e3 * with_map.mean():.1f} |")
-    print(f"\nC++ original (spec/gmapping.md): about 240 ms; speed-up at the median: "
-          f"{0.240 / np.median(times):.1f}x. Resamplings so far: {slam.resamplings} in {slam.updates} updates.\n")
+    print(
+        f"\nC++ original (spec/gmapping.md): about 240 ms; speed-up at the median: "
+        f"{0.240 / np.median(times):.1f}x. Resamplings so far: {slam.resamplings} in {slam.updates} updates.\n"
+    )
 
 
 def scaling(quick: bool) -> None:

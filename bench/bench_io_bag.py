@@ -22,10 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
+from benchutil import cpu_model
 from slamtrials.io.rosbag import run_from_bag, write_rosbag1, write_rosbag2
 from slamtrials.record import LaserGeometry, RunRecord
-
-from benchutil import cpu_model
 
 FRAMES = 18_000  # 30 minutes at 10 Hz
 BEAMS = 541  # 270 deg at 0.5 deg, the paper's laser
@@ -45,10 +44,24 @@ def synthetic_run(seed: int = 0) -> RunRecord:
     phase = rng.uniform(0, 2 * np.pi, (FRAMES, 1))
     scans = 4.0 + 3.0 * np.abs(np.sin(angles[None, :] * 2.0 + phase)) + rng.normal(0, 0.001, (FRAMES, BEAMS))
     scans = np.clip(scans, 0.1, 30.0).astype(np.float32)
-    laser = LaserGeometry.from_dict({"angle_min": float(angles[0]), "angle_increment": float(angles[1] - angles[0]), "range_min": 0.0,
-             "range_max": 30.0, "mount": [0.1, 0.0, 0.0]})
-    return RunRecord(t=t, scans=scans, odometry=odometry, truth=truth, stalled=rng.random(FRAMES) < 0.01, laser=laser,
-                     metadata={"world": "synthetic", "sim_config": {"dt": 0.1}})
+    laser = LaserGeometry.from_dict(
+        {
+            "angle_min": float(angles[0]),
+            "angle_increment": float(angles[1] - angles[0]),
+            "range_min": 0.0,
+            "range_max": 30.0,
+            "mount": [0.1, 0.0, 0.0],
+        }
+    )
+    return RunRecord(
+        t=t,
+        scans=scans,
+        odometry=odometry,
+        truth=truth,
+        stalled=rng.random(FRAMES) < 0.01,
+        laser=laser,
+        metadata={"world": "synthetic", "sim_config": {"dt": 0.1}},
+    )
 
 
 def size_of(path: Path) -> int:
@@ -84,12 +97,14 @@ def main() -> None:
             ("ROS 2, MCAP zstd", write_rosbag2, "zstd", {"compress": True}),
         ):
             path = folder / name
-            export_s, _ = best_of(REPEATS, lambda: writer(path, record, overwrite=True, **options))
-            import_s, back = best_of(REPEATS, lambda: run_from_bag(path))
+            export_s, _ = best_of(REPEATS, lambda w=writer, p=path, o=options: w(p, record, overwrite=True, **o))
+            import_s, back = best_of(REPEATS, lambda p=path: run_from_bag(p))
             assert np.array_equal(back.scans, record.scans) and np.max(np.abs(back.t - record.t)) <= 1e-9
             messages = 5 * FRAMES + 1
-            print(f"| {label} | {export_s:.2f} | {import_s:.2f} | {size_of(path) / 1e6:.0f} | "
-                  f"{messages / export_s:,.0f} | {FRAMES / import_s:,.0f} |")
+            print(
+                f"| {label} | {export_s:.2f} | {import_s:.2f} | {size_of(path) / 1e6:.0f} | "
+                f"{messages / export_s:,.0f} | {FRAMES / import_s:,.0f} |"
+            )
     finally:
         shutil.rmtree(folder, ignore_errors=True)
 

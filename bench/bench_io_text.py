@@ -38,7 +38,15 @@ def make_run(seed: int = 0) -> RunRecord:
         odometry=truth + rng.normal(0, 0.01, truth.shape),
         truth=truth,
         stalled=np.zeros(FRAMES, dtype=bool),
-        laser=LaserGeometry.from_dict({"angle_min": -3 * np.pi / 4, "angle_increment": 1.5 * np.pi / (BEAMS - 1), "range_min": 0.0, "range_max": 30.0, "mount": [0.0, 0.0, 0.0]}),
+        laser=LaserGeometry.from_dict(
+            {
+                "angle_min": -3 * np.pi / 4,
+                "angle_increment": 1.5 * np.pi / (BEAMS - 1),
+                "range_min": 0.0,
+                "range_max": 30.0,
+                "mount": [0.0, 0.0, 0.0],
+            }
+        ),
     )
 
 
@@ -53,16 +61,20 @@ def best(function, repeats: int = REPEATS) -> float:
 
 def main() -> None:
     record = make_run()
-    print(f"- Machine: {os.cpu_count()} cores, {platform.processor() or platform.machine()}; Python {platform.python_version()}, numpy {np.__version__}")
+    print(
+        f"- Machine: {os.cpu_count()} cores, {platform.processor() or platform.machine()}; Python {platform.python_version()}, numpy {np.__version__}"
+    )
     print(f"- Run: {FRAMES} frames x {BEAMS} beams; best of {REPEATS}\n")
     print("| format | export (s) | import (s) | file size (MB) |")
     print("|---|---:|---:|---:|")
     with tempfile.TemporaryDirectory() as folder:
         for kind in ("ROBOTLASER1", "FLASER"):
             path = Path(folder) / f"run-{kind}.clf"
-            export = best(lambda: write_carmen(path, carmen_from_run(record, kind=kind)))
-            imported = best(lambda: run_from_carmen(read_carmen(path)))
-            print(f"| CARMEN {kind} (laser + ODOM lines) | {export:.2f} | {imported:.2f} | {path.stat().st_size / 1e6:.1f} |")
+            export = best(lambda p=path, k=kind: write_carmen(p, carmen_from_run(record, kind=k)))
+            imported = best(lambda p=path: run_from_carmen(read_carmen(p)))
+            print(
+                f"| CARMEN {kind} (laser + ODOM lines) | {export:.2f} | {imported:.2f} | {path.stat().st_size / 1e6:.1f} |"
+            )
         path = Path(folder) / "truth.tum"
         trajectory = Trajectory(t=record.t, poses=record.truth)
         export = best(lambda: write_tum(path, trajectory))

@@ -28,13 +28,12 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from benchutil import cpu_model
 from slamtrials.geometry import compose, ominus  # noqa: E402
 from slamtrials.record import Frame, RunRecord  # noqa: E402
 from slamtrials.slam import make_algorithm  # noqa: E402
 from slamtrials.slam.karto.optimize import information, optimize_pose_graph  # noqa: E402
 from slamtrials.slamrun import load_recording  # noqa: E402
-
-from benchutil import cpu_model
 
 SHARED = Path(os.environ.get("SLAMTRIALS_SHARED", Path(__file__).resolve().parents[2] / "shared"))
 
@@ -57,11 +56,15 @@ def bench_log(path: Path) -> None:
     node_ms = 1000.0 * np.array([seconds for _, seconds in karto.timings])
     duration = float(record.t[-1] - record.t[0])
     print(f"\n### {path.name}: {len(record)} frames, {duration:.0f} s of log\n")
-    print("| nodes | loop closures | total (s) | ms per frame | node median (ms) | node p90 (ms) | node max (ms) | "
-          "log seconds per wall second |")
+    print(
+        "| nodes | loop closures | total (s) | ms per frame | node median (ms) | node p90 (ms) | node max (ms) | "
+        "log seconds per wall second |"
+    )
     print("|---|---|---|---|---|---|---|---|")
-    print(f"| {karto.updates} | {karto.loop_closures} | {total:.1f} | {1000 * total / len(record):.2f} | "
-          f"{np.median(node_ms):.1f} | {np.percentile(node_ms, 90):.1f} | {node_ms.max():.0f} | {duration / total:.1f} |")
+    print(
+        f"| {karto.updates} | {karto.loop_closures} | {total:.1f} | {1000 * total / len(record):.2f} | "
+        f"{np.median(node_ms):.1f} | {np.percentile(node_ms, 90):.1f} | {node_ms.max():.0f} | {duration / total:.1f} |"
+    )
     if karto.optimizations:
         print("\nOptimizer runs (one per accepted loop closure):\n")
         print("| nodes | edges | ms | iterations |")
@@ -95,7 +98,7 @@ def lap_graph(n_nodes: int, spacing: float = 0.5, lap: int = 120):
     weights = np.repeat(information(np.diag([1e-3, 1e-3, 1e-4]))[None], source.shape[0], axis=0)
     start = truth.copy()
     bent = max(n_nodes - lap, 1)
-    steps = ominus(truth[bent - 1:-1], truth[bent:])
+    steps = ominus(truth[bent - 1 : -1], truth[bent:])
     steps[:, 2] += 0.002
     for k, step in enumerate(steps):
         start[bent + k] = compose(start[bent + k - 1], step)
@@ -112,8 +115,10 @@ def bench_optimizer(sizes: list[int]) -> None:
         started = time.perf_counter()
         result = optimize_pose_graph(*args)
         seconds = time.perf_counter() - started
-        print(f"| {n} | {args[1].shape[0]} | {1000 * seconds:.1f} | {result.iterations} | {result.initial_cost:.3g} | "
-              f"{result.final_cost:.3g} |")
+        print(
+            f"| {n} | {args[1].shape[0]} | {1000 * seconds:.1f} | {result.iterations} | {result.initial_cost:.3g} | "
+            f"{result.final_cost:.3g} |"
+        )
 
 
 def main() -> None:

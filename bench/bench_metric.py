@@ -76,13 +76,20 @@ def main() -> None:
     cases = [
         ("evaluate, nearest pose", full),
         ("evaluate, interpolated", lambda: evaluate_relations(estimate, relations, interpolate=True)),
-        ("evaluate, every 5th pose + odometry correction", lambda: evaluate_relations(sparse, relations, odometry=odometry)),
+        (
+            "evaluate, every 5th pose + odometry correction",
+            lambda: evaluate_relations(sparse, relations, odometry=odometry),
+        ),
         ("sample relations (pilot 500 + N)", lambda: sample_relations(truth, estimate, rng=0)),
     ]
     for _, fn in cases:  # warm-up: compile or load the numba kernels
         fn()
-    print(f"- Machine: {os.cpu_count()} cores, {platform.processor() or platform.machine()}; Python {platform.python_version()}, numpy {np.__version__}")
-    print(f"- Trajectory: {POSES:,} poses at 10 Hz (t from 1.1e9 s); relations: {RELATIONS:,} random pairs in random order")
+    print(
+        f"- Machine: {os.cpu_count()} cores, {platform.processor() or platform.machine()}; Python {platform.python_version()}, numpy {np.__version__}"
+    )
+    print(
+        f"- Trajectory: {POSES:,} poses at 10 Hz (t from 1.1e9 s); relations: {RELATIONS:,} random pairs in random order"
+    )
     print()
     print("| case | relations | time (s) | relations/s | result |")
     print("|---|---:|---:|---:|---|")
@@ -93,7 +100,10 @@ def main() -> None:
             note = f"eps_t {trans.mean:.3f} +- {trans.std:.3f} m, eps_r {rot.mean:.4f} rad, N={trans.n:,}"
             count = len(errors)
         elif hasattr(result, "count"):
-            note = f"s_t {result.std_t:.3f} m, s_r {result.std_r:.4f} rad -> N_t {result.needed_t:,}, N_r {result.needed_r:,}" + (" (capped)" if result.capped else "")
+            note = (
+                f"s_t {result.std_t:.3f} m, s_r {result.std_r:.4f} rad -> N_t {result.needed_t:,}, N_r {result.needed_r:,}"
+                + (" (capped)" if result.capped else "")
+            )
             count = result.count + len(result.pilot_relations)
         else:
             note = f"matched {len(result):,}, odometry-corrected {len(result.corrected):,}"

@@ -23,7 +23,6 @@ from pathlib import Path
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 from benchutil import cpu_model  # noqa: E402
-
 from slamtrials.cli.slam import parse_settings  # noqa: E402
 from slamtrials.io.relations import read_relations  # noqa: E402
 from slamtrials.repeat import RepeatSettings, repeat_slam, write_repeat_outputs  # noqa: E402
@@ -69,18 +68,23 @@ def main() -> int:
         print(f"no shared data at {data}; set SLAMTRIALS_SHARED", file=sys.stderr)
         return 2
     overrides = parse_settings(args.settings)
-    print(f"# Real logs: {args.algorithm} {args.preset or 'defaults'} {overrides or ''}, seeds 0..{args.seeds - 1}, "
-          f"{args.workers or os.cpu_count()} workers; {cpu_model()}\n")
-    print("| log | frames | runs | eps_t mean +- std (m) | eps_r mean +- std (rad) | diverged (> 5 x median) "
-          "| median eps_t (m) | updates | s per run | published GMapping (m) |")
+    print(
+        f"# Real logs: {args.algorithm} {args.preset or 'defaults'} {overrides or ''}, seeds 0..{args.seeds - 1}, "
+        f"{args.workers or os.cpu_count()} workers; {cpu_model()}\n"
+    )
+    print(
+        "| log | frames | runs | eps_t mean +- std (m) | eps_r mean +- std (rad) | diverged (> 5 x median) "
+        "| median eps_t (m) | updates | s per run | published GMapping (m) |"
+    )
     print("|---|---|---|---|---|---|---|---|---|---|")
     for name, log, relations_path in datasets(data, args.logs):
         record = load_recording(log)
         relations = read_relations(relations_path)
         settings = RepeatSettings(algorithm=args.algorithm, preset=args.preset, overrides=overrides, runs=args.seeds)
         started = time.perf_counter()
-        result = repeat_slam(record, relations, settings, workers=args.workers, source=str(log),
-                             relations_source=str(relations_path))
+        result = repeat_slam(
+            record, relations, settings, workers=args.workers, source=str(log), relations_source=str(relations_path)
+        )
         wall = time.perf_counter() - started
         if args.out is not None:
             write_repeat_outputs(result, args.out / name, overwrite=True)
@@ -88,10 +92,15 @@ def main() -> int:
         st, sr, d = result.stats_t, result.stats_r, result.diverged
         median = statistics.median(r.eps_t for r in runs)
         per_run = sum(r.seconds for r in runs) / len(runs)
-        print(f"| {name} | {len(record)} | {len(runs)} | {st.mean:.3f} +- {st.std_sample:.3f} | {sr.mean:.3f} +- {sr.std_sample:.3f} "
-              f"| {int(d.diverged.sum())} of {len(runs)} (> {d.threshold:.3f} m) | {median:.3f} "
-              f"| {runs[0].updates} | {per_run:.0f} | {PUBLISHED.get(name, '-')} |", flush=True)
-        print(f"<!-- {name}: per-seed eps_t {[round(r.eps_t, 4) for r in runs]}; {wall:.0f} s wall in all -->", flush=True)
+        print(
+            f"| {name} | {len(record)} | {len(runs)} | {st.mean:.3f} +- {st.std_sample:.3f} | {sr.mean:.3f} +- {sr.std_sample:.3f} "
+            f"| {int(d.diverged.sum())} of {len(runs)} (> {d.threshold:.3f} m) | {median:.3f} "
+            f"| {runs[0].updates} | {per_run:.0f} | {PUBLISHED.get(name, '-')} |",
+            flush=True,
+        )
+        print(
+            f"<!-- {name}: per-seed eps_t {[round(r.eps_t, 4) for r in runs]}; {wall:.0f} s wall in all -->", flush=True
+        )
     return 0
 
 

@@ -27,12 +27,11 @@ import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from benchutil import cpu_model
 from slamtrials.sim import SimConfig, Simulator  # noqa: E402
 from slamtrials.sim.raycast import LaserModel, cast_scan, cast_scan_dda  # noqa: E402
 from slamtrials.sim.waypoints import waypoint_command  # noqa: E402
 from slamtrials.worlds.world import World, cell_to_world, world_to_map  # noqa: E402
-
-from benchutil import cpu_model
 
 RES = 0.05
 SIZE = 2000  # cells: 100 m
@@ -83,8 +82,9 @@ def empty_room() -> World:
     return World(occ, RES, name="empty-room", start=[50.0, 50.0, 0.0])
 
 
-def free_poses(world: World, n: int, rng: np.random.Generator, clearance: float = 0.2,
-               within: float | None = None) -> np.ndarray:
+def free_poses(
+    world: World, n: int, rng: np.random.Generator, clearance: float = 0.2, within: float | None = None
+) -> np.ndarray:
     """``n`` random poses [n, 3] at free cells with the given clearance (optionally near the centre)."""
     ok = world.clearance >= clearance
     if within is not None:
@@ -123,7 +123,7 @@ def time_steps(world: World, n_steps: int, seed: int = 0) -> tuple[float, int]:
     goals = free_poses(world, 200, rng, clearance=0.5)[:, :2]
     best = math.inf
     stalls = 0
-    for rep in range(3):
+    for _ in range(3):
         sim = Simulator(world, SimConfig(), np.random.default_rng(seed))
         sim.observe()
         robot = sim.config.robot

@@ -60,18 +60,24 @@ def main() -> None:
         rows.append((world.name, info, load))
         print(f"{world.name}: {info['duration_s']:.0f} s simulated in {info['wall_time_s']:.0f} s", flush=True)
 
-    print(f"\n- Machine: {os.cpu_count()} cores, CPU `{cpu_model()}`; one trial at a time, NUMBA_NUM_THREADS=1; "
-          f"date {time.strftime('%Y-%m-%d')}; seed {args.seed}")
+    print(
+        f"\n- Machine: {os.cpu_count()} cores, CPU `{cpu_model()}`; one trial at a time, NUMBA_NUM_THREADS=1; "
+        f"date {time.strftime('%Y-%m-%d')}; seed {args.seed}"
+    )
     print()
-    print("| world | reachable m^2 | end | mapped | simulated s | wall s | sim/wall | updates | SLAM ms per update "
-          "| SLAM share | planning share | distance m | turning rad | load avg |")
+    print(
+        "| world | reachable m^2 | end | mapped | simulated s | wall s | sim/wall | updates | SLAM ms per update "
+        "| SLAM share | planning share | distance m | turning rad | load avg |"
+    )
     print("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for name, info, load in rows:
         wall = info["wall_time_s"]
-        print(f"| {name} | {info['reachable_area_m2']:,.0f} | {info['termination_reason']} | {info['mapped_fraction']:.3f} | "
-              f"{info['duration_s']:.0f} | {wall:.0f} | {info['realtime_factor']:.1f} | {info['slam_updates']} | "
-              f"{1e3 * info['slam_seconds'] / max(info['slam_updates'], 1):.0f} | {info['slam_seconds'] / wall:.0%} | "
-              f"{info['explorer']['plan_seconds'] / wall:.0%} | {info['distance_m']:.0f} | {info['turning_rad']:.0f} | {load:.1f} |")
+        print(
+            f"| {name} | {info['reachable_area_m2']:,.0f} | {info['termination_reason']} | {info['mapped_fraction']:.3f} | "
+            f"{info['duration_s']:.0f} | {wall:.0f} | {info['realtime_factor']:.1f} | {info['slam_updates']} | "
+            f"{1e3 * info['slam_seconds'] / max(info['slam_updates'], 1):.0f} | {info['slam_seconds'] / wall:.0%} | "
+            f"{info['explorer']['plan_seconds'] / wall:.0%} | {info['distance_m']:.0f} | {info['turning_rad']:.0f} | {load:.1f} |"
+        )
 
 
 if __name__ == "__main__":

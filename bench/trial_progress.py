@@ -25,19 +25,24 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=1)
     args = parser.parse_args()
     samples: list[TrialProgress] = []
-    record = run_trial(load_world(resolve(args.world)), None, args.seed, on_progress=samples.append,
-                       progress_period=5.0)
+    record = run_trial(
+        load_world(resolve(args.world)), None, args.seed, on_progress=samples.append, progress_period=5.0
+    )
     info = record.metadata["trial"]
     final, total = info["mapped_free_area_m2"], info["slam_updates"]
-    print(f"{args.world} seed {args.seed}: {info['termination_reason']} after {info['duration_s']:.0f} s, "
-          f"{total} updates, final known free area {final:.0f} m^2")
+    print(
+        f"{args.world} seed {args.seed}: {info['termination_reason']} after {info['duration_s']:.0f} s, "
+        f"{total} updates, final known free area {final:.0f} m^2"
+    )
     print("| known free area | first at (s) | updates by then | updates after |")
     print("|---:|---:|---:|---:|")
     for fraction in FRACTIONS:
         hit = next((s for s in samples if s.known_free_area >= fraction * final), None)
         if hit is not None:
-            print(f"| {fraction:.0%} | {hit.t:.0f} | {hit.slam_updates} ({hit.slam_updates / total:.0%}) | "
-                  f"{total - hit.slam_updates} |")
+            print(
+                f"| {fraction:.0%} | {hit.t:.0f} | {hit.slam_updates} ({hit.slam_updates / total:.0%}) | "
+                f"{total - hit.slam_updates} |"
+            )
 
 
 if __name__ == "__main__":

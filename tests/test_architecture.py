@@ -34,9 +34,39 @@ COMPUTING = {"geometry", "record", "sim", "slam", "explore", "trial", "metric"}
 
 #: numpy functions whose float64 results depend on the machine: numpy's own SIMD code for these on
 #: AVX-512 CPUs differs from the C library's by a few ulp, and BLAS picks its kernels by CPU.
-MACHINE_DEPENDENT = {"sin", "cos", "tan", "arcsin", "arccos", "arctan", "arctan2", "hypot", "sinh", "cosh", "tanh",
-                     "arcsinh", "arccosh", "arctanh", "exp", "exp2", "expm1", "log", "log2", "log10", "log1p",
-                     "power", "float_power", "cbrt", "dot", "vdot", "inner", "matmul", "tensordot", "einsum", "linalg"}
+MACHINE_DEPENDENT = {
+    "sin",
+    "cos",
+    "tan",
+    "arcsin",
+    "arccos",
+    "arctan",
+    "arctan2",
+    "hypot",
+    "sinh",
+    "cosh",
+    "tanh",
+    "arcsinh",
+    "arccosh",
+    "arctanh",
+    "exp",
+    "exp2",
+    "expm1",
+    "log",
+    "log2",
+    "log10",
+    "log1p",
+    "power",
+    "float_power",
+    "cbrt",
+    "dot",
+    "vdot",
+    "inner",
+    "matmul",
+    "tensordot",
+    "einsum",
+    "linalg",
+}
 #: Layers whose numbers end up in runs, maps and files, and must be the same on every machine.
 REPRODUCIBLE = COMPUTING | {"worlds", "io", "campaign"}
 
@@ -76,7 +106,9 @@ def test_layer_imports_only_layers_above_it(path: Path) -> None:
     assert imported <= allowed, f"{path}: layer '{layer}' imports {sorted(imported - allowed)}"
 
 
-@pytest.mark.parametrize("path", [p for p in SOURCES if _layer_of(p) != "cli"], ids=lambda p: str(p.relative_to(PACKAGE)))
+@pytest.mark.parametrize(
+    "path", [p for p in SOURCES if _layer_of(p) != "cli"], ids=lambda p: str(p.relative_to(PACKAGE))
+)
 def test_library_code_never_prints_exits_or_uses_global_random_state(path: Path) -> None:
     tree = ast.parse(path.read_text(encoding="utf-8"))
     for node in ast.walk(tree):
@@ -94,7 +126,9 @@ def test_library_code_never_prints_exits_or_uses_global_random_state(path: Path)
             assert not text.startswith("random."), f"{path}:{node.lineno}: uses the random module's global state"
 
 
-@pytest.mark.parametrize("path", [p for p in SOURCES if _layer_of(p) in COMPUTING], ids=lambda p: str(p.relative_to(PACKAGE)))
+@pytest.mark.parametrize(
+    "path", [p for p in SOURCES if _layer_of(p) in COMPUTING], ids=lambda p: str(p.relative_to(PACKAGE))
+)
 def test_computing_layers_do_no_file_io_or_plotting(path: Path) -> None:
     tree = ast.parse(path.read_text(encoding="utf-8"))
     for node in ast.walk(tree):
@@ -105,17 +139,21 @@ def test_computing_layers_do_no_file_io_or_plotting(path: Path) -> None:
             assert not (module or "").startswith(("matplotlib", "PIL")), f"{path}:{node.lineno}: imports {module}"
 
 
-@pytest.mark.parametrize("path", [p for p in SOURCES if _layer_of(p) in REPRODUCIBLE],
-                         ids=lambda p: str(p.relative_to(PACKAGE)))
+@pytest.mark.parametrize(
+    "path", [p for p in SOURCES if _layer_of(p) in REPRODUCIBLE], ids=lambda p: str(p.relative_to(PACKAGE))
+)
 def test_reproducible_layers_take_transcendental_functions_from_stablemath(path: Path) -> None:
     tree = ast.parse(path.read_text(encoding="utf-8"))
     for node in ast.walk(tree):
         if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id in {"np", "numpy"}:
             assert node.attr not in MACHINE_DEPENDENT, (
                 f"{path}:{node.lineno}: np.{node.attr} differs between machines; use slamtrials.stablemath "
-                "(or write the products out instead of BLAS)")
+                "(or write the products out instead of BLAS)"
+            )
         if isinstance(node, ast.BinOp):
-            assert not isinstance(node.op, ast.MatMult), f"{path}:{node.lineno}: '@' runs BLAS, whose kernels differ by CPU"
+            assert not isinstance(node.op, ast.MatMult), (
+                f"{path}:{node.lineno}: '@' runs BLAS, whose kernels differ by CPU"
+            )
 
 
 #: fast-math flags that let LLVM change results by the CPU it compiles for (vector width, FMA, approximations).
@@ -132,7 +170,8 @@ def test_numba_kernels_use_no_result_changing_fast_math(path: Path) -> None:
             if isinstance(flags, (set, frozenset, list, tuple)):
                 assert not set(flags) & _RESULT_CHANGING_FASTMATH, (
                     f"{path}:{node.value.lineno}: fastmath {sorted(set(flags) & _RESULT_CHANGING_FASTMATH)} "
-                    "changes results with the CPU")
+                    "changes results with the CPU"
+                )
 
 
 #: Sort kinds whose order of equal keys is fixed. numpy's default (quicksort) is not stable, and its SIMD
@@ -170,19 +209,31 @@ def ordering_problems(tree: ast.AST) -> list[str]:
             stable = isinstance(kind, ast.Constant) and kind.value in _STABLE_KINDS
             python_list_sort = name == "sort" and ("key" in keywords or "reverse" in keywords) and kind is None
             if name in {"sort", "argsort", "sort_values"} and not stable and not python_list_sort:
-                problems.append(f"{node.lineno}: {ast.unparse(node.func)}() without kind=\"stable\" orders equal keys by "
-                                "implementation (numpy's SIMD sorts differ by CPU)")
+                problems.append(
+                    f'{node.lineno}: {ast.unparse(node.func)}() without kind="stable" orders equal keys by '
+                    "implementation (numpy's SIMD sorts differ by CPU)"
+                )
             if name == "argpartition":
-                problems.append(f"{node.lineno}: argpartition orders equal keys by implementation; use a stable argsort")
+                problems.append(
+                    f"{node.lineno}: argpartition orders equal keys by implementation; use a stable argsort"
+                )
         iterated = []
         if isinstance(node, (ast.For, ast.comprehension)):
             iterated.append(node.iter)
-        if isinstance(node, ast.Call) and node.args and (
+        if (
+            isinstance(node, ast.Call)
+            and node.args
+            and (
                 (isinstance(node.func, ast.Name) and node.func.id in {"list", "tuple", "enumerate"})
-                or (isinstance(node.func, ast.Attribute) and node.func.attr == "join")):
+                or (isinstance(node.func, ast.Attribute) and node.func.attr == "join")
+            )
+        ):
             iterated.append(node.args[0])
-        problems += [f"{it.lineno}: iterates a set, whose order of strings depends on PYTHONHASHSEED; iterate sorted(...)"
-                     for it in iterated if _is_set_expression(it)]
+        problems += [
+            f"{it.lineno}: iterates a set, whose order of strings depends on PYTHONHASHSEED; iterate sorted(...)"
+            for it in iterated
+            if _is_set_expression(it)
+        ]
     return problems
 
 
@@ -190,31 +241,36 @@ def ordering_problems(tree: ast.AST) -> list[str]:
 ORDERED = REPRODUCIBLE | {"report"}
 
 
-@pytest.mark.parametrize("path", [p for p in SOURCES if _layer_of(p) in ORDERED], ids=lambda p: str(p.relative_to(PACKAGE)))
+@pytest.mark.parametrize(
+    "path", [p for p in SOURCES if _layer_of(p) in ORDERED], ids=lambda p: str(p.relative_to(PACKAGE))
+)
 def test_reproducible_layers_order_ties_by_rule_not_by_sort_implementation(path: Path) -> None:
     problems = ordering_problems(ast.parse(path.read_text(encoding="utf-8")))
     assert not problems, f"{path}:" + f"\n{path}:".join(problems)
 
 
-@pytest.mark.parametrize(("source", "flagged"), [
-    ("np.argsort(d)[0]", True),
-    ("np.sort(values)", True),
-    ("a.argsort()", True),
-    ("a.sort()", True),
-    ("np.argsort(d, kind='quicksort')", True),
-    ("table.sort_values('x', ascending=False)", True),
-    ("np.argpartition(d, 3)", True),
-    ("for host in set(a) | set(b):\n    pass", True),
-    ("names = [n for n in {'a', 'b'}]", True),
-    ("text = ', '.join(set(names))", True),
-    ("np.argsort(d, kind='stable')[0]", False),
-    ("a.sort(kind='mergesort')", False),
-    ("table.sort_values('x', kind='stable')", False),
-    ("np.lexsort((fine, coarse))[0]", False),
-    ("items.sort(key=len)", False),
-    ("for host in sorted(set(a) | set(b)):\n    pass", False),
-    ("ok = 'x' in {'a', 'b'}", False),
-])
+@pytest.mark.parametrize(
+    ("source", "flagged"),
+    [
+        ("np.argsort(d)[0]", True),
+        ("np.sort(values)", True),
+        ("a.argsort()", True),
+        ("a.sort()", True),
+        ("np.argsort(d, kind='quicksort')", True),
+        ("table.sort_values('x', ascending=False)", True),
+        ("np.argpartition(d, 3)", True),
+        ("for host in set(a) | set(b):\n    pass", True),
+        ("names = [n for n in {'a', 'b'}]", True),
+        ("text = ', '.join(set(names))", True),
+        ("np.argsort(d, kind='stable')[0]", False),
+        ("a.sort(kind='mergesort')", False),
+        ("table.sort_values('x', kind='stable')", False),
+        ("np.lexsort((fine, coarse))[0]", False),
+        ("items.sort(key=len)", False),
+        ("for host in sorted(set(a) | set(b)):\n    pass", False),
+        ("ok = 'x' in {'a', 'b'}", False),
+    ],
+)
 def test_ordering_guard_flags_unstable_sorts_and_set_iteration(source: str, flagged: bool) -> None:
     assert bool(ordering_problems(ast.parse(source))) == flagged
 
@@ -225,9 +281,13 @@ _NUMBA_COMPILERS = {"njit", "jit", "vectorize", "guvectorize", "cfunc", "generat
 
 def _numba_compilers_imported(tree: ast.AST) -> set[str]:
     """The local names of numba's compiling decorators imported with ``from numba... import``."""
-    return {alias.asname or alias.name for node in ast.walk(tree)
-            if isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] == "numba"
-            for alias in node.names if alias.name in _NUMBA_COMPILERS}
+    return {
+        alias.asname or alias.name
+        for node in ast.walk(tree)
+        if isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] == "numba"
+        for alias in node.names
+        if alias.name in _NUMBA_COMPILERS
+    }
 
 
 def _numba_compiler(func: ast.expr, imported: set[str]) -> bool:
@@ -252,7 +312,9 @@ def test_numba_kernels_are_module_level_and_cached(path: Path) -> None:
                 if not _numba_compiler(call.func if call else decorator, imported):
                     continue
                 assert id(node) in top_level, f"{path}:{node.lineno}: kernel {node.name} is not at module level"
-                cached = call is not None and any(k.arg == "cache" and ast.literal_eval(k.value) is True for k in call.keywords)
+                cached = call is not None and any(
+                    k.arg == "cache" and ast.literal_eval(k.value) is True for k in call.keywords
+                )
                 assert cached, f"{path}:{node.lineno}: kernel {node.name} lacks cache=True"
         elif isinstance(node, ast.Call) and id(node) not in decorators and _numba_compiler(node.func, imported):
             raise AssertionError(f"{path}:{node.lineno}: {ast.unparse(node)} compiles a kernel outside a decorator")

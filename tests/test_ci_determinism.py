@@ -21,9 +21,15 @@ def _outputs(folder: Path, *, wall_time: float, estimate_last: float = 3.0) -> P
     (folder / "trial").mkdir(parents=True)
     np.savez(folder / "trial" / "frames.npz", t=np.arange(4.0), estimate=np.array([0.0, 1.0, 2.0, estimate_last]))
     (folder / "trial" / "map.pgm").write_bytes(b"P5 2 2 255\n" + bytes([0, 254, 205, 0]))
-    (folder / "trial" / "run.json").write_text(json.dumps(
-        {"seed": 1, "versions": {"numpy": "x"}, "trial": {"duration_s": 172.2, "wall_time_s": wall_time,
-                                                          "explorer": {"plan_seconds": wall_time}}}))
+    (folder / "trial" / "run.json").write_text(
+        json.dumps(
+            {
+                "seed": 1,
+                "versions": {"numpy": "x"},
+                "trial": {"duration_s": 172.2, "wall_time_s": wall_time, "explorer": {"plan_seconds": wall_time}},
+            }
+        )
+    )
     (folder / "trial" / "timing.csv").write_text(f"frame,t,seconds\n0,0.0,{wall_time}\n")
     return folder
 
@@ -52,8 +58,11 @@ def test_the_baseline_pass_leaves_numpy_no_dispatched_simd_code(tmp_path):
     named = env.get("NPY_DISABLE_CPU_FEATURES", "").split()
     assert set(named) <= {f for f in dispatch if features.get(f)}  # numpy rejects features the CPU lacks
     assert env["NUMBA_CPU_NAME"] == "generic" and env["NUMBA_CACHE_DIR"] == str(tmp_path / "cache")
-    probe = ("import json, sys; sys.path.insert(0, sys.argv[1]); import determinism as d; "
-             "f, dispatch = d.numpy_dispatch(); print(json.dumps([x for x in dispatch if f.get(x)]))")
-    out = subprocess.run([sys.executable, "-c", probe, str(SCRIPT.parent)], env=env, capture_output=True, text=True,
-                         check=True)
+    probe = (
+        "import json, sys; sys.path.insert(0, sys.argv[1]); import determinism as d; "
+        "f, dispatch = d.numpy_dispatch(); print(json.dumps([x for x in dispatch if f.get(x)]))"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", probe, str(SCRIPT.parent)], env=env, capture_output=True, text=True, check=True
+    )
     assert json.loads(out.stdout) == []

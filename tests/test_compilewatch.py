@@ -34,7 +34,9 @@ def test_the_first_slamtrials_compile_is_announced_once_and_each_is_logged(caplo
         stop()
     assert seen == ["slamtrials.stablemath._cos1"]
     logged = [r.getMessage() for r in caplog.records if r.name == "slamtrials.compilewatch"]
-    assert len(logged) == 2 and "slamtrials.stablemath._cos1" in logged[0] and "slamtrials.stablemath._sin1" in logged[1]
+    assert (
+        len(logged) == 2 and "slamtrials.stablemath._cos1" in logged[0] and "slamtrials.stablemath._sin1" in logged[1]
+    )
     numba.njit(stablemath._cos1.py_func)(0.5)  # after stop(): not heard
     assert seen == ["slamtrials.stablemath._cos1"]
 
@@ -46,8 +48,15 @@ def _cli(*args: str, cache) -> tuple[int, str, str]:
     code = "import sys; from slamtrials.cli.main import main; sys.argv[0] = 'slamtrials'; main()"
     leader, follower = pty.openpty()
     try:
-        done = subprocess.run([sys.executable, "-c", code, *args], env=env, stdout=subprocess.PIPE, stderr=follower,
-                              text=True, timeout=300, check=False)
+        done = subprocess.run(
+            [sys.executable, "-c", code, *args],
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=follower,
+            text=True,
+            timeout=300,
+            check=False,
+        )
     finally:
         os.close(follower)
     stderr = b""
@@ -80,8 +89,14 @@ def test_no_notice_when_stderr_is_not_a_terminal(tmp_path):
     # scripts, logs and tests get a clean stderr (with --verbose, the log names each kernel compiled)
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba-cache")}
     code = "import sys; from slamtrials.cli.main import main; sys.argv[0] = 'slamtrials'; main()"
-    done = subprocess.run([sys.executable, "-c", code, "-v", "worlds", "info", "office_small_01"], env=env,
-                          capture_output=True, text=True, timeout=300, check=False)
+    done = subprocess.run(
+        [sys.executable, "-c", code, "-v", "worlds", "info", "office_small_01"],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
     assert done.returncode == 0, done.stderr
     assert COMPILING_NOTICE not in done.stderr
     assert "compiled slamtrials.stablemath." in done.stderr

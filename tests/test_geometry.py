@@ -38,4 +38,6 @@ def test_broadcasting_over_arrays():
     a = np.zeros((4, 5, 3))
     b = np.ones(3)
     assert compose(a, b).shape == (4, 5, 3)
-    assert -np.pi <= wrap_angle(np.linspace(-50, 50, 1001)).min() and wrap_angle(np.linspace(-50, 50, 1001)).max() < np.pi
+    assert (
+        -np.pi <= wrap_angle(np.linspace(-50, 50, 1001)).min() and wrap_angle(np.linspace(-50, 50, 1001)).max() < np.pi
+    )

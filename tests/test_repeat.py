@@ -57,7 +57,9 @@ def test_each_seed_is_a_separate_run_scored_on_the_relations(dataset, tmp_path):
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["runs"] == 3 and summary["translational_m"]["mean"] == pytest.approx(eps.mean())
     lines = (tmp_path / "out" / "runs.csv").read_text().splitlines()
-    assert lines[0].startswith("seed,eps_t") and len(lines) == 4 and float(lines[2].split(",")[1]) == result.runs[1].eps_t
+    assert (
+        lines[0].startswith("seed,eps_t") and len(lines) == 4 and float(lines[2].split(",")[1]) == result.runs[1].eps_t
+    )
     assert {p.name for p in written} >= {"errors.png", "best_map.png", "worst_map.yaml"}
     with pytest.raises(ConfigError, match="already holds"):
         write_repeat_outputs(result, tmp_path / "out")
@@ -72,8 +74,15 @@ def test_relations_of_another_recording_are_refused(dataset):
         repeat_slam(record, foreign, RepeatSettings(algorithm="odometry", runs=2), workers=1)
 
 
-@pytest.mark.parametrize(("options", "match"), [({"runs": 1}, "at least 2"), ({"runs": "many"}, "at least 2"),
-                                                ({"confidence": 1.5}, "confidence"), ({"initial": 1}, "initial")])
+@pytest.mark.parametrize(
+    ("options", "match"),
+    [
+        ({"runs": 1}, "at least 2"),
+        ({"runs": "many"}, "at least 2"),
+        ({"confidence": 1.5}, "confidence"),
+        ({"initial": 1}, "initial"),
+    ],
+)
 def test_bad_settings_are_refused(options, match):
     with pytest.raises(ConfigError, match=match):
         RepeatSettings(algorithm="gmapping", **options)
@@ -88,8 +97,13 @@ def test_the_cli_repeats_on_a_carmen_log_and_refuses_bad_options(dataset, tmp_pa
     done = runner.invoke(app, [*base, "--relations", str(rel), "--runs", "2", "--workers", "1"])
     assert done.exit_code == 0, done.output
     assert "translational: mean" in done.output and "diverged: 0 of 2 runs" in done.output
-    for extra, expected in (([ "--runs", "2"], "go together"), (["--relations", str(rel), "--runs", "1"], "at least 2"),
-                            (["--relations", str(rel), "--runs", "x"], "'auto'")):
-        bad = runner.invoke(app, ["slam", "--algorithm", "odometry", "--input", str(log), "--out", str(tmp_path / "b"), *extra])
+    for extra, expected in (
+        (["--runs", "2"], "go together"),
+        (["--relations", str(rel), "--runs", "1"], "at least 2"),
+        (["--relations", str(rel), "--runs", "x"], "'auto'"),
+    ):
+        bad = runner.invoke(
+            app, ["slam", "--algorithm", "odometry", "--input", str(log), "--out", str(tmp_path / "b"), *extra]
+        )
         assert bad.exit_code == 2 and expected in bad.output and "Traceback" not in bad.output, bad.output
     assert not (tmp_path / "b").exists()

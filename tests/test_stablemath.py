@@ -48,8 +48,10 @@ def test_binary_functions_give_the_c_librarys_bits(ours, libm) -> None:
 
 
 @settings(max_examples=200, deadline=None)
-@given(st.floats(allow_nan=False, allow_infinity=False, min_value=-1e9, max_value=1e9),
-       st.floats(allow_nan=False, allow_infinity=False, min_value=-1e9, max_value=1e9))
+@given(
+    st.floats(allow_nan=False, allow_infinity=False, min_value=-1e9, max_value=1e9),
+    st.floats(allow_nan=False, allow_infinity=False, min_value=-1e9, max_value=1e9),
+)
 def test_every_function_agrees_with_the_c_library_on_any_finite_input(x: float, y: float) -> None:
     for ours, libm in UNARY:
         assert _same_bits(np.float64(ours(x)), np.float64(libm(x)))
@@ -81,7 +83,9 @@ def test_shapes_follow_numpy() -> None:
     assert stablemath.cos(np.zeros(0)).shape == (0,)
     # broadcasting: a column against a row, an array against a scalar
     column, row = np.arange(3.0)[:, None], np.arange(1.0, 5.0)[None, :]
-    assert _same_bits(stablemath.arctan2(column, row), np.array([[_LIBM.atan2(c, r) for r in range(1, 5)] for c in range(3)]))
+    assert _same_bits(
+        stablemath.arctan2(column, row), np.array([[_LIBM.atan2(c, r) for r in range(1, 5)] for c in range(3)])
+    )
     assert _same_bits(stablemath.hypot(np.arange(4.0), 2.0), np.array([_LIBM.hypot(v, 2.0) for v in range(4)]))
 
 

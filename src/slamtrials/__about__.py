@@ -19,9 +19,11 @@ def source_revision() -> str | None:
     """
     here = Path(__file__).resolve().parent
     try:
+
         def git(*args: str) -> str:
-            return subprocess.run(["git", "-C", str(here), *args], capture_output=True, text=True, timeout=10,
-                                  check=True).stdout.strip()
+            return subprocess.run(
+                ["git", "-C", str(here), *args], capture_output=True, text=True, timeout=10, check=True
+            ).stdout.strip()
 
         commit = git("rev-parse", "--short=12", "HEAD")
         dirty = git("status", "--porcelain", "--untracked-files=no", "--", ".")

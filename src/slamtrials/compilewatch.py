@@ -61,8 +61,12 @@ class _CompileListener(event.Listener):
         kernel, started = stack.pop()
         if kernel is not None:
             outermost = not any(name is not None for name, _ in stack)
-            log.log(logging.INFO if outermost else logging.DEBUG, "compiled %s in %.1f s (not in numba's on-disk cache)",
-                    kernel, time.perf_counter() - started)
+            log.log(
+                logging.INFO if outermost else logging.DEBUG,
+                "compiled %s in %.1f s (not in numba's on-disk cache)",
+                kernel,
+                time.perf_counter() - started,
+            )
 
 
 def watch_compilation(on_first_compile: Callable[[str], None] | None = None) -> Callable[[], None]:

@@ -47,9 +47,18 @@ def demo_config(out: str | Path, worlds: Sequence[str] = DEMO_WORLDS, *, seed: i
     return small_campaign_config(tuple(worlds), seed, output=str(out))
 
 
-def run_demo(out: str | Path, worlds: Sequence[str] = DEMO_WORLDS, *, seed: int = 0, workers: int | None = None,
-             scheduler: Any = None, trial_fn: Callable | None = None, on_event: Callable | None = None,
-             repeats: int = 200, pdf: bool = True) -> DemoResult:
+def run_demo(
+    out: str | Path,
+    worlds: Sequence[str] = DEMO_WORLDS,
+    *,
+    seed: int = 0,
+    workers: int | None = None,
+    scheduler: Any = None,
+    trial_fn: Callable | None = None,
+    on_event: Callable | None = None,
+    repeats: int = 200,
+    pdf: bool = True,
+) -> DemoResult:
     """Run (or resume) the demo campaign in ``out`` and write its report.
 
     Parameters

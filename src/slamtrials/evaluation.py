@@ -32,7 +32,16 @@ from slamtrials.record import Relations, Trajectory
 
 logger = logging.getLogger(__name__)
 
-__all__ = ["EvaluationResult", "PoseTriple", "Quantile", "evaluate_files", "evaluate_run", "format_report", "FILE_TOLERANCE", "RUN_TOLERANCE"]
+__all__ = [
+    "EvaluationResult",
+    "PoseTriple",
+    "Quantile",
+    "evaluate_files",
+    "evaluate_run",
+    "format_report",
+    "FILE_TOLERANCE",
+    "RUN_TOLERANCE",
+]
 
 #: Default matching tolerance (s) for dataset files: the Freiburg program's.
 FILE_TOLERANCE = DEFAULT_TOLERANCE
@@ -133,8 +142,14 @@ def _read_trajectory(path: Path, triple: PoseTriple, what: str) -> _Source:
             if what == "estimate" and pose_only:
                 differ = int(np.count_nonzero((laser.pose != laser.odometry).any(axis=1)))
                 if differ:
-                    logger.warning("%s: the two pose triples differ on %d of %d pose-only %s lines: the second is evaluated, as the "
-                                   "Freiburg metricEvaluator does (--estimate-pose first for the other)", path, differ, len(laser), laser.kind)
+                    logger.warning(
+                        "%s: the two pose triples differ on %d of %d pose-only %s lines: the second is evaluated, as the "
+                        "Freiburg metricEvaluator does (--estimate-pose first for the other)",
+                        path,
+                        differ,
+                        len(laser),
+                        laser.kind,
+                    )
         poses = laser.pose if triple is PoseTriple.first else laser.odometry
         label = f"{path} (CARMEN, {len(laser)} {laser.kind} lines, {triple.value} pose triple)"
         return _Source(Trajectory(t=laser.t, poses=poses), path, "carmen", label)
@@ -162,8 +177,11 @@ def _check_belong(relations: Relations, relations_path: Path, sources: dict[str,
             return
         spans.append(f"{source.path} has {len(t)} poses in [{float(t[0])!r}, {float(t[-1])!r}] s")
     where = f"[{float(stamps.min())!r}, {float(stamps.max())!r}] s" if len(stamps) else "no finite time"
-    raise FormatError(relations_path, f"no relation timestamp ({len(relations)} relations in {where}) is within {tolerance:g} s of "
-                      f"a pose: {'; '.join(spans)}. These relations are not of this log")
+    raise FormatError(
+        relations_path,
+        f"no relation timestamp ({len(relations)} relations in {where}) is within {tolerance:g} s of "
+        f"a pose: {'; '.join(spans)}. These relations are not of this log",
+    )
 
 
 def _with_lines(exc: MetricError, sources: dict[str, _Source], relations_path: Path | None) -> Exception:
@@ -283,7 +301,9 @@ def evaluate_files(
     label = f"{relations} ({len(rel)} relations)"
     if odometry is not None:
         label += f", odometry {sources['odometry'].label}"
-    return EvaluationResult(rel, errors, trans, rot, estimate_source.label, label, tolerance, relations_path=Path(relations))
+    return EvaluationResult(
+        rel, errors, trans, rot, estimate_source.label, label, tolerance, relations_path=Path(relations)
+    )
 
 
 def evaluate_run(
@@ -339,7 +359,9 @@ def evaluate_run(
     if estimate is not None:
         source = _read_trajectory(Path(estimate), estimate_pose, "estimate")
     elif record.estimate is not None:
-        source = _Source(Trajectory(t=record.t, poses=record.estimate), files.frames, "run", f"{run} (the run's estimate)")
+        source = _Source(
+            Trajectory(t=record.t, poses=record.estimate), files.frames, "run", f"{run} (the run's estimate)"
+        )
     else:
         source = _Source(odometry, files.frames, "run", f"{run} (no SLAM estimate in the folder: the run's odometry)")
     sources["estimate"] = source
@@ -359,10 +381,24 @@ def evaluate_run(
     written: tuple[Path, ...] = ()
     relations_path = files.relations
     if write:
-        written = (write_relations(relations_path, sampled.relations), write_errors(files.errors, sampled.relations, sampled.errors))
+        written = (
+            write_relations(relations_path, sampled.relations),
+            write_errors(files.errors, sampled.relations, sampled.errors),
+        )
     trans, rot = _summaries(sampled.errors)
     label = f"{files.relations if write else 'sampled'} ({len(sampled.relations)} relations sampled from the ground truth, seed {seed})"
-    return EvaluationResult(sampled.relations, sampled.errors, trans, rot, source.label, label, tolerance, sampled, relations_path if write else None, written)
+    return EvaluationResult(
+        sampled.relations,
+        sampled.errors,
+        trans,
+        rot,
+        source.label,
+        label,
+        tolerance,
+        sampled,
+        relations_path if write else None,
+        written,
+    )
 
 
 # ----------------------------------------------------------------------------- printing
@@ -389,7 +425,11 @@ def format_report(result: EvaluationResult) -> str:
     )
     if len(errors.unmatched):
         shown = errors.unmatched[:10].tolist()
-        where = [f"line {_data_line(result.relations_path, i)}" for i in shown] if result.relations_path else [f"#{i}" for i in shown]
+        where = (
+            [f"line {_data_line(result.relations_path, i)}" for i in shown]
+            if result.relations_path
+            else [f"#{i}" for i in shown]
+        )
         more = f" and {len(errors.unmatched) - len(shown)} more" if len(errors.unmatched) > len(shown) else ""
         out.write(f"unmatched: {', '.join(where)}{more}\n")
     s = result.sampling

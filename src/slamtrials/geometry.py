@@ -15,7 +15,19 @@ from numpy.typing import ArrayLike, NDArray
 
 from slamtrials import stablemath
 
-__all__ = ["Pose1Like", "wrap_angle", "compose", "inverse", "ominus", "transform_points", "as_poses", "wrap_angle1", "compose1", "ominus1", "interpolate"]
+__all__ = [
+    "Pose1Like",
+    "wrap_angle",
+    "compose",
+    "inverse",
+    "ominus",
+    "transform_points",
+    "as_poses",
+    "wrap_angle1",
+    "compose1",
+    "ominus1",
+    "interpolate",
+]
 
 #: One pose ``(x, y, theta)`` (or one point) given as numbers: a sequence of floats or a 1-D array.
 #: The single-pose functions read its elements one by one as Python floats.

@@ -9,14 +9,24 @@ from __future__ import annotations
 
 import math
 import numbers
-from dataclasses import dataclass, field
 from collections.abc import Mapping
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Frame", "LaserGeometry", "RunRecord", "Trajectory", "Relations", "OccupancyGrid", "OCCUPIED", "FREE", "UNKNOWN"]
+__all__ = [
+    "Frame",
+    "LaserGeometry",
+    "RunRecord",
+    "Trajectory",
+    "Relations",
+    "OccupancyGrid",
+    "OCCUPIED",
+    "FREE",
+    "UNKNOWN",
+]
 
 
 @dataclass(frozen=True, eq=False)
@@ -81,7 +91,9 @@ class LaserGeometry:
         if self.angle_increment <= 0:
             raise ValueError(f"LaserGeometry.angle_increment must be > 0 rad, got {self.angle_increment!r}")
         if not 0 <= self.range_min < self.range_max:
-            raise ValueError(f"LaserGeometry needs 0 <= range_min < range_max, got {self.range_min!r} and {self.range_max!r}")
+            raise ValueError(
+                f"LaserGeometry needs 0 <= range_min < range_max, got {self.range_min!r} and {self.range_max!r}"
+            )
 
     def beam_angles(self, beams: int) -> NDArray[np.float64]:
         """float64 ``[beams]`` bearings (rad) of the beams in the laser frame."""
@@ -89,11 +101,16 @@ class LaserGeometry:
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON form stored in run.json: the four numbers and ``mount`` as a list."""
-        return {"angle_min": self.angle_min, "angle_increment": self.angle_increment,
-                "range_min": self.range_min, "range_max": self.range_max, "mount": list(self.mount)}
+        return {
+            "angle_min": self.angle_min,
+            "angle_increment": self.angle_increment,
+            "range_min": self.range_min,
+            "range_max": self.range_max,
+            "mount": list(self.mount),
+        }
 
     @classmethod
-    def from_dict(cls, doc: Mapping[str, Any]) -> "LaserGeometry":
+    def from_dict(cls, doc: Mapping[str, Any]) -> LaserGeometry:
         """Read the JSON form (``mount`` optional, default at the base origin). Raises ValueError naming the field."""
         fields = ("angle_min", "angle_increment", "range_min", "range_max")
         missing = [k for k in fields if k not in doc]
@@ -152,7 +169,9 @@ class RunRecord:
         return len(self.t)
 
     @classmethod
-    def from_frames(cls, frames: list[Frame], laser: LaserGeometry, metadata: dict[str, Any] | None = None) -> "RunRecord":
+    def from_frames(
+        cls, frames: list[Frame], laser: LaserGeometry, metadata: dict[str, Any] | None = None
+    ) -> RunRecord:
         """Stack a list of frames into a record."""
         return cls(
             t=np.array([f.t for f in frames], dtype=np.float64),
@@ -241,7 +260,9 @@ class Relations:
     def __post_init__(self) -> None:
         k = len(self.t1)
         if self.t1.ndim != 1 or self.t2.shape != (k,) or self.delta.shape != (k, 3):
-            raise ValueError(f"Relations needs t1 [K], t2 [K], delta [K, 3], got {self.t1.shape}, {self.t2.shape}, {self.delta.shape}")
+            raise ValueError(
+                f"Relations needs t1 [K], t2 [K], delta [K, 3], got {self.t1.shape}, {self.t2.shape}, {self.delta.shape}"
+            )
 
     def __len__(self) -> int:
         return len(self.t1)

@@ -35,12 +35,28 @@ from slamtrials.metric.stats import EnvironmentStats, environment_stats
 from slamtrials.record import OccupancyGrid, Relations, RunRecord, Trajectory
 from slamtrials.slam.offline import run_over_recording
 
-__all__ = ["RepeatSettings", "RepeatedRun", "RepeatedSlam", "repeat_slam", "write_repeat_outputs", "check_relations_fit",
-           "REPEAT_FILES"]
+__all__ = [
+    "RepeatSettings",
+    "RepeatedRun",
+    "RepeatedSlam",
+    "repeat_slam",
+    "write_repeat_outputs",
+    "check_relations_fit",
+    "REPEAT_FILES",
+]
 
 #: Files :func:`write_repeat_outputs` writes (``summary.json`` last).
-REPEAT_FILES = ("runs.csv", "errors.png", "best_map.png", "best_map.yaml", "best_map.pgm", "worst_map.png",
-                "worst_map.yaml", "worst_map.pgm", "summary.json")
+REPEAT_FILES = (
+    "runs.csv",
+    "errors.png",
+    "best_map.png",
+    "best_map.yaml",
+    "best_map.pgm",
+    "worst_map.png",
+    "worst_map.yaml",
+    "worst_map.pgm",
+    "summary.json",
+)
 
 
 @dataclass(frozen=True)
@@ -163,8 +179,14 @@ class RepeatedSlam:
         return max(self.runs, key=lambda run: (run.eps_t, -run.seed))
 
 
-def check_relations_fit(record: RunRecord, relations: Relations, tolerance: float, *, source: str = "the recording",
-                        relations_source: str = "the relations") -> None:
+def check_relations_fit(
+    record: RunRecord,
+    relations: Relations,
+    tolerance: float,
+    *,
+    source: str = "the recording",
+    relations_source: str = "the relations",
+) -> None:
     """Raise :class:`ConfigError` when no relation timestamp is within ``tolerance`` of a frame of ``record``.
 
     Valid files that do not belong together (a log and another dataset's relations) would otherwise give
@@ -173,8 +195,10 @@ def check_relations_fit(record: RunRecord, relations: Relations, tolerance: floa
     if not relations_meet(record.t, relations, tolerance):
         stamps = np.concatenate([relations.t1, relations.t2])
         span = f"{np.nanmin(stamps):.3f} to {np.nanmax(stamps):.3f} s" if len(stamps) else "none"
-        raise ConfigError(f"{relations_source} and {source} do not belong together: no relation timestamp ({span}) "
-                          f"is within {tolerance:g} s of a frame ({record.t[0]:.3f} to {record.t[-1]:.3f} s)")
+        raise ConfigError(
+            f"{relations_source} and {source} do not belong together: no relation timestamp ({span}) "
+            f"is within {tolerance:g} s of a frame ({record.t[0]:.3f} to {record.t[-1]:.3f} s)"
+        )
 
 
 def _one_run(record: RunRecord, relations: Relations, settings: RepeatSettings, seed: int) -> RepeatedRun:
@@ -187,13 +211,28 @@ def _one_run(record: RunRecord, relations: Relations, settings: RepeatSettings, 
     errors = evaluate_relations(estimate, relations, tolerance=s.tolerance, allow_outside=True)
     if len(errors) == 0:
         raise MetricError(f"seed {seed}: no relation matched a pose of the estimate within {s.tolerance:g} s")
-    return RepeatedRun(seed=seed, eps_t=float(np.mean(errors.translational)), eps_r=float(np.mean(errors.rotational)),
-                       relations=len(errors), updates=result.updates, seconds=seconds, occupancy=result.occupancy)
+    return RepeatedRun(
+        seed=seed,
+        eps_t=float(np.mean(errors.translational)),
+        eps_r=float(np.mean(errors.rotational)),
+        relations=len(errors),
+        updates=result.updates,
+        seconds=seconds,
+        occupancy=result.occupancy,
+    )
 
 
-def repeat_slam(record: RunRecord, relations: Relations, settings: RepeatSettings, *, scheduler: Any = None,
-                workers: int | None = None, on_run: Callable[[RepeatedRun, int], None] | None = None,
-                source: str = "", relations_source: str = "") -> RepeatedSlam:
+def repeat_slam(
+    record: RunRecord,
+    relations: Relations,
+    settings: RepeatSettings,
+    *,
+    scheduler: Any = None,
+    workers: int | None = None,
+    on_run: Callable[[RepeatedRun, int], None] | None = None,
+    source: str = "",
+    relations_source: str = "",
+) -> RepeatedSlam:
     """Run ``settings.algorithm`` over ``record`` with seeds ``0, 1, ...`` and score each run on ``relations``.
 
     Parameters
@@ -222,8 +261,13 @@ def repeat_slam(record: RunRecord, relations: Relations, settings: RepeatSetting
     if len(record) == 0:
         raise ConfigError(f"{source or 'the recording'} has no frames")
     resolve_config(get_algorithm(settings.algorithm), preset=settings.preset, overrides=settings.overrides)
-    check_relations_fit(record, relations, settings.tolerance, source=source or "the recording",
-                        relations_source=relations_source or "the relations")
+    check_relations_fit(
+        record,
+        relations,
+        settings.tolerance,
+        source=source or "the recording",
+        relations_source=relations_source or "the relations",
+    )
     done: dict[int, RepeatedRun] = {}
     rule = ""
     with dask_client(scheduler, workers) as client:
@@ -242,12 +286,21 @@ def repeat_slam(record: RunRecord, relations: Relations, settings: RepeatSetting
             while True:
                 run_seeds(range(len(done), planned), planned)
                 ordered = [done[s] for s in sorted(done)]
-                decision = runs_needed([r.eps_t for r in ordered], [r.eps_r for r in ordered], margin_t=settings.margin_t,
-                                       margin_r=settings.margin_r, confidence=settings.confidence, distribution="t",
-                                       min_runs=settings.initial, max_runs=settings.max_runs)
-                rule = (f"Section III-C rule: {decision.done} runs done, N_t = {decision.needed_t}, N_r = {decision.needed_r} "
-                        f"(margins {settings.margin_t:g} m, {settings.margin_r:g} rad at {100 * settings.confidence:g} %, Student t)"
-                        + ("; capped" if decision.capped else ""))
+                decision = runs_needed(
+                    [r.eps_t for r in ordered],
+                    [r.eps_r for r in ordered],
+                    margin_t=settings.margin_t,
+                    margin_r=settings.margin_r,
+                    confidence=settings.confidence,
+                    distribution="t",
+                    min_runs=settings.initial,
+                    max_runs=settings.max_runs,
+                )
+                rule = (
+                    f"Section III-C rule: {decision.done} runs done, N_t = {decision.needed_t}, N_r = {decision.needed_r} "
+                    f"(margins {settings.margin_t:g} m, {settings.margin_r:g} rad at {100 * settings.confidence:g} %, Student t)"
+                    + ("; capped" if decision.capped else "")
+                )
                 if decision.enough or decision.needed <= len(done):
                     break
                 planned = decision.needed
@@ -255,11 +308,16 @@ def repeat_slam(record: RunRecord, relations: Relations, settings: RepeatSetting
             run_seeds(range(settings.runs), settings.runs)
     runs = tuple(done[s] for s in sorted(done))
     eps_t = [r.eps_t for r in runs]
-    return RepeatedSlam(settings=settings, runs=runs,
-                        stats_t=environment_stats(eps_t, confidence=settings.confidence, distribution="t"),
-                        stats_r=environment_stats([r.eps_r for r in runs], confidence=settings.confidence, distribution="t"),
-                        diverged=divergence(eps_t, settings.divergence_factor), rule=rule, source=source,
-                        relations_source=relations_source)
+    return RepeatedSlam(
+        settings=settings,
+        runs=runs,
+        stats_t=environment_stats(eps_t, confidence=settings.confidence, distribution="t"),
+        stats_r=environment_stats([r.eps_r for r in runs], confidence=settings.confidence, distribution="t"),
+        diverged=divergence(eps_t, settings.divergence_factor),
+        rule=rule,
+        source=source,
+        relations_source=relations_source,
+    )
 
 
 def _as_completed(futures: list[Any]) -> Any:
@@ -287,12 +345,19 @@ def write_repeat_outputs(result: RepeatedSlam, out_dir: str | Path, *, overwrite
     out.mkdir(parents=True, exist_ok=True)
     diverged = dict(zip((r.seed for r in result.runs), result.diverged.diverged.tolist()))
     lines = ["seed,eps_t,eps_r,relations,updates,seconds,diverged\n"]
-    lines += [f"{r.seed},{r.eps_t!r},{r.eps_r!r},{r.relations},{r.updates},{r.seconds:.3f},{int(diverged[r.seed])}\n"
-              for r in result.runs]
+    lines += [
+        f"{r.seed},{r.eps_t!r},{r.eps_r!r},{r.relations},{r.updates},{r.seconds:.3f},{int(diverged[r.seed])}\n"
+        for r in result.runs
+    ]
     written = [atomic_write_text(out / "runs.csv", "".join(lines))]
     fig = Figure(figsize=(7.0, 3.6))
-    draw_repeated_errors(fig.add_subplot(1, 1, 1), [r.eps_t for r in result.runs], result.diverged.threshold,
-                         factor=result.diverged.factor, title=f"{result.settings.algorithm}: {len(result.runs)} runs of {Path(result.source).name or 'the recording'}")
+    draw_repeated_errors(
+        fig.add_subplot(1, 1, 1),
+        [r.eps_t for r in result.runs],
+        result.diverged.threshold,
+        factor=result.diverged.factor,
+        title=f"{result.settings.algorithm}: {len(result.runs)} runs of {Path(result.source).name or 'the recording'}",
+    )
     fig.tight_layout()
     written.append(atomic_write(out / "errors.png", lambda handle: fig.savefig(handle, format="png", dpi=150)))
     for name, run in (("best", result.best), ("worst", result.worst)):
@@ -312,9 +377,12 @@ def write_repeat_outputs(result: RepeatedSlam, out_dir: str | Path, *, overwrite
         "confidence": result.settings.confidence,
         "translational_m": _stats_json(result.stats_t),
         "rotational_rad": _stats_json(result.stats_r),
-        "diverged": {"threshold_m": result.diverged.threshold, "factor": result.diverged.factor,
-                     "share": result.diverged.share,
-                     "seeds": [r.seed for r, d in zip(result.runs, result.diverged.diverged) if d]},
+        "diverged": {
+            "threshold_m": result.diverged.threshold,
+            "factor": result.diverged.factor,
+            "share": result.diverged.share,
+            "seeds": [r.seed for r, d in zip(result.runs, result.diverged.diverged) if d],
+        },
         "best": {"seed": result.best.seed, "eps_t": result.best.eps_t},
         "worst": {"seed": result.worst.seed, "eps_t": result.worst.eps_t},
     }

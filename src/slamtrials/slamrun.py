@@ -45,7 +45,16 @@ __all__ = ["SlamResult", "run_slam", "write_slam_outputs", "load_recording", "OU
 
 SLAM_FILE = "slam.json"
 #: Files :func:`write_slam_outputs` writes, in order (``slam.json`` last).
-OUTPUT_FILES = ("trajectory.tum", "trajectory.clf", "trajectory.log", "map.yaml", "map.pgm", "map.png", "timing.csv", SLAM_FILE)
+OUTPUT_FILES = (
+    "trajectory.tum",
+    "trajectory.clf",
+    "trajectory.log",
+    "map.yaml",
+    "map.pgm",
+    "map.png",
+    "timing.csv",
+    SLAM_FILE,
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -88,8 +97,16 @@ class SlamResult:
     source: str = ""
 
 
-def run_slam(record: RunRecord, algorithm_name: str, *, preset: str | None = None, overrides: dict[str, Any] | None = None,
-             seed: int = 0, on_frame: Callable[[int, int], None] | None = None, source: str = "") -> SlamResult:
+def run_slam(
+    record: RunRecord,
+    algorithm_name: str,
+    *,
+    preset: str | None = None,
+    overrides: dict[str, Any] | None = None,
+    seed: int = 0,
+    on_frame: Callable[[int, int], None] | None = None,
+    source: str = "",
+) -> SlamResult:
     """Process every frame of ``record`` with algorithm ``algorithm_name``
     (:func:`slamtrials.slam.offline.run_over_recording`).
 
@@ -115,9 +132,18 @@ def run_slam(record: RunRecord, algorithm_name: str, *, preset: str | None = Non
         Unknown algorithm, preset or parameter, a bad value, a negative seed or an empty record.
     """
     run = run_over_recording(record, algorithm_name, preset=preset, overrides=overrides, seed=seed, on_frame=on_frame)
-    return SlamResult(algorithm=algorithm_name, preset=preset, config=run.config.model_dump(mode="json"), seed=run.seed,
-                      trajectory=run.trajectory, occupancy=run.occupancy, timing=run.timing, updates=run.updates,
-                      record=record, source=source)
+    return SlamResult(
+        algorithm=algorithm_name,
+        preset=preset,
+        config=run.config.model_dump(mode="json"),
+        seed=run.seed,
+        trajectory=run.trajectory,
+        occupancy=run.occupancy,
+        timing=run.timing,
+        updates=run.updates,
+        record=record,
+        source=source,
+    )
 
 
 def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bool = False) -> list[Path]:
@@ -140,12 +166,16 @@ def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bo
     written = [write_tum(out / "trajectory.tum", result.trajectory)]
     as_run = replace(result.record, truth=estimate, estimate=estimate)  # first CARMEN triple = the estimate
     written.append(write_carmen(out / "trajectory.clf", carmen_from_run(as_run)))
-    written.append(write_carmen(out / "trajectory.log", carmen_from_trajectory(Trajectory(t=result.record.t, poses=estimate))))
+    written.append(
+        write_carmen(out / "trajectory.log", carmen_from_trajectory(Trajectory(t=result.record.t, poses=estimate)))
+    )
     grid = result.occupancy
     written.append(write_map(out / "map.yaml", grid.grid, grid.resolution, grid.origin))
     written.append(out / "map.pgm")
     written.append(write_map_png(out / "map.png", grid.grid))
-    rows = "".join(f"{k},{t!r},{s!r}\n" for k, (t, s) in enumerate(zip(result.record.t.tolist(), result.timing.tolist())))
+    rows = "".join(
+        f"{k},{t!r},{s!r}\n" for k, (t, s) in enumerate(zip(result.record.t.tolist(), result.timing.tolist()))
+    )
     written.append(atomic_write_text(out / "timing.csv", "frame,t,seconds\n" + rows))
     total = float(result.timing.sum())
     summary = {
@@ -159,7 +189,11 @@ def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bo
         "seconds_total": total,
         "ms_per_frame_mean": 1000.0 * total / max(len(result.record), 1),
         "ms_per_frame_max": 1000.0 * float(result.timing.max()) if len(result.timing) else math.nan,
-        "map": {"shape": list(grid.grid.shape), "resolution": grid.resolution, "origin": [float(v) for v in grid.origin]},
+        "map": {
+            "shape": list(grid.grid.shape),
+            "resolution": grid.resolution,
+            "origin": [float(v) for v in grid.origin],
+        },
         "trajectory_clf": "first pose triple = SLAM estimate, second = recorded odometry",
         "trajectory_log": "FLASER 0 lines, SLAM estimate in both pose triples (the Freiburg metricEvaluator's input)",
     }

@@ -30,29 +30,52 @@ def test_dump_is_complete_commented_and_loads_back_equal():
     for i, line in enumerate(lines):
         if line.strip() and not line.lstrip().startswith(("#", "- ")):
             assert lines[i - 1].lstrip().startswith("#"), line
-    for key in ("sim:", "laser:", "odometry:", "slam:", "termination:", "metric:", "runs:", "max_runs:", "seed:", "pilot:"):
+    for key in (
+        "sim:",
+        "laser:",
+        "odometry:",
+        "slam:",
+        "termination:",
+        "metric:",
+        "runs:",
+        "max_runs:",
+        "seed:",
+        "pilot:",
+    ):
         assert any(line.strip() == key or line.strip().startswith(key + " ") for line in lines), key
 
 
 def test_a_changed_config_dumps_and_loads_back_equal():
-    config = CampaignConfig.from_dict({"worlds": ["a.yaml", "b"], "seed": 12, "runs": {"initial": 3, "max_runs": 7},
-                                       "slam": {"algorithm": "gmapping", "params": {"particles": 5}},
-                                       "sim": {"laser": {"mount": [0.1, 0.0, 0.2]}}})
+    config = CampaignConfig.from_dict(
+        {
+            "worlds": ["a.yaml", "b"],
+            "seed": 12,
+            "runs": {"initial": 3, "max_runs": 7},
+            "slam": {"algorithm": "gmapping", "params": {"particles": 5}},
+            "sim": {"laser": {"mount": [0.1, 0.0, 0.2]}},
+        }
+    )
     assert CampaignConfig.from_dict(yaml.safe_load(dump_config_yaml(config))) == config
 
 
-@pytest.mark.parametrize(("data", "expected"), [
-    ({"worlds": ["w"], "runz": {}}, "runz: Extra inputs are not permitted"),
-    ({"worlds": ["w"], "runs": {"initial": 1}}, "runs.initial: Input should be greater than or equal to 2 (got 1)"),
-    ({"worlds": ["w"], "runs": {"initial": 10, "max_runs": 5}}, "max_runs (5) must be at least initial (10)"),
-    ({"worlds": ["w"], "metric": {"confidence": 1.5}}, "metric.confidence: Input should be less than 1 (got 1.5)"),
-    ({"worlds": ["w"], "sim": {"laser": {"max_range": -1}}}, "sim.laser.max_range"),
-    ({"worlds": ["w"], "seed": -3}, "seed: Input should be greater than or equal to 0 (got -3)"),
-    ({"worlds": []}, "worlds: List should have at least 1 item"),
-    ({"seed": 1}, "worlds: required setting is missing"),
-    ({"worlds": ["w"], "slam": {"params": {"particlez": 3}}}, "slam: SLAM algorithm 'gmapping' has no parameter particlez"),
-    ({"worlds": ["w"], "slam": {"algorithm": "nope"}}, "unknown SLAM algorithm 'nope'"),
-])
+@pytest.mark.parametrize(
+    ("data", "expected"),
+    [
+        ({"worlds": ["w"], "runz": {}}, "runz: Extra inputs are not permitted"),
+        ({"worlds": ["w"], "runs": {"initial": 1}}, "runs.initial: Input should be greater than or equal to 2 (got 1)"),
+        ({"worlds": ["w"], "runs": {"initial": 10, "max_runs": 5}}, "max_runs (5) must be at least initial (10)"),
+        ({"worlds": ["w"], "metric": {"confidence": 1.5}}, "metric.confidence: Input should be less than 1 (got 1.5)"),
+        ({"worlds": ["w"], "sim": {"laser": {"max_range": -1}}}, "sim.laser.max_range"),
+        ({"worlds": ["w"], "seed": -3}, "seed: Input should be greater than or equal to 0 (got -3)"),
+        ({"worlds": []}, "worlds: List should have at least 1 item"),
+        ({"seed": 1}, "worlds: required setting is missing"),
+        (
+            {"worlds": ["w"], "slam": {"params": {"particlez": 3}}},
+            "slam: SLAM algorithm 'gmapping' has no parameter particlez",
+        ),
+        ({"worlds": ["w"], "slam": {"algorithm": "nope"}}, "unknown SLAM algorithm 'nope'"),
+    ],
+)
 def test_bad_values_are_one_line_errors_naming_the_field(data, expected):
     with pytest.raises(ConfigError) as info:
         CampaignConfig.from_dict(data, source="c.yaml")
@@ -63,7 +86,9 @@ def test_bad_values_are_one_line_errors_naming_the_field(data, expected):
 def test_from_yaml_names_the_file(tmp_path):
     path = tmp_path / "campaign.yaml"
     path.write_text("worlds: [office_small_01]\nruns:\n  retries: -1\n")
-    with pytest.raises(ConfigError, match=r"campaign.yaml: runs.retries: Input should be greater than or equal to 0 \(got -1\)"):
+    with pytest.raises(
+        ConfigError, match=r"campaign.yaml: runs.retries: Input should be greater than or equal to 0 \(got -1\)"
+    ):
         CampaignConfig.from_yaml(path)
     path.write_text("worlds: [office_small_01\n")
     with pytest.raises(FormatError, match="campaign.yaml"):

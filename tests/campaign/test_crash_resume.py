@@ -41,7 +41,11 @@ def outcome(folder):
     recorded = {}
     for path in (folder / "runs").glob("*/*/run.json"):
         doc = json.loads(path.read_text())
-        recorded[path.parent.relative_to(folder).as_posix()] = (doc["seed"], doc["campaign"]["eps_t"], doc["campaign"]["eps_r"])
+        recorded[path.parent.relative_to(folder).as_posix()] = (
+            doc["seed"],
+            doc["campaign"]["eps_t"],
+            doc["campaign"]["eps_r"],
+        )
     return runs, worlds, folders, recorded
 
 
@@ -60,8 +64,14 @@ def done_count(folder) -> int:
 
 @pytest.mark.slow
 def test_kill_9_then_resume_equals_an_uninterrupted_campaign(tmp_path, rooms, client):
-    config = CampaignConfig.from_dict({"worlds": rooms, "seed": 11, "slam": {"algorithm": "odometry", "preset": None},
-                                       "runs": {"initial": 10, "max_runs": 60}})
+    config = CampaignConfig.from_dict(
+        {
+            "worlds": rooms,
+            "seed": 11,
+            "slam": {"algorithm": "odometry", "preset": None},
+            "runs": {"initial": 10, "max_runs": 60},
+        }
+    )
     reference = run_campaign(config, tmp_path / "reference", scheduler=client, trial_fn=FakeTrial())
     total = reference.runs_done
     assert total > 40
@@ -71,8 +81,11 @@ def test_kill_9_then_resume_equals_an_uninterrupted_campaign(tmp_path, rooms, cl
     folder = tmp_path / "killed"
     killed = 0
     for kill_at in (3, total // 3, (2 * total) // 3):
-        proc = subprocess.Popen([sys.executable, str(script), json.dumps(config.model_dump(mode="json")), str(folder)],
-                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        proc = subprocess.Popen(
+            [sys.executable, str(script), json.dumps(config.model_dump(mode="json")), str(folder)],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
         deadline = time.monotonic() + 60
         while proc.poll() is None and done_count(folder) < kill_at and time.monotonic() < deadline:
             time.sleep(0.005)
@@ -91,8 +104,14 @@ def test_kill_9_then_resume_equals_an_uninterrupted_campaign(tmp_path, rooms, cl
 
 
 def test_a_crash_between_rename_and_commit_is_redone(tmp_path, rooms, client):
-    config = CampaignConfig.from_dict({"worlds": rooms[:1], "seed": 2, "runs": {"initial": 4, "max_runs": 4},
-                                       "slam": {"algorithm": "odometry", "preset": None}})
+    config = CampaignConfig.from_dict(
+        {
+            "worlds": rooms[:1],
+            "seed": 2,
+            "runs": {"initial": 4, "max_runs": 4},
+            "slam": {"algorithm": "odometry", "preset": None},
+        }
+    )
     reference = run_campaign(config, tmp_path / "reference", scheduler=client, trial_fn=FakeTrial())
     folder = tmp_path / "c"
     run_campaign(config, folder, scheduler=client, trial_fn=FakeTrial())

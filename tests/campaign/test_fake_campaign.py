@@ -16,16 +16,28 @@ FAKE = FakeTrial(mean_t=0.3, std_t=0.05, mean_r=0.05, std_r=0.012)
 
 
 def config_for(rooms, **changes) -> CampaignConfig:
-    data = {"worlds": rooms, "seed": 7, "slam": {"algorithm": "odometry", "preset": None},
-            "runs": {"initial": 10, "max_runs": 80}, **changes}
+    data = {
+        "worlds": rooms,
+        "seed": 7,
+        "slam": {"algorithm": "odometry", "preset": None},
+        "runs": {"initial": 10, "max_runs": 80},
+        **changes,
+    }
     return CampaignConfig.from_dict(data)
 
 
 def expected_runs(config: CampaignConfig, world: str, trial: FakeTrial = FAKE):
     """The rule replayed independently over the fake's errors, taken in run order."""
     errors = np.array([trial.errors(run_seed(config.seed, world, i)) for i in range(config.runs.max_runs)])
-    return replay_run_count(errors[:, 0], errors[:, 1], margin_t=config.runs.margin_t, margin_r=config.runs.margin_r,
-                            confidence=config.runs.confidence, min_runs=config.runs.initial, max_runs=config.runs.max_runs)
+    return replay_run_count(
+        errors[:, 0],
+        errors[:, 1],
+        margin_t=config.runs.margin_t,
+        margin_r=config.runs.margin_r,
+        confidence=config.runs.confidence,
+        min_runs=config.runs.initial,
+        max_runs=config.runs.max_runs,
+    )
 
 
 def snapshot(folder):
@@ -126,7 +138,12 @@ def test_bad_input_fails_before_any_work(tmp_path, rooms, client):
     run_campaign(config, tmp_path / "c", scheduler=client, trial_fn=FAKE)
     before = snapshot(tmp_path / "c")
     with pytest.raises(ConfigError, match=r"different config \(seed: stored 7, given 8\)"):
-        run_campaign(config_for(rooms[:1], seed=8, runs={"initial": 3, "max_runs": 3}), tmp_path / "c", scheduler=client, trial_fn=FAKE)
+        run_campaign(
+            config_for(rooms[:1], seed=8, runs={"initial": 3, "max_runs": 3}),
+            tmp_path / "c",
+            scheduler=client,
+            trial_fn=FAKE,
+        )
     assert snapshot(tmp_path / "c") == before
 
 

@@ -11,7 +11,7 @@ from slamtrials.campaign import RunSettings, run_seed
 from slamtrials.campaign.loop import next_step
 from slamtrials.metric import replay_run_count
 
-Z2 = 2.5758293035489004 ** 2  # two-sided normal quantile of 99 %, squared
+Z2 = 2.5758293035489004**2  # two-sided normal quantile of 99 %, squared
 
 
 def alternating(n: int, mean: float = 0.3, half: float = 0.05) -> dict[int, tuple[float, float]]:
@@ -70,8 +70,15 @@ def test_agrees_with_replay_run_count(seed):
     settings = RunSettings(initial=5 + seed, max_runs=300)
     results = {i: (float(t), float(r)) for i, (t, r) in enumerate(zip(eps_t, eps_r, strict=True))}
     step = next_step(results, settings)
-    expected = replay_run_count(eps_t, eps_r, margin_t=0.02, margin_r=0.02, confidence=0.99, min_runs=settings.initial,
-                                max_runs=settings.max_runs)
+    expected = replay_run_count(
+        eps_t,
+        eps_r,
+        margin_t=0.02,
+        margin_r=0.02,
+        confidence=0.99,
+        min_runs=settings.initial,
+        max_runs=settings.max_runs,
+    )
     assert step.finished and expected is not None
     assert step.target == expected.done and step.capped == expected.capped
 

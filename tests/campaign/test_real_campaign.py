@@ -19,13 +19,23 @@ def process_client():
     """A LocalCluster of 2 single-threaded worker processes, as run_campaign starts by default."""
     from distributed import Client, LocalCluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster, Client(cluster) as c:
+    with (
+        LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster,
+        Client(cluster) as c,
+    ):
         yield c
 
 
 def tiny_config(rooms, **changes) -> CampaignConfig:
-    return CampaignConfig.from_dict({"worlds": rooms, "seed": 1, "termination": {"small_period": 60.0, "max_time": 300.0},
-                                     "runs": {"initial": 2, "max_runs": 3}, **changes})
+    return CampaignConfig.from_dict(
+        {
+            "worlds": rooms,
+            "seed": 1,
+            "termination": {"small_period": 60.0, "max_time": 300.0},
+            "runs": {"initial": 2, "max_runs": 3},
+            **changes,
+        }
+    )
 
 
 @pytest.fixture(scope="module")
@@ -49,7 +59,16 @@ def test_a_real_campaign_on_two_worker_processes(campaign):
         assert len({r.worker for r in runs}) == 2  # both worker processes ran runs
         for run in runs:
             run_dir = folder / run.folder
-            for name in ("run.json", "frames.npz", "estimate.tum", "map.yaml", "map.pgm", "map.png", "relations.txt", "errors.npz"):
+            for name in (
+                "run.json",
+                "frames.npz",
+                "estimate.tum",
+                "map.yaml",
+                "map.pgm",
+                "map.png",
+                "relations.txt",
+                "errors.npz",
+            ):
                 assert (run_dir / name).is_file(), name
             doc = json.loads((run_dir / "run.json").read_text())
             assert doc["seed"] == run.seed and doc["campaign"]["index"] == run.idx
@@ -67,8 +86,9 @@ def test_the_same_campaign_elsewhere_gives_the_same_runs(campaign, rooms, client
     again = run_campaign(tiny_config(rooms), tmp_path / "again", scheduler=client)
     assert again.summary == result.summary
     with CampaignStore.open(folder) as a, CampaignStore.open(tmp_path / "again") as b:
-        assert [(r.world, r.idx, r.seed, r.eps_t, r.eps_r, r.termination) for r in a.runs()] == \
-               [(r.world, r.idx, r.seed, r.eps_t, r.eps_r, r.termination) for r in b.runs()]
+        assert [(r.world, r.idx, r.seed, r.eps_t, r.eps_r, r.termination) for r in a.runs()] == [
+            (r.world, r.idx, r.seed, r.eps_t, r.eps_r, r.termination) for r in b.runs()
+        ]
 
 
 def test_replay_with_another_algorithm(campaign, process_client, tmp_path):

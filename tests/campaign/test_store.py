@@ -19,10 +19,28 @@ from slamtrials.campaign.store import DB_FILE, CampaignStore, WorldInfo
 from slamtrials.errors import ConfigError
 
 WORLDS = [WorldInfo("a", "a", 0, 10.0), WorldInfo("b", "/x/b.yaml", 1, 20.0)]
-RESULT = RunDone(world="a", index=0, eps_t=0.25, eps_r=0.03, relations=12, termination="map_converged",
-                 mapped_fraction=0.97, sim_duration=100.0, wall_time=2.0, worker="w:1", folder="runs/a/000",
-                 details=RunDetails(frames=5, distance_m=3.0, observed_fraction=0.99, slam_updates=7,
-                                    relation_std_t=0.1, relation_std_r=0.01, relations_capped=False))
+RESULT = RunDone(
+    world="a",
+    index=0,
+    eps_t=0.25,
+    eps_r=0.03,
+    relations=12,
+    termination="map_converged",
+    mapped_fraction=0.97,
+    sim_duration=100.0,
+    wall_time=2.0,
+    worker="w:1",
+    folder="runs/a/000",
+    details=RunDetails(
+        frames=5,
+        distance_m=3.0,
+        observed_fraction=0.99,
+        slam_updates=7,
+        relation_std_t=0.1,
+        relation_std_r=0.01,
+        relations_capped=False,
+    ),
+)
 
 
 def snapshot(folder):
@@ -69,7 +87,9 @@ def test_a_different_config_is_refused_before_anything_changes(tmp_path):
         open_campaign(folder, CampaignConfig(worlds=["a", "b"], seed=5), WORLDS, kind="replay")
     assert snapshot(folder) == before
     # the same config with another output folder is the same campaign
-    open_campaign(folder, CampaignConfig(worlds=["a", "b"], seed=5, output="elsewhere"), WORLDS, kind="campaign").close()
+    open_campaign(
+        folder, CampaignConfig(worlds=["a", "b"], seed=5, output="elsewhere"), WORLDS, kind="campaign"
+    ).close()
 
 
 def test_a_folder_that_is_not_a_campaign_is_not_touched(tmp_path):
@@ -87,6 +107,7 @@ def test_publish_run_is_atomic_and_replaces_a_stale_folder(tmp_path):
     def write(content):
         def go(folder):
             (folder / "run.json").write_text(content)
+
         return go
 
     final = publish_run(tmp_path, "a", 3, write("first"))

@@ -40,8 +40,13 @@ def write_room(folder, name="room"):
 
 
 def write_config(path, worlds, **changes):
-    data = {"worlds": worlds, "slam": {"algorithm": "odometry", "preset": None},
-            "termination": {"small_period": 60.0, "max_time": 300.0}, "runs": {"initial": 2, "max_runs": 2}, **changes}
+    data = {
+        "worlds": worlds,
+        "slam": {"algorithm": "odometry", "preset": None},
+        "termination": {"small_period": 60.0, "max_time": 300.0},
+        "runs": {"initial": 2, "max_runs": 2},
+        **changes,
+    }
     path.write_text(yaml.safe_dump(data))
     return path
 
@@ -56,11 +61,17 @@ def test_config_dump_prints_a_loadable_default(tmp_path):
     assert out.read_text() == result.output
 
 
-@pytest.mark.parametrize(("content", "expected"), [
-    ("worlds: [office_small_01]\nrunz: {initial: 3}\n", "c.yaml: runz: Extra inputs are not permitted"),
-    ("worlds: [office_small_01]\nruns: {initial: 0}\n", "c.yaml: runs.initial: Input should be greater than or equal to 2 (got 0)"),
-    ("worlds: [no_such_world]\n", "worlds: world 'no_such_world' does not load"),
-])
+@pytest.mark.parametrize(
+    ("content", "expected"),
+    [
+        ("worlds: [office_small_01]\nrunz: {initial: 3}\n", "c.yaml: runz: Extra inputs are not permitted"),
+        (
+            "worlds: [office_small_01]\nruns: {initial: 0}\n",
+            "c.yaml: runs.initial: Input should be greater than or equal to 2 (got 0)",
+        ),
+        ("worlds: [no_such_world]\n", "worlds: world 'no_such_world' does not load"),
+    ],
+)
 def test_bad_config_is_one_line_and_exit_2(tmp_path, content, expected):
     config = tmp_path / "c.yaml"
     config.write_text(content)
@@ -78,7 +89,9 @@ def test_missing_arguments_and_folders(tmp_path):
     assert result.exit_code == 2 and "not a campaign folder" in result.output
     result = runner.invoke(app, ["campaign", "status", str(tmp_path)])
     assert result.exit_code == 2 and "not a campaign folder" in result.output
-    result = runner.invoke(app, ["campaign", "replay", str(tmp_path), "--algorithm", "odometry", "--out", str(tmp_path / "new")])
+    result = runner.invoke(
+        app, ["campaign", "replay", str(tmp_path), "--algorithm", "odometry", "--out", str(tmp_path / "new")]
+    )
     assert result.exit_code == 2 and "not a campaign folder" in result.output
 
 
@@ -90,7 +103,9 @@ def test_a_small_real_campaign_status_resume_and_replay(tmp_path):
     out = tmp_path / "campaign"
     result = runner.invoke(app, ["campaign", "run", str(config), "--out", str(out), "--workers", "1"])
     assert result.exit_code == 0, result.output
-    assert ("room: done with 2 runs" in result.output or "room: capped with 2 runs" in result.output) and "eps_t" in result.output
+    assert (
+        "room: done with 2 runs" in result.output or "room: capped with 2 runs" in result.output
+    ) and "eps_t" in result.output
     assert f"summary: {out / 'summary.csv'}" in result.output.replace("\n", "")
     assert (out / "summary.csv").is_file() and (out / "runs" / "room" / "001" / "run.json").is_file()
     status = runner.invoke(app, ["campaign", "status", str(out)])
@@ -103,9 +118,26 @@ def test_a_small_real_campaign_status_resume_and_replay(tmp_path):
     refused = runner.invoke(app, ["campaign", "run", str(other), "--out", str(out)])
     assert refused.exit_code == 2 and "different config (seed: stored 0, given 5)" in refused.output
     # replay with another parameter of the same algorithm
-    replay = runner.invoke(app, ["campaign", "replay", str(out), "--algorithm", "odometry", "--set", "resolution=0.1",
-                                 "--out", str(tmp_path / "replay"), "--workers", "1"])
+    replay = runner.invoke(
+        app,
+        [
+            "campaign",
+            "replay",
+            str(out),
+            "--algorithm",
+            "odometry",
+            "--set",
+            "resolution=0.1",
+            "--out",
+            str(tmp_path / "replay"),
+            "--workers",
+            "1",
+        ],
+    )
     assert replay.exit_code == 0, replay.output
     assert "first algorithm's maps" in replay.output and (tmp_path / "replay" / "summary.csv").is_file()
-    bad = runner.invoke(app, ["campaign", "replay", str(out), "--algorithm", "odometry", "--set", "nope=1", "--out", str(tmp_path / "r2")])
+    bad = runner.invoke(
+        app,
+        ["campaign", "replay", str(out), "--algorithm", "odometry", "--set", "nope=1", "--out", str(tmp_path / "r2")],
+    )
     assert bad.exit_code == 2 and "no parameter nope" in bad.output

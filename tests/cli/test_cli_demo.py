@@ -25,7 +25,10 @@ runner = CliRunner()
 def client():
     from distributed import Client, LocalCluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster, Client(cluster) as c:
+    with (
+        LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster,
+        Client(cluster) as c,
+    ):
         yield c
 
 
@@ -58,11 +61,19 @@ def test_run_demo_runs_the_campaign_writes_the_report_and_resumes(tmp_path, clie
 def test_demo_command_prints_the_summary_and_the_report(tmp_path, client, monkeypatch):
     import slamtrials.demo
 
-    monkeypatch.setattr(slamtrials.demo, "run_demo", functools.partial(run_demo, scheduler=client, trial_fn=FakeTrial(std_t=0.01), repeats=5, pdf=False))
+    monkeypatch.setattr(
+        slamtrials.demo,
+        "run_demo",
+        functools.partial(run_demo, scheduler=client, trial_fn=FakeTrial(std_t=0.01), repeats=5, pdf=False),
+    )
     out = tmp_path / "results" / "demo"
-    result = runner.invoke(app, ["demo", "--out", str(out), "--world", "office_small_01", "--world", "lab_small_01", "--seed", "4"])
+    result = runner.invoke(
+        app, ["demo", "--out", str(out), "--world", "office_small_01", "--world", "lab_small_01", "--seed", "4"]
+    )
     assert result.exit_code == 0, result.output
-    assert "office_small_01" in result.output and "lab_small_01" in result.output and "house_small_01" not in result.output
+    assert (
+        "office_small_01" in result.output and "lab_small_01" in result.output and "house_small_01" not in result.output
+    )
     assert f"Report: {out.absolute() / 'report' / 'index.html'}" in result.output
     assert "runs done" in result.output and (out / "report" / "index.html").is_file()
     assert result.output.startswith(f"Demo campaign in {out}")
@@ -70,7 +81,11 @@ def test_demo_command_prints_the_summary_and_the_report(tmp_path, client, monkey
 
 def test_demo_command_bad_input_is_one_line(tmp_path):
     result = runner.invoke(app, ["demo", "--out", str(tmp_path / "d"), "--workers", "0"])
-    assert result.exit_code == 2 and result.output.strip().startswith("error: ") and len(result.output.strip().splitlines()) == 1
+    assert (
+        result.exit_code == 2
+        and result.output.strip().startswith("error: ")
+        and len(result.output.strip().splitlines()) == 1
+    )
     (tmp_path / "taken").mkdir()
     (tmp_path / "taken" / "notes.txt").write_text("not a campaign")
     result = runner.invoke(app, ["demo", "--out", str(tmp_path / "taken"), "--workers", "1"])

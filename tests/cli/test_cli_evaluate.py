@@ -19,7 +19,9 @@ from slamtrials.record import LaserGeometry, Relations, RunRecord, Trajectory
 runner = CliRunner()
 REPO = Path(__file__).resolve().parents[2]
 DATA = Path(os.environ.get("SLAMTRIALS_SHARED", REPO.parent / "shared")) / "data" / "mit-csail"
-LASER = LaserGeometry.from_dict({"angle_min": -2.356, "angle_increment": 0.0087, "range_min": 0.0, "range_max": 30.0, "mount": [0.0, 0.0, 0.0]})
+LASER = LaserGeometry.from_dict(
+    {"angle_min": -2.356, "angle_increment": 0.0087, "range_min": 0.0, "range_max": 30.0, "mount": [0.0, 0.0, 0.0]}
+)
 
 
 def _summary_rows(output: str) -> tuple[list[float], list[float]]:
@@ -45,16 +47,22 @@ def _files(tmp_path, comment: bool = True):
 
 def test_estimate_and_relations_files_known_answer(tmp_path):
     est, rel, _ = _files(tmp_path)
-    result = runner.invoke(app, ["evaluate", "--estimate", str(est), "--relations", str(rel), "--errors", str(tmp_path / "e.npz")])
+    result = runner.invoke(
+        app, ["evaluate", "--estimate", str(est), "--relations", str(rel), "--errors", str(tmp_path / "e.npz")]
+    )
     assert result.exit_code == 0, result.output
     trans, rot = _summary_rows(result.output)
-    np.testing.assert_allclose(trans, [0.4 / 3, np.std([0.1, 0.1, 0.2], ddof=1), 0.1, 0.2, 3], rtol=1e-5)  # printed to 6 digits
+    np.testing.assert_allclose(
+        trans, [0.4 / 3, np.std([0.1, 0.1, 0.2], ddof=1), 0.1, 0.2, 3], rtol=1e-5
+    )  # printed to 6 digits
     np.testing.assert_allclose(rot, [0, 0, 0, 0, 3], atol=1e-9)
     assert "Translational error (m, absolute)" in result.output and "Rotational error (rad, absolute)" in result.output
     with np.load(tmp_path / "e.npz") as npz:
         np.testing.assert_allclose(npz["translational"], [0.1, 0.1, 0.2], atol=1e-9)
         assert not npz["squared"] and len(npz["unmatched"]) == 0
-    squared = runner.invoke(app, ["evaluate", "-e", str(est), "-r", str(rel), "--squared", "--errors", str(tmp_path / "e.txt")])
+    squared = runner.invoke(
+        app, ["evaluate", "-e", str(est), "-r", str(rel), "--squared", "--errors", str(tmp_path / "e.txt")]
+    )
     assert squared.exit_code == 0 and "(m^2, squared)" in squared.output
     assert _summary_rows(squared.output)[0][3] == pytest.approx(0.04)
     assert (tmp_path / "e.txt").read_text().startswith("# t1 t2 translational_error[m^2]")
@@ -109,8 +117,13 @@ def _run(tmp_path, n: int = 400) -> tuple[Path, RunRecord]:
         truth[k + 1] = compose(truth[k], steps[k])
         odometry[k + 1] = compose(odometry[k], steps[k] * [1.01, 1.0, 1.02])
     record = RunRecord(
-        t=np.arange(n) * 0.1, scans=np.zeros((n, 3), np.float32), odometry=odometry, truth=truth,
-        stalled=np.zeros(n, bool), laser=LASER, metadata={"seed": 0},
+        t=np.arange(n) * 0.1,
+        scans=np.zeros((n, 3), np.float32),
+        odometry=odometry,
+        truth=truth,
+        stalled=np.zeros(n, bool),
+        laser=LASER,
+        metadata={"seed": 0},
     )
     return write_run(tmp_path / "run", record), record
 
@@ -162,7 +175,18 @@ def test_run_folder_with_a_sparse_estimate_uses_the_odometry_between_its_poses(t
 def test_mit_csail_raw_odometry():
     """Both pose triples of this log are the raw odometry (see tests/metric/test_mit_csail.py):
     observed 1.68146 m and 0.0885188 rad mean error over all 1,172 relations."""
-    result = runner.invoke(app, ["evaluate", "-e", str(DATA / "mit-csail.clf"), "-r", str(DATA / "mit-csail.relations"), "--odometry", str(DATA / "mit-csail.clf")])
+    result = runner.invoke(
+        app,
+        [
+            "evaluate",
+            "-e",
+            str(DATA / "mit-csail.clf"),
+            "-r",
+            str(DATA / "mit-csail.relations"),
+            "--odometry",
+            str(DATA / "mit-csail.clf"),
+        ],
+    )
     assert result.exit_code == 0, result.output
     trans, rot = _summary_rows(result.output)
     assert trans[4] == rot[4] == 1172
@@ -179,8 +203,8 @@ def test_run_folder_with_an_estimate_that_covers_nothing(tmp_path):
 
 def test_pose_indices_map_to_file_lines(tmp_path):
     """The readers refuse bad trajectories themselves; this is the backstop for errors the metric finds."""
-    from slamtrials.evaluation import PoseTriple, _read_trajectory, _with_lines
     from slamtrials.errors import FormatError, MetricError
+    from slamtrials.evaluation import PoseTriple, _read_trajectory, _with_lines
 
     tum = tmp_path / "est.tum"
     tum.write_text("# header\n0.0 0 0 0 0 0 0 1\n\n1.0 0 0 0 0 0 0 1\n2.0 0 0 0 0 0 0 1\n")

@@ -38,7 +38,11 @@ def _test_log(path: Path, t, poses, second=None) -> Path:
     second = poses if second is None else second
     with path.open("w") as handle:
         for stamp, p, q in zip(t, poses, second):
-            handle.write("FLASER 0 %.6f %.6f %.6f %.6f %.6f %.6f %.6f nohost %.6f\n" % (*p, *q, stamp, stamp - t[0]))
+            handle.write(
+                "FLASER 0 {:.6f} {:.6f} {:.6f} {:.6f} {:.6f} {:.6f} {:.6f} nohost {:.6f}\n".format(
+                    *p, *q, stamp, stamp - t[0]
+                )
+            )
     return path
 
 
@@ -77,14 +81,18 @@ def _by_hand(t, poses, relations_path: Path, tolerance: float = 0.1) -> tuple[st
 def _synthetic(tmp_path: Path):
     rng = np.random.default_rng(7)
     t = 1134864600.0 + 0.2 * np.arange(40)
-    steps = np.column_stack([0.1 + 0.02 * rng.standard_normal(40), 0.01 * rng.standard_normal(40), 0.05 * rng.standard_normal(40)])
+    steps = np.column_stack(
+        [0.1 + 0.02 * rng.standard_normal(40), 0.01 * rng.standard_normal(40), 0.05 * rng.standard_normal(40)]
+    )
     poses = np.cumsum(steps, axis=0)
     poses = np.round(poses, 6)  # what the %.6f test log holds
     relations = tmp_path / "test.relations"
     with relations.open("w") as handle:
         for i, j in [(0, 1), (3, 9), (10, 30), (5, 6), (12, 39), (20, 21), (0, 39)]:
             truth = poses[j] - poses[i] + 0.03 * rng.standard_normal(3)  # any numbers serve as relations
-            handle.write(f"{t[i]:.5f} {t[j]:.5f} {truth[0]:.5f} {truth[1]:.5f} 0.00000 0.00000 0.00000 {truth[2]:.5f}\n")
+            handle.write(
+                f"{t[i]:.5f} {t[j]:.5f} {truth[0]:.5f} {truth[1]:.5f} 0.00000 0.00000 0.00000 {truth[2]:.5f}\n"
+            )
     return t, poses, relations
 
 
@@ -131,7 +139,10 @@ def test_a_compressed_test_log_cut_short_warns_once_per_oddity(tmp_path, caplog)
     assert _rows(result.output) == _by_hand(t, poses, relations)
     messages = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
     assert sum("ends early" in m for m in messages) == 1, messages
-    assert sum("cut short" in m for m in messages) == 1 and sum("repeat an earlier line's timestamp" in m for m in messages) == 1
+    assert (
+        sum("cut short" in m for m in messages) == 1
+        and sum("repeat an earlier line's timestamp" in m for m in messages) == 1
+    )
 
 
 def test_changing_beam_counts_are_evaluated_from_the_poses(tmp_path):
@@ -141,8 +152,10 @@ def test_changing_beam_counts_are_evaluated_from_the_poses(tmp_path):
     with log.open("w") as handle:
         for k, (stamp, p) in enumerate(zip(t, poses)):
             n, res = (3, 0.5) if k % 2 else (5, 0.25)
-            handle.write(f"ROBOTLASER1 0 -0.5 {res * (n - 1)} {res} 30 0.01 0 {n} {' '.join(['2.0'] * n)} 0 "
-                         f"%.6f %.6f %.6f %.6f %.6f %.6f 0 0 0 0 0 %.6f h 0\n" % (*p, *p, stamp))
+            handle.write(
+                f"ROBOTLASER1 0 -0.5 {res * (n - 1)} {res} 30 0.01 0 {n} {' '.join(['2.0'] * n)} 0 "
+                f"%.6f %.6f %.6f %.6f %.6f %.6f 0 0 0 0 0 %.6f h 0\n" % (*p, *p, stamp)
+            )
     with pytest.raises(Exception, match="angular grid"):
         read_carmen(log)
     result = runner.invoke(app, ["evaluate", "-e", str(log), "-r", str(relations)])
@@ -160,7 +173,10 @@ def test_relations_of_another_log_are_one_line_and_exit_2(tmp_path):
         result = runner.invoke(app, ["evaluate", "-e", str(log), "-r", str(relations)])
         assert result.exit_code == 2
         assert result.output.count("\n") == 1, result.output
-        assert f"{relations}: no relation timestamp (7 relations in [" in result.output and "not of this log" in result.output
+        assert (
+            f"{relations}: no relation timestamp (7 relations in [" in result.output
+            and "not of this log" in result.output
+        )
         assert f"within 0.1 s of a pose: {log} has" in result.output and "Traceback" not in result.output
 
 
@@ -175,7 +191,9 @@ def test_infinite_tolerance_is_the_programs_nearest_pose_whatever_the_gap(tmp_pa
     assert "matched 7 of 7 relations" in result.output
 
 
-@pytest.mark.skipif(not (DATA / "mit-csail.relations").is_file() or not FR079.is_file(), reason="shared data not present")
+@pytest.mark.skipif(
+    not (DATA / "mit-csail.relations").is_file() or not FR079.is_file(), reason="shared data not present"
+)
 def test_relations_of_another_real_log_are_refused(tmp_path):
     result = runner.invoke(app, ["evaluate", "-e", str(FR079), "-r", str(DATA / "mit-csail.relations")])
     assert result.exit_code == 2 and result.output.count("\n") == 1, result.output
@@ -206,8 +224,13 @@ def test_the_cli_shows_each_tolerated_oddity_once(tmp_path):
     lines[8], lines[9] = lines[9], lines[8]
     log.write_text("".join(lines) + lines[-1][:25])  # a last line cut short
     code = "import sys; from slamtrials.cli.main import main; sys.argv[0] = 'slamtrials'; main()"
-    done = subprocess.run([sys.executable, "-c", code, "evaluate", "-e", str(log), "-r", str(relations)],
-                          capture_output=True, text=True, check=False, env={**os.environ, "PYTHONPATH": str(REPO / "src")})
+    done = subprocess.run(
+        [sys.executable, "-c", code, "evaluate", "-e", str(log), "-r", str(relations)],
+        capture_output=True,
+        text=True,
+        check=False,
+        env={**os.environ, "PYTHONPATH": str(REPO / "src")},
+    )
     assert done.returncode == 0, done.stderr
     warnings = [line for line in done.stderr.splitlines() if line.startswith("WARNING")]
     assert len(warnings) == 3, done.stderr

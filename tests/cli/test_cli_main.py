@@ -79,13 +79,28 @@ def test_import_help_shows_the_default_topics():
     assert "[default: /base_scan]" in result.output and "[default: /base_pose_ground_truth]" in result.output
 
 
-@pytest.mark.parametrize(("args", "expected"), [
-    (["export", "RUN", "--to", "xyz", "--out", "x.bag"], "error: --to: 'xyz' is not one of 'bag', 'bag2', 'carmen', 'tum'"),
-    (["export", "RUN", "--to", "tum", "--what", "gps", "--out", "x.tum"], "error: --what: 'gps' is not one of 'truth', 'odometry'"),
-    (["import", "x.bag", "--out", "r", "--format", "csv"], "error: --format: 'csv' is not one of 'auto', 'bag', 'carmen'"),
-    (["export-table", "CAMPAIGN", "--format", "xls"], "error: --format: 'xls' is not one of 'csv', 'parquet'"),
-    (["simulate", "--world", "office_small_01", "--tour", "--seed", "three", "--out", "r"], "error: --seed: Input should be a valid integer"),
-])
+@pytest.mark.parametrize(
+    ("args", "expected"),
+    [
+        (
+            ["export", "RUN", "--to", "xyz", "--out", "x.bag"],
+            "error: --to: 'xyz' is not one of 'bag', 'bag2', 'carmen', 'tum'",
+        ),
+        (
+            ["export", "RUN", "--to", "tum", "--what", "gps", "--out", "x.tum"],
+            "error: --what: 'gps' is not one of 'truth', 'odometry'",
+        ),
+        (
+            ["import", "x.bag", "--out", "r", "--format", "csv"],
+            "error: --format: 'csv' is not one of 'auto', 'bag', 'carmen'",
+        ),
+        (["export-table", "CAMPAIGN", "--format", "xls"], "error: --format: 'xls' is not one of 'csv', 'parquet'"),
+        (
+            ["simulate", "--world", "office_small_01", "--tour", "--seed", "three", "--out", "r"],
+            "error: --seed: Input should be a valid integer",
+        ),
+    ],
+)
 def test_a_bad_option_value_is_one_line_and_exit_2(args, expected):
     result = runner.invoke(app, args)
     assert result.exit_code == 2

@@ -30,9 +30,18 @@ def cli_app():
 def fake_campaign(folder, trial):
     from distributed import Client, LocalCluster
 
-    config = CampaignConfig.from_dict({"worlds": WORLDS, "seed": 11, "slam": {"algorithm": "odometry", "preset": None},
-                                       "runs": {"initial": 8, "max_runs": 8}})
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster, Client(cluster) as client:
+    config = CampaignConfig.from_dict(
+        {
+            "worlds": WORLDS,
+            "seed": 11,
+            "slam": {"algorithm": "odometry", "preset": None},
+            "runs": {"initial": 8, "max_runs": 8},
+        }
+    )
+    with (
+        LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster,
+        Client(cluster) as client,
+    ):
         run_campaign(config, folder, scheduler=client, trial_fn=trial)
     return folder
 
@@ -87,7 +96,9 @@ def test_export_table_command(campaigns, tmp_path, fmt):
     assert result.exit_code == 0, result.output
     table = pd.read_csv(out) if fmt == "csv" else pd.read_parquet(out)
     assert len(table) == 16 and {"world", "run", "seed", "eps_t", "eps_r", "termination"} <= set(table.columns)
-    worlds = runner.invoke(cli_app(), ["export-table", str(a), "--format", fmt, "--table", "worlds", "--out", str(tmp_path / f"w.{fmt}")])
+    worlds = runner.invoke(
+        cli_app(), ["export-table", str(a), "--format", fmt, "--table", "worlds", "--out", str(tmp_path / f"w.{fmt}")]
+    )
     assert worlds.exit_code == 0 and "worlds table" in worlds.output
 
 

@@ -24,7 +24,9 @@ def test_simulate_writes_a_run_that_follows_the_waypoints(tmp_path):
     world_file = _corridor_world(tmp_path)
     (tmp_path / "w.yaml").write_text("waypoints:\n  - [4.0, 1.5]\n  - [8.0, 1.5]\n")
     out = tmp_path / "run"
-    result = runner.invoke(app, ["simulate", "-w", str(world_file), "-p", str(tmp_path / "w.yaml"), "-s", "4", "-o", str(out)])
+    result = runner.invoke(
+        app, ["simulate", "-w", str(world_file), "-p", str(tmp_path / "w.yaml"), "-s", "4", "-o", str(out)]
+    )
     assert result.exit_code == 0, result.output
     record = read_run(out)
     assert (out / "run.png").stat().st_size > 1000
@@ -50,7 +52,9 @@ def test_simulate_refuses_to_overwrite_a_stored_run(tmp_path):
 def test_bad_waypoint_file_is_one_line_with_its_name(tmp_path):
     world_file = _corridor_world(tmp_path)
     (tmp_path / "w.yaml").write_text("waypoints:\n  - [3.0]\n")
-    result = runner.invoke(app, ["simulate", "-w", str(world_file), "-p", str(tmp_path / "w.yaml"), "-o", str(tmp_path / "r")])
+    result = runner.invoke(
+        app, ["simulate", "-w", str(world_file), "-p", str(tmp_path / "w.yaml"), "-o", str(tmp_path / "r")]
+    )
     assert result.exit_code == 2
     assert "w.yaml:2" in result.output and "Traceback" not in result.output
 
@@ -58,9 +62,21 @@ def test_bad_waypoint_file_is_one_line_with_its_name(tmp_path):
 def test_config_file_sets_the_laser(tmp_path):
     world_file = _corridor_world(tmp_path)
     (tmp_path / "w.yaml").write_text("waypoints:\n  - [3.0, 1.5]\n")
-    (tmp_path / "sim.yaml").write_text("laser:\n  fov: 1.3962634\n  angular_resolution: 0.017453293\n  max_range: 20.0\n")
+    (tmp_path / "sim.yaml").write_text(
+        "laser:\n  fov: 1.3962634\n  angular_resolution: 0.017453293\n  max_range: 20.0\n"
+    )
     out = tmp_path / "run"
-    args = ["simulate", "-w", str(world_file), "-p", str(tmp_path / "w.yaml"), "-c", str(tmp_path / "sim.yaml"), "-o", str(out)]
+    args = [
+        "simulate",
+        "-w",
+        str(world_file),
+        "-p",
+        str(tmp_path / "w.yaml"),
+        "-c",
+        str(tmp_path / "sim.yaml"),
+        "-o",
+        str(out),
+    ]
     assert runner.invoke(app, args).exit_code == 0
     record = read_run(out)
     assert record.scans.shape[1] == 81  # 80 degrees at 1 degree, as the paper's industrial-hall laser
@@ -71,7 +87,9 @@ def test_config_file_sets_the_laser(tmp_path):
 def test_bad_config_names_file_and_field(tmp_path):
     world_file = _corridor_world(tmp_path)
     (tmp_path / "sim.yaml").write_text("laser:\n  fov: -1\n")
-    result = runner.invoke(app, ["simulate", "-w", str(world_file), "--tour", "-c", str(tmp_path / "sim.yaml"), "-o", str(tmp_path / "r")])
+    result = runner.invoke(
+        app, ["simulate", "-w", str(world_file), "--tour", "-c", str(tmp_path / "sim.yaml"), "-o", str(tmp_path / "r")]
+    )
     assert result.exit_code == 2
     assert "sim.yaml" in result.output and "laser.fov" in result.output
     assert not (tmp_path / "r").exists()

@@ -39,10 +39,21 @@ def run_folder(tmp_path_factory):
 def test_slam_writes_every_output_and_evaluate_reads_them(run_folder, tmp_path):
     folder, record = run_folder
     out = tmp_path / "out"
-    result = runner.invoke(app, ["slam", "--algorithm", "odometry", "--input", str(folder), "--out", str(out), "--set", "resolution=0.1"])
+    result = runner.invoke(
+        app, ["slam", "--algorithm", "odometry", "--input", str(folder), "--out", str(out), "--set", "resolution=0.1"]
+    )
     assert result.exit_code == 0, result.output
     assert f"{len(record)} frames, {len(record)} updates" in result.output and "ms per frame" in result.output
-    for name in ("trajectory.tum", "trajectory.clf", "trajectory.log", "map.yaml", "map.pgm", "map.png", "timing.csv", "slam.json"):
+    for name in (
+        "trajectory.tum",
+        "trajectory.clf",
+        "trajectory.log",
+        "map.yaml",
+        "map.pgm",
+        "map.png",
+        "timing.csv",
+        "slam.json",
+    ):
         assert (out / name).is_file(), name
     tum = read_tum(out / "trajectory.tum")
     np.testing.assert_allclose(tum.t, record.t, atol=1e-6)
@@ -116,7 +127,9 @@ def test_slam_reads_a_bzip2_log_and_refuses_a_pose_only_one(run_folder, tmp_path
 
 
 def test_bad_input_exits_2(tmp_path):
-    missing = runner.invoke(app, ["slam", "-a", "odometry", "-i", str(tmp_path / "none.clf"), "-o", str(tmp_path / "o")])
+    missing = runner.invoke(
+        app, ["slam", "-a", "odometry", "-i", str(tmp_path / "none.clf"), "-o", str(tmp_path / "o")]
+    )
     assert missing.exit_code == 2 and "none.clf" in missing.output and "Traceback" not in missing.output
     (tmp_path / "bad.clf").write_text("FLASER 3 1.0 2.0\n")
     bad = runner.invoke(app, ["slam", "-a", "odometry", "-i", str(tmp_path / "bad.clf"), "-o", str(tmp_path / "o")])
@@ -124,6 +137,12 @@ def test_bad_input_exits_2(tmp_path):
 
 
 def test_set_values_are_yaml():
-    assert parse_settings(["a=1", "b=0.5", "c=[1, 2, 0]", "d=true", "e=text"]) == {"a": 1, "b": 0.5, "c": [1, 2, 0], "d": True, "e": "text"}
+    assert parse_settings(["a=1", "b=0.5", "c=[1, 2, 0]", "d=true", "e=text"]) == {
+        "a": 1,
+        "b": 0.5,
+        "c": [1, 2, 0],
+        "d": True,
+        "e": "text",
+    }
     with pytest.raises(ConfigError, match="not a YAML value"):
         parse_settings(["a=[1"])

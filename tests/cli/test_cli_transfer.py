@@ -120,7 +120,11 @@ def test_missing_topic_is_one_line_listing_the_topics(tmp_path, run_folder):
     assert _invoke("export", run_folder, "--to", "bag", "--out", bag).exit_code == 0
     result = _invoke("import", bag, "--out", tmp_path / "back", "--scan-topic", "/scan")
     assert result.exit_code == 2
-    assert "run.bag" in result.output and "/scan" in result.output and "/base_scan (sensor_msgs/msg/LaserScan)" in result.output
+    assert (
+        "run.bag" in result.output
+        and "/scan" in result.output
+        and "/base_scan (sensor_msgs/msg/LaserScan)" in result.output
+    )
     assert "Traceback" not in result.output
     assert not (tmp_path / "back").exists()
 
@@ -138,7 +142,12 @@ def test_recording_without_ground_truth(tmp_path, run_folder):
     assert np.isnan(imported.truth).all() and imported.metadata["truth_available"] is False
     result = _invoke("export", tmp_path / "robot", "--to", "tum", "--out", tmp_path / "t.tum")
     assert result.exit_code == 2 and "--what odometry" in result.text
-    assert _invoke("export", tmp_path / "robot", "--to", "tum", "--what", "odometry", "--out", tmp_path / "t.tum").exit_code == 0
+    assert (
+        _invoke(
+            "export", tmp_path / "robot", "--to", "tum", "--what", "odometry", "--out", tmp_path / "t.tum"
+        ).exit_code
+        == 0
+    )
     result = _invoke("export", tmp_path / "robot", "--to", "carmen", "--out", tmp_path / "r.clf")
     assert result.exit_code == 2 and "ground truth" in result.text
 

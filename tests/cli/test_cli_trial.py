@@ -28,7 +28,22 @@ def test_trial_writes_a_complete_run_folder(tmp_path):
     config = tmp_path / "trial.yaml"
     config.write_text("termination:\n  small_period: 60\n  max_time: 600\n")
     out = tmp_path / "run"
-    result = runner.invoke(app, ["trial", "--world", str(plan), "--resolution", "0.05", "--seed", "3", "--config", str(config), "--out", str(out)])
+    result = runner.invoke(
+        app,
+        [
+            "trial",
+            "--world",
+            str(plan),
+            "--resolution",
+            "0.05",
+            "--seed",
+            "3",
+            "--config",
+            str(config),
+            "--out",
+            str(out),
+        ],
+    )
     assert result.exit_code == 0, result.output
     for name in ("frames.npz", "run.json", "estimate.tum", "map.yaml", "map.pgm", "map.png", "run.png"):
         assert (out / name).is_file(), name
@@ -49,13 +64,17 @@ def test_trial_writes_a_complete_run_folder(tmp_path):
 def test_bad_config_is_one_line_and_exit_2(tmp_path):
     bad = tmp_path / "bad.yaml"
     bad.write_text("slam:\n  params:\n    particles: 0\n")
-    result = runner.invoke(app, ["trial", "--world", "office_small_01", "--config", str(bad), "--out", str(tmp_path / "o")])
+    result = runner.invoke(
+        app, ["trial", "--world", "office_small_01", "--config", str(bad), "--out", str(tmp_path / "o")]
+    )
     assert result.exit_code == 2
     assert "bad.yaml" in result.output and "particles" in result.output
     assert len(result.output.strip().splitlines()) == 1
     unknown = tmp_path / "unknown.yaml"
     unknown.write_text("explore:\n  warp_speed: 9\n")
-    result = runner.invoke(app, ["trial", "--world", "office_small_01", "--config", str(unknown), "--out", str(tmp_path / "o")])
+    result = runner.invoke(
+        app, ["trial", "--world", "office_small_01", "--config", str(unknown), "--out", str(tmp_path / "o")]
+    )
     assert result.exit_code == 2 and "warp_speed" in result.output
     result = runner.invoke(app, ["trial", "--world", "no_such_world", "--out", str(tmp_path / "o")])
     assert result.exit_code == 2 and "no_such_world" in result.output

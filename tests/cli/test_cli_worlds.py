@@ -82,16 +82,19 @@ def test_generate_writes_a_rosmap_and_one_summary_line(tmp_path):
     assert loaded.metadata["kind"] == "office" and loaded.metadata["seed"] == 3
 
 
-@pytest.mark.parametrize("args, words", [
-    (["generate", "--kind", "castle", "--area", "300", "--out", "x.yaml"], ["--kind", "castle", "office"]),
-    (["generate", "--kind", "office", "--area", "5", "--out", "x.yaml"], ["--area", "5", "80"]),
-    (["generate", "--kind", "office", "--area", "300", "--seed", "-2", "--out", "x.yaml"], ["--seed"]),
-    (["generate", "--kind", "office", "--area", "300", "--out", "x.txt"], ["--out", ".yaml"]),
-    (["show", "no_such_building", "-o", "x.png"], ["no_such_building"]),
-    (["show", "office_small_01", "-o", "x.bmp3"], ["--out"]),
-    (["info", "no_such_building"], ["no_such_building"]),
-    (["info", "office_small_01", "--resolution", "-1"], ["--resolution"]),
-])
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["generate", "--kind", "castle", "--area", "300", "--out", "x.yaml"], ["--kind", "castle", "office"]),
+        (["generate", "--kind", "office", "--area", "5", "--out", "x.yaml"], ["--area", "5", "80"]),
+        (["generate", "--kind", "office", "--area", "300", "--seed", "-2", "--out", "x.yaml"], ["--seed"]),
+        (["generate", "--kind", "office", "--area", "300", "--out", "x.txt"], ["--out", ".yaml"]),
+        (["show", "no_such_building", "-o", "x.png"], ["no_such_building"]),
+        (["show", "office_small_01", "-o", "x.bmp3"], ["--out"]),
+        (["info", "no_such_building"], ["no_such_building"]),
+        (["info", "office_small_01", "--resolution", "-1"], ["--resolution"]),
+    ],
+)
 def test_bad_input_is_one_line_and_exit_2(args, words, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert_one_line_error(run(*args), *words)

@@ -44,10 +44,12 @@ class HarnessResult:
 
     def line(self) -> str:
         s = self.stats
-        return (f"{self.world:24s} {self.reachable_area:8.0f} m2  {self.reason:14s} sim {self.sim_time:7.0f} s  "
-                f"wall {self.wall_time:6.1f} s  cov {100 * self.coverage:5.1f} %  plans {s['replans']:4d} "
-                f"({s['plan_seconds']:.1f} s)  reached {s['goals_reached']:3d}  black {s['goals_blacklisted']:3d}  "
-                f"recov {s['recoveries']:3d}  resets {s['blacklist_resets']}  bumps {self.collisions}")
+        return (
+            f"{self.world:24s} {self.reachable_area:8.0f} m2  {self.reason:14s} sim {self.sim_time:7.0f} s  "
+            f"wall {self.wall_time:6.1f} s  cov {100 * self.coverage:5.1f} %  plans {s['replans']:4d} "
+            f"({s['plan_seconds']:.1f} s)  reached {s['goals_reached']:3d}  black {s['goals_blacklisted']:3d}  "
+            f"recov {s['recoveries']:3d}  resets {s['blacklist_resets']}  bumps {self.collisions}"
+        )
 
 
 def coverage(world: World, occupancy) -> tuple[float, float]:
@@ -64,8 +66,16 @@ def coverage(world: World, occupancy) -> tuple[float, float]:
     return float(mapped.mean()), float(reach.sum()) * world.resolution**2
 
 
-def run(world: World, *, seed: int = 0, max_time: float = 10800.0, integrate_every: int = 2, map_every: int = 5,
-        explore: ExploreConfig | None = None, termination: TerminationConfig | None = None) -> HarnessResult:
+def run(
+    world: World,
+    *,
+    seed: int = 0,
+    max_time: float = 10800.0,
+    integrate_every: int = 2,
+    map_every: int = 5,
+    explore: ExploreConfig | None = None,
+    termination: TerminationConfig | None = None,
+) -> HarnessResult:
     started = time.perf_counter()
     sim = Simulator(world, SimConfig(), np.random.default_rng(seed))
     laser = sim.laser
@@ -99,15 +109,18 @@ def run(world: World, *, seed: int = 0, max_time: float = 10800.0, integrate_eve
     occupancy = gridmap.occupancy()
     cov, area = coverage(world, occupancy)
     stats = dict(vars(explorer.stats))
-    return HarnessResult(world.name, str(reason), frame.t, time.perf_counter() - started, cov, area, stats, bumps,
-                         explorer, occupancy)
+    return HarnessResult(
+        world.name, str(reason), frame.t, time.perf_counter() - started, cov, area, stats, bumps, explorer, occupancy
+    )
 
 
 def main(argv: list[str]) -> None:
     for source in argv:
         world = load_world(source)
         if world.name in ("map", "world"):
-            world = World(world.occupied, world.resolution, world.origin, source.split("/")[-2], world.start, world.metadata)
+            world = World(
+                world.occupied, world.resolution, world.origin, source.split("/")[-2], world.start, world.metadata
+            )
         result = run(world)
         sys.stdout.write(result.line() + "\n")
         sys.stdout.flush()

@@ -31,8 +31,11 @@ coverage, run = harness.coverage, harness.run
 pytestmark = pytest.mark.slow
 
 
-@pytest.mark.parametrize("make", [lambda: load_world("office_small_01"), lambda: generate_world("house", 90, seed=7)],
-                         ids=["office_small_01", "generated_house"])
+@pytest.mark.parametrize(
+    "make",
+    [lambda: load_world("office_small_01"), lambda: generate_world("house", 90, seed=7)],
+    ids=["office_small_01", "generated_house"],
+)
 def test_explores_a_small_building(make):
     world = make()
     result = run(world, max_time=900.0)

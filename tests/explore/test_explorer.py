@@ -10,8 +10,15 @@ import numpy as np
 from slamtrials.explore import ExploreConfig, Explorer
 from slamtrials.record import LaserGeometry
 
-LASER = LaserGeometry.from_dict({"angle_min": -math.radians(135), "angle_increment": math.radians(0.5), "range_min": 0.0,
-         "range_max": 30.0, "mount": [0.0, 0.0, 0.0]})
+LASER = LaserGeometry.from_dict(
+    {
+        "angle_min": -math.radians(135),
+        "angle_increment": math.radians(0.5),
+        "range_min": 0.0,
+        "range_max": 30.0,
+        "mount": [0.0, 0.0, 0.0],
+    }
+)
 SCAN = np.full(541, 30.0, dtype=np.float32)
 RES = 0.05
 
@@ -30,7 +37,7 @@ def closed_room(n=100):
 def open_room(n=100):
     """The same room, but its right half is still unknown."""
     grid = closed_room(n)
-    grid[:, n // 2:] = -1
+    grid[:, n // 2 :] = -1
     return grid
 
 
@@ -122,7 +129,7 @@ def room_with_door(gap_cells, wall=50):
     grid[0, :70] = grid[-1, :70] = grid[:, 0] = 100
     grid[:, wall] = 100
     top = 50 - gap_cells // 2
-    grid[top:top + gap_cells, wall] = 0
+    grid[top : top + gap_cells, wall] = 0
     return grid
 
 

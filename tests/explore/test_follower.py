@@ -13,8 +13,15 @@ from slamtrials.explore.follower import free_travel, scan_points, turn_rate
 from slamtrials.record import LaserGeometry
 
 ROBOT = RobotLimits()  # the defaults: the paper's robot, which the followers below drive
-LASER = LaserGeometry.from_dict({"angle_min": -math.radians(135), "angle_increment": math.radians(0.5), "range_min": 0.0,
-         "range_max": 30.0, "mount": [0.0, 0.0, 0.0]})
+LASER = LaserGeometry.from_dict(
+    {
+        "angle_min": -math.radians(135),
+        "angle_increment": math.radians(0.5),
+        "range_min": 0.0,
+        "range_max": 30.0,
+        "mount": [0.0, 0.0, 0.0],
+    }
+)
 BEAMS = 541
 
 

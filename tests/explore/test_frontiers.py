@@ -67,8 +67,11 @@ def reference_mask(grid, min_cells, min_unknown_cells):
 
 
 @settings(max_examples=80, deadline=None)
-@given(arrays(np.int8, st.tuples(st.integers(1, 25), st.integers(1, 25)), elements=st.sampled_from([U, F, F, OCC])),
-       st.integers(1, 6), st.integers(0, 15))
+@given(
+    arrays(np.int8, st.tuples(st.integers(1, 25), st.integers(1, 25)), elements=st.sampled_from([U, F, F, OCC])),
+    st.integers(1, 6),
+    st.integers(0, 15),
+)
 def test_kernel_matches_the_reference(grid, min_cells, min_unknown_cells):
     fr = find_frontiers(grid, min_cells=min_cells, min_unknown_cells=min_unknown_cells)
     assert (fr.mask == reference_mask(grid, min_cells, min_unknown_cells)).all()

@@ -8,8 +8,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from slamtrials.explore import ExploreConfig
-from slamtrials.explore import RobotLimits
+from slamtrials.explore import ExploreConfig, RobotLimits
 from slamtrials.explore.costmap import influence_distance
 from slamtrials.explore.goalsearch import GoalSearch
 
@@ -22,10 +21,10 @@ def building(frontier_cols):
     grid = np.zeros((200, 400), dtype=np.int8)
     grid[0, :] = grid[-1, :] = grid[:, 0] = grid[:, -1] = 100
     for c in range(40, 400, 60):
-        grid[90:110, c:c + 8] = 100
+        grid[90:110, c : c + 8] = 100
     grid[0, :] = 100
     for c in frontier_cols:
-        grid[0:3, c:c + 20] = -1
+        grid[0:3, c : c + 20] = -1
     return SimpleNamespace(grid=grid, resolution=RES, origin=np.zeros(3))
 
 
@@ -77,8 +76,9 @@ def test_reached_and_failed_goals_are_skipped():
         lists[kind] = gap
         _, other = search.search(pose, occ, occ.grid, whole, None, current=None, **lists)
         assert 15.0 < other.goal[0] < 16.0
-    search_all = search.search(pose, occ, occ.grid, whole, None, visited=[gap[0], np.array([15.5, 9.8])],
-                               blacklist=[], current=None)
+    search_all = search.search(
+        pose, occ, occ.grid, whole, None, visited=[gap[0], np.array([15.5, 9.8])], blacklist=[], current=None
+    )
     assert search_all == ("none", None)
     assert search.reachable_share > 0.9
 
@@ -91,25 +91,29 @@ def test_the_current_goal_is_kept_unless_clearly_worse():
     whole = search.known_box(occ, occ.grid)
     _, free_choice = search.search(pose, occ, occ.grid, whole, None, visited=[], blacklist=[], current=None)
     assert free_choice.goal[0] < 5.0
-    _, kept = search.search(pose, occ, occ.grid, whole, None, visited=[], blacklist=[],
-                            current=np.array([11.5, 9.8]))
+    _, kept = search.search(pose, occ, occ.grid, whole, None, visited=[], blacklist=[], current=np.array([11.5, 9.8]))
     assert kept.kept and kept.goal[0] > 10.0
 
 
-@pytest.mark.parametrize(("x", "heading", "expect_east"), [
-    (7.5, 0.0, True),       # gaps 4.0 and 4.0 m away (gap 1 a little closer): facing east, the east one
-    (7.5, math.pi, False),  # facing west: the west one, which is also the closest
-    (5.5, 0.0, False),      # 2 m against 6 m: not worth the 3 m that turning round counts for
-])
+@pytest.mark.parametrize(
+    ("x", "heading", "expect_east"),
+    [
+        (7.5, 0.0, True),  # gaps 4.0 and 4.0 m away (gap 1 a little closer): facing east, the east one
+        (7.5, math.pi, False),  # facing west: the west one, which is also the closest
+        (5.5, 0.0, False),  # 2 m against 6 m: not worth the 3 m that turning round counts for
+    ],
+)
 def test_a_goal_ahead_wins_when_turning_round_costs_more_than_it_saves(x, heading, expect_east):
     occ = building([60, 220])  # gaps at x = 3..4 m and 11..12 m in the top wall
     search = GoalSearch(ExploreConfig(turn_penalty=1.0))
     whole = search.known_box(occ, occ.grid)
-    _, found = search.search(np.array([x, 6.0, heading]), occ, occ.grid, whole, None, visited=[], blacklist=[],
-                             current=None)
+    _, found = search.search(
+        np.array([x, 6.0, heading]), occ, occ.grid, whole, None, visited=[], blacklist=[], current=None
+    )
     assert (found.goal[0] > 10.0) == expect_east
     # without the penalty the closest gap wins whatever the heading
     plain = GoalSearch(ExploreConfig(turn_penalty=0.0))
-    _, closest = plain.search(np.array([x, 6.0, heading]), occ, occ.grid, whole, None, visited=[], blacklist=[],
-                              current=None)
+    _, closest = plain.search(
+        np.array([x, 6.0, heading]), occ, occ.grid, whole, None, visited=[], blacklist=[], current=None
+    )
     assert closest.goal[0] < 5.0

@@ -60,8 +60,10 @@ MAZE = """
 def parse(text):
     rows = [line for line in text.strip().splitlines()]
     grid = np.array([[ch != "#" for ch in row] for row in rows])
+
     def find(ch):
         return next((r, c) for r, row in enumerate(rows) for c, x in enumerate(row) if x == ch)
+
     return grid, find("S"), find("G")
 
 
@@ -161,7 +163,7 @@ def test_escape_from_an_inflated_start():
     path = result.path_to(20, 5)
     blocked = costmap.kind[path[:, 0], path[:, 1]] != PASSABLE
     # the blocked cells come first (leaving the inflated zone), then never again
-    assert blocked[0] and not blocked[np.argmin(blocked):].any()
+    assert blocked[0] and not blocked[np.argmin(blocked) :].any()
     assert (path[:, 1] <= 18).all()  # it leaves away from the wall, not through it
     assert path[1, 1] == 17 and path[1, 0] == 20  # straight away from the wall: the cheapest escape
 

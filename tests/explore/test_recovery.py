@@ -11,8 +11,15 @@ from slamtrials.explore import ExploreConfig, RobotLimits
 from slamtrials.explore.recovery import Recovery, StuckMonitor, open_side, segment_clear
 from slamtrials.record import LaserGeometry
 
-LASER = LaserGeometry.from_dict({"angle_min": -math.radians(135), "angle_increment": math.radians(0.5), "range_min": 0.0,
-         "range_max": 30.0, "mount": [0.0, 0.0, 0.0]})
+LASER = LaserGeometry.from_dict(
+    {
+        "angle_min": -math.radians(135),
+        "angle_increment": math.radians(0.5),
+        "range_min": 0.0,
+        "range_max": 30.0,
+        "mount": [0.0, 0.0, 0.0],
+    }
+)
 
 
 def test_not_moving_while_commanded_is_stuck():

@@ -28,7 +28,9 @@ def crosses_blocked(cost, corners):
     """Whether any straight piece between corners passes a blocked cell (sampled finely)."""
     for (r0, c0), (r1, c1) in zip(corners[:-1], corners[1:]):
         for f in np.linspace(0.0, 1.0, 200):
-            if not np.isfinite(cost[int(math.floor(r0 + f * (r1 - r0) + 0.5)), int(math.floor(c0 + f * (c1 - c0) + 0.5))]):
+            if not np.isfinite(
+                cost[int(math.floor(r0 + f * (r1 - r0) + 0.5)), int(math.floor(c0 + f * (c1 - c0) + 0.5))]
+            ):
                 return True
     return False
 
@@ -64,9 +66,16 @@ def test_shortcut_does_not_hug_walls_where_the_costmap_says_keep_off():
     # along every shortcut, the integrated cost is no more than along the grid path it replaced
     index = shortcut_path(cells, costmap.cost)
     for a, b in zip(index[:-1], index[1:]):
-        grid_cost = sum(math.hypot(*(cells[k + 1] - cells[k])) * 0.5 * (costmap.cost[tuple(cells[k])] + costmap.cost[tuple(cells[k + 1])])
-                        for k in range(a, b))
-        assert _segment_cost(costmap.cost.astype(np.float64), cells[a][0], cells[a][1], cells[b][0], cells[b][1]) <= grid_cost + 1e-6
+        grid_cost = sum(
+            math.hypot(*(cells[k + 1] - cells[k]))
+            * 0.5
+            * (costmap.cost[tuple(cells[k])] + costmap.cost[tuple(cells[k + 1])])
+            for k in range(a, b)
+        )
+        assert (
+            _segment_cost(costmap.cost.astype(np.float64), cells[a][0], cells[a][1], cells[b][0], cells[b][1])
+            <= grid_cost + 1e-6
+        )
     # the wall's top is passed with at least the clearance the grid path had there
     top_grid = min(costmap.clearance[tuple(c)] for c in cells if c[0] <= 22 and 38 <= c[1] <= 42)
     dense = resample_polyline(corners.astype(float), 0.25)
@@ -90,7 +99,7 @@ def test_random_rooms_shortcuts_stay_passable_and_shorter(seed):
     cost = np.ones((30, 30), dtype=np.float32)
     for _ in range(6):
         r, c = rng.integers(0, 28, size=2)
-        cost[r:r + rng.integers(1, 4), c:c + rng.integers(1, 12)] = np.inf
+        cost[r : r + rng.integers(1, 4), c : c + rng.integers(1, 12)] = np.inf
     start, goal = (1, 1), (28, 28)
     cost[start] = cost[goal] = 1.0
     cells = plan(cost, start, goal)

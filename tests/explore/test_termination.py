@@ -18,8 +18,9 @@ from slamtrials.explore.termination import (
 
 
 def occupancy(grid, origin=(0.0, 0.0), resolution=0.05):
-    return SimpleNamespace(grid=np.asarray(grid, dtype=np.int8), resolution=resolution,
-                           origin=np.array([origin[0], origin[1], 0.0]))
+    return SimpleNamespace(
+        grid=np.asarray(grid, dtype=np.int8), resolution=resolution, origin=np.array([origin[0], origin[1], 0.0])
+    )
 
 
 def room(n=80, known=80):
@@ -55,8 +56,10 @@ def test_identical_maps_converge_after_two_small_periods():
 
 def test_growing_maps_do_not_converge():
     rule = SnapshotTermination(TerminationConfig(max_snapshots=100))
+
     def grow(t):
         return occupancy(room(known=min(10 + int(t / 10), 200), n=200))
+
     t, reason = run(rule, grow, 1500)
     assert reason is None or t >= 1900
     assert all(mse >= 10 for _, mse in rule.history)
@@ -85,8 +88,10 @@ def test_grown_map_is_aligned_by_its_origin():
     shifted = Snapshot(1.0, map_image(new), res, np.array([-7 * res, -12 * res, 0.0]), 0.0)
     assert snapshot_mse(a, shifted) > 10.0
     rule = SnapshotTermination(TerminationConfig())
+
     def maps(t):
         return occupancy(old) if t < 200 else occupancy(new, origin=(-8 * res, -12 * res))
+
     assert run(rule, maps, 1000) == (240.0, "map_converged")
 
 
@@ -105,6 +110,7 @@ def test_mse_is_summed_over_channels_and_downscaled():
 def test_time_cap_and_snapshot_cap():
     def grow(t):
         return occupancy(room(known=min(10 + int(t / 3), 200), n=200))
+
     assert run(SnapshotTermination(TerminationConfig(max_time=300.0)), grow, 1000) == (300.0, "time_cap")
     t, reason = run(SnapshotTermination(TerminationConfig(max_snapshots=3)), grow, 1000)
     assert (t, reason) == (360.0, "max_snapshots")

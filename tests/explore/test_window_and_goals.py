@@ -6,8 +6,7 @@ import math
 
 import numpy as np
 
-from slamtrials.explore import ExploreConfig, GridFrame, build_costmap
-from slamtrials.explore import RobotLimits
+from slamtrials.explore import ExploreConfig, GridFrame, RobotLimits, build_costmap
 from slamtrials.explore.costmap import influence_distance
 from slamtrials.explore.frontiers import frontier_near
 from slamtrials.explore.goals import GoalRecord, exclude_discs

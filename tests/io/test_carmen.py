@@ -32,12 +32,12 @@ MIT = SHARED / "data" / "mit-csail"
 
 def r3(values) -> np.ndarray:
     """Ranges as the writer prints them (%.3f) and the reader stores them (float32)."""
-    return np.array([float("%.3f" % v) for v in np.ravel(values).tolist()], dtype=np.float32).reshape(np.shape(values))
+    return np.array([float(f"{v:.3f}") for v in np.ravel(values).tolist()], dtype=np.float32).reshape(np.shape(values))
 
 
 def r6(values) -> np.ndarray:
     """Numbers as the writer prints them (%.6f) and reads them back."""
-    return np.array([float("%.6f" % v) for v in np.ravel(values).tolist()]).reshape(np.shape(values))
+    return np.array([float(f"{v:.6f}") for v in np.ravel(values).tolist()]).reshape(np.shape(values))
 
 
 def _log(kind: str = "ROBOTLASER1", n: int = 30, beams: int = 9, seed: int = 0, hostname="b21") -> CarmenLog:
@@ -45,18 +45,36 @@ def _log(kind: str = "ROBOTLASER1", n: int = 30, beams: int = 9, seed: int = 0, 
     t = r6(1134864629.0 + np.cumsum(rng.uniform(0.05, 0.2, n)))
     increment = math.radians(1.0)
     laser = CarmenLaser(
-        kind=kind, t=t, logger_t=r6(t - t[0] + 0.25), hostname=hostname, ranges=r3(rng.uniform(0, 80, (n, beams))),
-        pose=r6(rng.normal(0, 50, (n, 3))), odometry=r6(rng.normal(0, 50, (n, 3))),
-        angle_min=-increment * (beams - 1) / 2 if kind == "FLASER" else -2.1, angle_increment=increment, range_max=80.0,
-        laser_type=4 if kind == "ROBOTLASER1" else 0, accuracy=0.01 if kind == "ROBOTLASER1" else 0.0, remission_mode=0,
+        kind=kind,
+        t=t,
+        logger_t=r6(t - t[0] + 0.25),
+        hostname=hostname,
+        ranges=r3(rng.uniform(0, 80, (n, beams))),
+        pose=r6(rng.normal(0, 50, (n, 3))),
+        odometry=r6(rng.normal(0, 50, (n, 3))),
+        angle_min=-increment * (beams - 1) / 2 if kind == "FLASER" else -2.1,
+        angle_increment=increment,
+        range_max=80.0,
+        laser_type=4 if kind == "ROBOTLASER1" else 0,
+        accuracy=0.01 if kind == "ROBOTLASER1" else 0.0,
+        remission_mode=0,
         extra=r6(rng.normal(size=(n, 5))) if kind == "ROBOTLASER1" else None,
     )
     m = 2 * n
     odom_t = r6(np.sort(rng.uniform(t[0] - 1, t[-1] + 1, m)))
     odom_host = hostname if isinstance(hostname, str) else (hostname * 2)[:m]
-    odom = CarmenOdometry(t=odom_t, logger_t=r6(odom_t - t[0]), hostname=odom_host, pose=r6(rng.normal(0, 50, (m, 3))),
-                          tv=r6(rng.normal(size=m)), rv=r6(rng.normal(size=m)), accel=r6(rng.normal(size=m)))
-    return CarmenLog(laser=laser, odom=odom, params={"robot_use_laser": "on", "robot_frontlaser_offset": "0.12", "note": "two words"})
+    odom = CarmenOdometry(
+        t=odom_t,
+        logger_t=r6(odom_t - t[0]),
+        hostname=odom_host,
+        pose=r6(rng.normal(0, 50, (m, 3))),
+        tv=r6(rng.normal(size=m)),
+        rv=r6(rng.normal(size=m)),
+        accel=r6(rng.normal(size=m)),
+    )
+    return CarmenLog(
+        laser=laser, odom=odom, params={"robot_use_laser": "on", "robot_frontlaser_offset": "0.12", "note": "two words"}
+    )
 
 
 def _assert_same_log(back: CarmenLog, log: CarmenLog, exact_angles: bool = True) -> None:
@@ -69,7 +87,9 @@ def _assert_same_log(back: CarmenLog, log: CarmenLog, exact_angles: bool = True)
     if exact_angles:
         assert (a.angle_min, a.angle_increment, a.range_max) == (b.angle_min, b.angle_increment, b.range_max)
     else:
-        np.testing.assert_allclose([a.angle_min, a.angle_increment, a.range_max], [b.angle_min, b.angle_increment, b.range_max], rtol=1e-15)
+        np.testing.assert_allclose(
+            [a.angle_min, a.angle_increment, a.range_max], [b.angle_min, b.angle_increment, b.range_max], rtol=1e-15
+        )
     for name in ("t", "logger_t", "pose", "tv", "rv", "accel"):
         np.testing.assert_array_equal(getattr(back.odom, name), getattr(log.odom, name), err_msg=name)
     assert back.odom.hostnames() == log.odom.hostnames()
@@ -152,10 +172,20 @@ def _record(n: int = 40, beams: int = 541, seed: int = 1) -> RunRecord:
     rng = np.random.default_rng(seed)
     increment = 1.5 * math.pi / (beams - 1)
     return RunRecord(
-        t=np.arange(n) * 0.1, scans=rng.uniform(0.05, 30, (n, beams)).astype(np.float32),
-        odometry=np.cumsum(rng.normal(0, 0.05, (n, 3)), axis=0), truth=np.cumsum(rng.normal(0, 0.05, (n, 3)), axis=0),
+        t=np.arange(n) * 0.1,
+        scans=rng.uniform(0.05, 30, (n, beams)).astype(np.float32),
+        odometry=np.cumsum(rng.normal(0, 0.05, (n, 3)), axis=0),
+        truth=np.cumsum(rng.normal(0, 0.05, (n, 3)), axis=0),
         stalled=np.zeros(n, dtype=bool),
-        laser=LaserGeometry.from_dict({"angle_min": -0.75 * math.pi, "angle_increment": increment, "range_min": 0.02, "range_max": 30.0, "mount": [0.1, -0.02, 0.01]}),
+        laser=LaserGeometry.from_dict(
+            {
+                "angle_min": -0.75 * math.pi,
+                "angle_increment": increment,
+                "range_min": 0.02,
+                "range_max": 30.0,
+                "mount": [0.1, -0.02, 0.01],
+            }
+        ),
         metadata={"world": "lab"},
     )
 
@@ -172,7 +202,10 @@ def test_run_export_and_import(tmp_path, kind):
     assert not back.stalled.any()
     assert back.laser.mount == (0.1, -0.02, 0.01) and back.laser.range_min == 0.02 and back.laser.range_max == 30.0
     if kind == "ROBOTLASER1":
-        assert (back.laser.angle_min, back.laser.angle_increment) == (record.laser.angle_min, record.laser.angle_increment)
+        assert (back.laser.angle_min, back.laser.angle_increment) == (
+            record.laser.angle_min,
+            record.laser.angle_increment,
+        )
     else:
         assert back.laser.angle_min == pytest.approx(record.laser.angle_min, rel=1e-15)
         assert back.laser.angle_increment == pytest.approx(record.laser.angle_increment, rel=1e-15)
@@ -242,7 +275,12 @@ def test_other_line_types_are_skipped_and_counted(tmp_path):
     [
         ("", -math.pi / 2, math.pi / 4, 7.5),  # CARMEN's default: 180 degrees over the beams; largest range
         ("PARAM laser_front_laser_fov 100 1.0 h 1.0\n", -math.radians(50), math.radians(25), 7.5),
-        ("PARAM laser_front_laser_resolution 1.0\nPARAM robot_front_laser_max 50.0 1.0 h 1.0\n", -math.radians(2), math.radians(1), 50.0),
+        (
+            "PARAM laser_front_laser_resolution 1.0\nPARAM robot_front_laser_max 50.0 1.0 h 1.0\n",
+            -math.radians(2),
+            math.radians(1),
+            50.0,
+        ),
     ],
 )
 def test_flaser_geometry_comes_from_params(tmp_path, params, angle_min, increment, range_max):

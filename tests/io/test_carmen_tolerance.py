@@ -35,8 +35,10 @@ def _flaser(t: float, beams: int = 3, pose=(1.0, 2.0, 0.5), odom=(1.1, 2.1, 0.6)
 def _robot(t: float, ranges: list[float], start: float = -0.5, res: float = 0.25, max_range: float = 30.0) -> str:
     fov = res * (len(ranges) - 1)
     values = " ".join(map(str, ranges))
-    return (f"ROBOTLASER1 0 {start} {fov} {res} {max_range} 0.01 0 {len(ranges)} {values} 0 "
-            f"1 2 0.5 1.1 2.1 0.6 0 0 0 0 0 {t} host 1.0\n")
+    return (
+        f"ROBOTLASER1 0 {start} {fov} {res} {max_range} 0.01 0 {len(ranges)} {values} 0 "
+        f"1 2 0.5 1.1 2.1 0.6 0 0 0 0 0 {t} host 1.0\n"
+    )
 
 
 def _warnings(caplog) -> list[str]:
@@ -48,8 +50,7 @@ def test_param_lines_with_any_trailing_fields(tmp_path):
     path.write_text(
         "PARAM robot_frontlaser_offset 0.0 nohost 0\n"  # as in aces.clf: no ipc timestamp
         "PARAM robot_front_laser_max 80.0 1071078718.46 merci 1071078718.46\n"
-        "PARAM robot_frontlaser_side_offset 0.05 trailing words\n"  # a numeric PARAM is its first token
-        + _flaser(1.0)
+        "PARAM robot_frontlaser_side_offset 0.05 trailing words\n" + _flaser(1.0)  # a numeric PARAM is its first token
     )
     log = read_carmen(path)
     assert log.params["robot_frontlaser_offset"] == "0.0" and log.params["robot_front_laser_max"] == "80.0"
@@ -89,7 +90,10 @@ def test_beam_count_change_on_one_grid_is_padded_with_no_returns(tmp_path, caplo
     assert log.tolerated == {"laser_padded": 3, "laser_range_raised": 3}
     messages = _warnings(caplog)
     assert len(messages) == 2
-    assert "3 ROBOTLASER1 lines with fewer readings than the common grid padded" in messages[0] and "(first: line 1)" in messages[0]
+    assert (
+        "3 ROBOTLASER1 lines with fewer readings than the common grid padded" in messages[0]
+        and "(first: line 1)" in messages[0]
+    )
 
 
 def test_beam_count_change_off_the_grid_is_refused_for_scans_but_read_for_poses(tmp_path):
@@ -111,7 +115,9 @@ def test_flaser_beam_count_change_without_a_resolution_param_is_another_grid(tmp
     path.write_text("PARAM laser_front_laser_resolution 45\n" + _flaser(1.0, beams=5) + _flaser(2.0, beams=3))
     laser = read_carmen(path).laser  # centred on the heading, 45 degrees apart: the 3 are the middle of the 5
     np.testing.assert_array_equal(laser.ranges[1], [1.5, 1.5, 1.5, 1.5, 1.5])
-    path.write_text("PARAM laser_front_laser_resolution 45\n" + _flaser(1.0, beams=5, ranges="1 1 1 1 1") + _flaser(2.0, beams=0))
+    path.write_text(
+        "PARAM laser_front_laser_resolution 45\n" + _flaser(1.0, beams=5, ranges="1 1 1 1 1") + _flaser(2.0, beams=0)
+    )
     laser = read_carmen(path).laser  # a line without readings: all no-return
     np.testing.assert_array_equal(laser.ranges[1], [1, 1, 1, 1, 1])
 
@@ -120,9 +126,12 @@ def test_odom_lines_interleaved_with_laser_lines(tmp_path):
     """A frame's odometry is its own laser line's second triple; ODOM lines are kept apart, in time order."""
     path = tmp_path / "log.clf"
     path.write_text(
-        "ODOM 0 0 0 0 0 0 0.95 h 0\n" + _flaser(1.0, odom=(1, 0, 0)) + "ODOM 1.2 0 0 0 0 0 1.05 h 0\n"
+        "ODOM 0 0 0 0 0 0 0.95 h 0\n"
+        + _flaser(1.0, odom=(1, 0, 0))
+        + "ODOM 1.2 0 0 0 0 0 1.05 h 0\n"
         + "ODOM 1.4 0 0 0 0 0 1.02 h 0\n"  # earlier than the ODOM line before it
-        + _flaser(1.1, odom=(2, 0, 0)) + "ODOM 2 0 0 nan 0 0 1.15 h 0\n"
+        + _flaser(1.1, odom=(2, 0, 0))
+        + "ODOM 2 0 0 nan 0 0 1.15 h 0\n"
     )
     log = read_carmen(path)
     np.testing.assert_array_equal(log.laser.odometry[:, 0], [1, 2])
@@ -133,8 +142,13 @@ def test_odom_lines_interleaved_with_laser_lines(tmp_path):
 
 def test_non_finite_poses_are_skipped_and_counted_once(tmp_path, caplog):
     path = tmp_path / "log.clf"
-    path.write_text(_flaser(1.0) + _flaser(2.0, pose=("nan", 2, 0)) + _flaser(3.0, odom=(1, "inf", 0))
-                    + _flaser(4.0) + "FLASER 0 1 2 0 1 2 0 nan host 1\n")
+    path.write_text(
+        _flaser(1.0)
+        + _flaser(2.0, pose=("nan", 2, 0))
+        + _flaser(3.0, odom=(1, "inf", 0))
+        + _flaser(4.0)
+        + "FLASER 0 1 2 0 1 2 0 nan host 1\n"
+    )
     log = read_carmen(path)
     assert log.laser.t.tolist() == [1.0, 4.0] and log.tolerated == {"laser_nonfinite": 3}
     messages = _warnings(caplog)
@@ -143,8 +157,13 @@ def test_non_finite_poses_are_skipped_and_counted_once(tmp_path, caplog):
 
 def test_backwards_timestamps_are_ordered_stably_and_repeats_dropped(tmp_path, caplog):
     path = tmp_path / "log.clf"
-    path.write_text(_flaser(1.0, pose=(1, 0, 0)) + _flaser(3.0, pose=(3, 0, 0)) + _flaser(2.0, pose=(2, 0, 0))
-                    + _flaser(3.0, pose=(33, 0, 0)) + _flaser(4.0, pose=(4, 0, 0)))
+    path.write_text(
+        _flaser(1.0, pose=(1, 0, 0))
+        + _flaser(3.0, pose=(3, 0, 0))
+        + _flaser(2.0, pose=(2, 0, 0))
+        + _flaser(3.0, pose=(33, 0, 0))
+        + _flaser(4.0, pose=(4, 0, 0))
+    )
     log = read_carmen(path)
     assert log.laser.t.tolist() == [1.0, 2.0, 3.0, 4.0]
     assert log.laser.pose[:, 0].tolist() == [1, 2, 3, 4]  # of the two lines at t = 3, the first in the file
@@ -248,7 +267,9 @@ def test_a_trajectory_written_as_a_freiburg_test_log_reads_back(tmp_path):
     poses = np.column_stack([np.arange(6) * 0.5, np.sin(np.arange(6)), 0.1 * np.arange(6)])
     path = write_carmen(tmp_path / "test.log", carmen_from_trajectory(Trajectory(t=t, poses=poses)))
     lines = [line for line in path.read_text().splitlines() if not line.startswith("#")]
-    assert len(lines) == 6 and lines[1].startswith("FLASER 0 0.500000 0.841471 0.100000 0.500000 0.841471 0.100000 1134864600.250000 ")
+    assert len(lines) == 6 and lines[1].startswith(
+        "FLASER 0 0.500000 0.841471 0.100000 0.500000 0.841471 0.100000 1134864600.250000 "
+    )
     log = read_carmen(path)
     assert log.laser.pose_only and log.params == {} and log.tolerated == {}
     np.testing.assert_allclose(log.laser.odometry, poses, atol=5e-7)

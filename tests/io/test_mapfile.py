@@ -35,9 +35,13 @@ def _slam_grid(seed: int = 0) -> np.ndarray:
 
 def test_map_saver_thresholds():
     percent = np.array([[-1, 0, 25, 26, 64, 65, 100, -128]], dtype=np.int8)
-    np.testing.assert_array_equal(trinary(percent), [[UNKNOWN, FREE, FREE, UNKNOWN, UNKNOWN, OCCUPIED, OCCUPIED, UNKNOWN]])
+    np.testing.assert_array_equal(
+        trinary(percent), [[UNKNOWN, FREE, FREE, UNKNOWN, UNKNOWN, OCCUPIED, OCCUPIED, UNKNOWN]]
+    )
     probability = np.array([[np.nan, 0.0, 0.25, 0.2500001, 0.6499, 0.65, 1.0, -0.5]])
-    np.testing.assert_array_equal(trinary(probability), [[UNKNOWN, FREE, FREE, UNKNOWN, UNKNOWN, OCCUPIED, OCCUPIED, UNKNOWN]])
+    np.testing.assert_array_equal(
+        trinary(probability), [[UNKNOWN, FREE, FREE, UNKNOWN, UNKNOWN, OCCUPIED, OCCUPIED, UNKNOWN]]
+    )
     np.testing.assert_array_equal(trinary(np.array([[True, False]])), [[OCCUPIED, FREE]])
     with pytest.raises(ValueError, match="2-D"):
         trinary(np.zeros(3))
@@ -47,8 +51,15 @@ def test_yaml_and_pgm_are_those_of_map_saver(tmp_path):
     grid = _slam_grid()
     path = write_map(tmp_path / "map.yaml", grid, 0.05, [-1.5, 2.25, 0.0])
     doc = yaml.safe_load(path.read_text())
-    assert doc == {"image": "map.pgm", "resolution": 0.05, "origin": [-1.5, 2.25, 0.0], "negate": 0,
-                   "occupied_thresh": 0.65, "free_thresh": 0.196, "mode": "trinary"}
+    assert doc == {
+        "image": "map.pgm",
+        "resolution": 0.05,
+        "origin": [-1.5, 2.25, 0.0],
+        "negate": 0,
+        "occupied_thresh": 0.65,
+        "free_thresh": 0.196,
+        "mode": "trinary",
+    }
     data = (tmp_path / "map.pgm").read_bytes()
     assert data.startswith(b"P5\n# CREATOR: slamtrials 0.050 m/pix\n60 40\n255\n")
     pixels = np.asarray(Image.open(tmp_path / "map.pgm"))

@@ -58,14 +58,23 @@ def test_round_trip_property(tmp_path, rows):
 
 
 def _matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
-    cr, sr, cp, sp, cy, sy = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch), math.cos(yaw), math.sin(yaw)
+    cr, sr, cp, sp, cy, sy = (
+        math.cos(roll),
+        math.sin(roll),
+        math.cos(pitch),
+        math.sin(pitch),
+        math.cos(yaw),
+        math.sin(yaw),
+    )
     rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
     ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
     rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
     return rz @ ry @ rx
 
 
-@pytest.mark.parametrize(("roll", "pitch", "yaw"), [(0.2, 0.1, 1.0), (-0.5, 0.4, -2.9), (1.0, 2.0, 0.3), (0.0, -2.5, 3.0), (3.0, 0.0, 4.0)])
+@pytest.mark.parametrize(
+    ("roll", "pitch", "yaw"), [(0.2, 0.1, 1.0), (-0.5, 0.4, -2.9), (1.0, 2.0, 0.3), (0.0, -2.5, 3.0), (3.0, 0.0, 4.0)]
+)
 def test_three_d_relations_are_projected_to_the_heading_of_the_x_axis(tmp_path, roll, pitch, yaw):
     (tmp_path / "r.relations").write_text(f"1 2 0.5 -0.25 3.0 {roll} {pitch} {yaw}\n")
     back = read_relations(tmp_path / "r.relations")
@@ -75,7 +84,9 @@ def test_three_d_relations_are_projected_to_the_heading_of_the_x_axis(tmp_path, 
 
 
 def test_planar_yaw_is_taken_as_written(tmp_path):
-    (tmp_path / "r.relations").write_text("# t1 t2 x y z roll pitch yaw\n\n1 2 0 0 0 0 0 4.0\n3 1 0 0 0.0 -0.0 0 -7.5\n")
+    (tmp_path / "r.relations").write_text(
+        "# t1 t2 x y z roll pitch yaw\n\n1 2 0 0 0 0 0 4.0\n3 1 0 0 0.0 -0.0 0 -7.5\n"
+    )
     back = read_relations(tmp_path / "r.relations")
     assert back.delta[:, 2].tolist() == [4.0, -7.5] and back.t1.tolist() == [1.0, 3.0]
 
@@ -103,4 +114,6 @@ def test_malformed_files_name_file_and_line(tmp_path, text, line, message):
 
 def test_writer_refuses_non_finite_values(tmp_path):
     with pytest.raises(ValueError, match="non-finite"):
-        write_relations(tmp_path / "r", Relations(t1=np.array([1.0]), t2=np.array([2.0]), delta=np.array([[0, np.inf, 0]])))
+        write_relations(
+            tmp_path / "r", Relations(t1=np.array([1.0]), t2=np.array([2.0]), delta=np.array([[0, np.inf, 0]]))
+        )

@@ -35,8 +35,15 @@ def _simulated() -> RunRecord:
 def small_run() -> RunRecord:
     """A fresh copy of a short simulated run that turns (yaw crosses quadrants) with an off-centre laser."""
     run = _simulated()
-    return RunRecord(t=run.t.copy(), scans=run.scans.copy(), odometry=run.odometry.copy(), truth=run.truth.copy(),
-                     stalled=run.stalled.copy(), laser=run.laser, metadata=dict(run.metadata))
+    return RunRecord(
+        t=run.t.copy(),
+        scans=run.scans.copy(),
+        odometry=run.odometry.copy(),
+        truth=run.truth.copy(),
+        stalled=run.stalled.copy(),
+        laser=run.laser,
+        metadata=dict(run.metadata),
+    )
 
 
 def wrapped(angle):
@@ -169,7 +176,9 @@ json.dump({"topics": topics, "latching": latching, "messages": messages}, sys.st
 
 def _ros1_python() -> bool:
     try:
-        return subprocess.run(["/usr/bin/python3", "-c", "import rosbag"], capture_output=True, timeout=60).returncode == 0
+        return (
+            subprocess.run(["/usr/bin/python3", "-c", "import rosbag"], capture_output=True, timeout=60).returncode == 0
+        )
     except (OSError, subprocess.TimeoutExpired):
         return False
 
@@ -182,13 +191,17 @@ def _yaw(q: dict) -> float:
     return float(np.arctan2(2 * (q["w"] * q["z"] + q["x"] * q["y"]), 1 - 2 * (q["y"] ** 2 + q["z"] ** 2)))
 
 
-@pytest.mark.skipif(not _ros1_python(), reason="ROS 1's rosbag is not importable by /usr/bin/python3 (apt-get install python3-rosbag)")
+@pytest.mark.skipif(
+    not _ros1_python(), reason="ROS 1's rosbag is not importable by /usr/bin/python3 (apt-get install python3-rosbag)"
+)
 def test_ros1_reader_sees_the_stage_layout(tmp_path):
     record = small_run()
     record.stalled[3] = True
     origin = 1_000_000_000
     bag = write_rosbag1(tmp_path / "run.bag", record)
-    result = subprocess.run(["/usr/bin/python3", "-c", DUMP_SCRIPT, str(bag)], capture_output=True, text=True, timeout=300)
+    result = subprocess.run(
+        ["/usr/bin/python3", "-c", DUMP_SCRIPT, str(bag)], capture_output=True, text=True, timeout=300
+    )
     assert result.returncode == 0, result.stderr
     dump = json.loads(result.stdout)
     n = len(record)
@@ -230,7 +243,11 @@ def test_ros1_reader_sees_the_stage_layout(tmp_path):
             assert msg["header"]["seq"] == k and _stamp(msg["header"]) == stamps[k] == m["time"]
             assert msg["header"]["frame_id"] == frame and msg["child_frame_id"] == "base_link"
             pose = msg["pose"]["pose"]
-            assert (pose["position"]["x"], pose["position"]["y"], pose["position"]["z"]) == (poses[k, 0], poses[k, 1], 0.0)
+            assert (pose["position"]["x"], pose["position"]["y"], pose["position"]["z"]) == (
+                poses[k, 0],
+                poses[k, 1],
+                0.0,
+            )
             q = pose["orientation"]
             assert q["x"] == 0.0 and q["y"] == 0.0 and abs(q["z"] ** 2 + q["w"] ** 2 - 1) < 1e-15
             assert abs(wrapped(_yaw(q) - poses[k, 2])) < 1e-12
@@ -253,17 +270,25 @@ def test_ros1_reader_sees_the_stage_layout(tmp_path):
         assert (translation["x"], translation["y"]) == (record.odometry[k, 0], record.odometry[k, 1])
         assert abs(wrapped(_yaw(odom_tf["transform"]["rotation"]) - record.odometry[k, 2])) < 1e-12
         mount = laser_tf["transform"]
-        assert (mount["translation"]["x"], mount["translation"]["y"], mount["translation"]["z"]) == (MOUNT[0], MOUNT[1], 0.0)
+        assert (mount["translation"]["x"], mount["translation"]["y"], mount["translation"]["z"]) == (
+            MOUNT[0],
+            MOUNT[1],
+            0.0,
+        )
         assert abs(_yaw(mount["rotation"]) - MOUNT[2]) < 1e-15
 
     assert [m["msg"]["data"] for m in by_topic["/stall"]] == record.stalled.astype(int).tolist()
 
 
-@pytest.mark.skipif(not _ros1_python(), reason="ROS 1's rosbag is not importable by /usr/bin/python3 (apt-get install python3-rosbag)")
+@pytest.mark.skipif(
+    not _ros1_python(), reason="ROS 1's rosbag is not importable by /usr/bin/python3 (apt-get install python3-rosbag)"
+)
 def test_ros1_reader_reads_lz4_bags(tmp_path):
     record = small_run()
     bag = write_rosbag1(tmp_path / "run.bag", record, compress=True)
-    result = subprocess.run(["/usr/bin/python3", "-c", DUMP_SCRIPT, str(bag)], capture_output=True, text=True, timeout=300)
+    result = subprocess.run(
+        ["/usr/bin/python3", "-c", DUMP_SCRIPT, str(bag)], capture_output=True, text=True, timeout=300
+    )
     assert result.returncode == 0, result.stderr
     scans = [m["msg"]["ranges"] for m in json.loads(result.stdout)["messages"] if m["topic"] == "/base_scan"]
     np.testing.assert_array_equal(np.array(scans, dtype=np.float32), record.scans)
@@ -307,26 +332,38 @@ with rosbag.Bag(sys.argv[1], "w") as bag:
 """
 
 
-@pytest.mark.skipif(not _ros1_python(), reason="ROS 1's rosbag is not importable by /usr/bin/python3 (apt-get install python3-rosbag)")
+@pytest.mark.skipif(
+    not _ros1_python(), reason="ROS 1's rosbag is not importable by /usr/bin/python3 (apt-get install python3-rosbag)"
+)
 @pytest.mark.parametrize("use_tf", [False, True])
 def test_bag_written_by_ros1_itself_is_imported(tmp_path, use_tf):
     from slamtrials.io.ros_messages import typestore
 
     store = typestore(1)
-    definitions = {name.replace("/msg/", "/"): store.generate_msgdef(name)[0]
-                   for name in ("sensor_msgs/msg/LaserScan", "nav_msgs/msg/Odometry", "tf2_msgs/msg/TFMessage")}
+    definitions = {
+        name.replace("/msg/", "/"): store.generate_msgdef(name)[0]
+        for name in ("sensor_msgs/msg/LaserScan", "nav_msgs/msg/Odometry", "tf2_msgs/msg/TFMessage")
+    }
     bag = tmp_path / "robot.bag"
-    result = subprocess.run(["/usr/bin/python3", "-c", WRITE_SCRIPT, str(bag)], input=json.dumps(definitions),
-                            capture_output=True, text=True, timeout=300)
+    result = subprocess.run(
+        ["/usr/bin/python3", "-c", WRITE_SCRIPT, str(bag)],
+        input=json.dumps(definitions),
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert result.returncode == 0, result.stderr
     run = run_from_bag(bag, scan_topic="/scan", truth_topic=None, use_tf=use_tf)
     k = 2 + 5 * np.arange(6)
     np.testing.assert_allclose(run.t, 0.1 * np.arange(6), rtol=0, atol=1e-15)
     np.testing.assert_array_equal(run.scans, [[1.0 + 0.25 * kk + 0.125 * i for i in range(5)] for kk in k])
     # each scan lies halfway between two odometry messages
-    np.testing.assert_allclose(run.odometry, np.column_stack([0.05 * (k + 0.5), -0.01 * (k + 0.5), 0.1 * (k + 0.5)]), atol=1e-12)
-    assert run.laser == LaserGeometry(angle_min=-1.0, angle_increment=0.5, range_min=float(np.float32(0.05)),
-                                      range_max=20.0, mount=(0.25, 0.0, 0.0))
+    np.testing.assert_allclose(
+        run.odometry, np.column_stack([0.05 * (k + 0.5), -0.01 * (k + 0.5), 0.1 * (k + 0.5)]), atol=1e-12
+    )
+    assert run.laser == LaserGeometry(
+        angle_min=-1.0, angle_increment=0.5, range_min=float(np.float32(0.05)), range_max=20.0, mount=(0.25, 0.0, 0.0)
+    )
     assert np.isnan(run.truth).all() and run.metadata["ros_bag"]["ros_time_origin_ns"] == 1_600_000_000_050_000_000
 
 
@@ -351,7 +388,11 @@ def _robot_bag(path: Path, *, ros: int, with_mount: bool = True, odom_delay_ns: 
 
     def header(stamp, frame):
         time = T["builtin_interfaces/msg/Time"](sec=int(stamp) // 10**9, nanosec=int(stamp) % 10**9)
-        return T["std_msgs/msg/Header"](seq=0, stamp=time, frame_id=frame) if ros == 1 else T["std_msgs/msg/Header"](stamp=time, frame_id=frame)
+        return (
+            T["std_msgs/msg/Header"](seq=0, stamp=time, frame_id=frame)
+            if ros == 1
+            else T["std_msgs/msg/Header"](stamp=time, frame_id=frame)
+        )
 
     def quat(yaw):
         x, y, z, w = yaw_quaternions(yaw)
@@ -359,23 +400,63 @@ def _robot_bag(path: Path, *, ros: int, with_mount: bool = True, odom_delay_ns: 
 
     messages = []
     for k, stamp in enumerate(scan_stamps):
-        messages.append(("/scan", "sensor_msgs/msg/LaserScan", int(stamp), T["sensor_msgs/msg/LaserScan"](
-            header=header(stamp, "laser"), angle_min=-1.5, angle_max=1.5, angle_increment=3.0 / 180, time_increment=0.0,
-            scan_time=0.1, range_min=0.1, range_max=10.0, ranges=ranges[k], intensities=np.zeros(0, np.float32))))
+        messages.append(
+            (
+                "/scan",
+                "sensor_msgs/msg/LaserScan",
+                int(stamp),
+                T["sensor_msgs/msg/LaserScan"](
+                    header=header(stamp, "laser"),
+                    angle_min=-1.5,
+                    angle_max=1.5,
+                    angle_increment=3.0 / 180,
+                    time_increment=0.0,
+                    scan_time=0.1,
+                    range_min=0.1,
+                    range_max=10.0,
+                    ranges=ranges[k],
+                    intensities=np.zeros(0, np.float32),
+                ),
+            )
+        )
     zero36 = np.zeros(36)
     for k, stamp in enumerate(odom_stamps):
         Vector3 = T["geometry_msgs/msg/Vector3"]
-        messages.append(("/odom", "nav_msgs/msg/Odometry", int(stamp), T["nav_msgs/msg/Odometry"](
-            header=header(stamp, "odom"), child_frame_id="base_footprint",
-            pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=T["geometry_msgs/msg/Pose"](
-                position=T["geometry_msgs/msg/Point"](x=odom[k, 0], y=odom[k, 1], z=0.0), orientation=quat(odom[k, 2])), covariance=zero36),
-            twist=T["geometry_msgs/msg/TwistWithCovariance"](twist=T["geometry_msgs/msg/Twist"](
-                linear=Vector3(x=0.0, y=0.0, z=0.0), angular=Vector3(x=0.0, y=0.0, z=0.0)), covariance=zero36))))
+        messages.append(
+            (
+                "/odom",
+                "nav_msgs/msg/Odometry",
+                int(stamp),
+                T["nav_msgs/msg/Odometry"](
+                    header=header(stamp, "odom"),
+                    child_frame_id="base_footprint",
+                    pose=T["geometry_msgs/msg/PoseWithCovariance"](
+                        pose=T["geometry_msgs/msg/Pose"](
+                            position=T["geometry_msgs/msg/Point"](x=odom[k, 0], y=odom[k, 1], z=0.0),
+                            orientation=quat(odom[k, 2]),
+                        ),
+                        covariance=zero36,
+                    ),
+                    twist=T["geometry_msgs/msg/TwistWithCovariance"](
+                        twist=T["geometry_msgs/msg/Twist"](
+                            linear=Vector3(x=0.0, y=0.0, z=0.0), angular=Vector3(x=0.0, y=0.0, z=0.0)
+                        ),
+                        covariance=zero36,
+                    ),
+                ),
+            )
+        )
     if with_mount:
-        transform = T["geometry_msgs/msg/TransformStamped"](header=header(start, "base_link"), child_frame_id="laser",
-                                                            transform=T["geometry_msgs/msg/Transform"](
-                                                                translation=T["geometry_msgs/msg/Vector3"](x=0.2, y=0.0, z=0.3), rotation=quat(np.pi)))
-        messages.append(("/tf_static", "tf2_msgs/msg/TFMessage", start, T["tf2_msgs/msg/TFMessage"](transforms=[transform])))
+        transform = T["geometry_msgs/msg/TransformStamped"](
+            header=header(start, "base_link"),
+            child_frame_id="laser",
+            transform=T["geometry_msgs/msg/Transform"](
+                translation=T["geometry_msgs/msg/Vector3"](x=0.2, y=0.0, z=0.3), rotation=quat(np.pi)
+            ),
+        )
+        messages.append(
+            ("/tf_static", "tf2_msgs/msg/TFMessage", start, T["tf2_msgs/msg/TFMessage"](transforms=[transform]))
+        )
     messages.sort(key=lambda m: m[2])
     serialize = store.serialize_ros1 if ros == 1 else store.serialize_cdr
     writer = Writer1(path) if ros == 1 else Writer2(path, version=9, storage_plugin=StoragePlugin.MCAP)
@@ -447,7 +528,10 @@ def test_missing_truth_says_how_to_read_without_it(tmp_path):
 @pytest.mark.parametrize("kind", ["ros1", "ros2"])
 def test_wrong_message_type_names_topic_and_types(tmp_path, kind):
     bag = _write(kind, tmp_path, small_run())
-    with pytest.raises(FormatError, match=r"topic /odom \(laser scans\) has type nav_msgs/msg/Odometry, expected sensor_msgs/msg/LaserScan"):
+    with pytest.raises(
+        FormatError,
+        match=r"topic /odom \(laser scans\) has type nav_msgs/msg/Odometry, expected sensor_msgs/msg/LaserScan",
+    ):
         run_from_bag(bag, scan_topic="/odom")
     with pytest.raises(FormatError, match="topic /base_scan .*expected nav_msgs/msg/Odometry"):
         run_from_bag(bag, truth_topic="/base_scan")
@@ -481,6 +565,8 @@ def test_ros1_type_with_another_definition_is_refused(tmp_path):
     definition = "std_msgs/Header header\nfloat32[] ranges\n"
     bag = tmp_path / "odd.bag"
     with Writer(bag) as writer:
-        writer.add_connection("/base_scan", "sensor_msgs/msg/LaserScan", msgdef=definition, md5sum="0123456789abcdef0123456789abcdef")
+        writer.add_connection(
+            "/base_scan", "sensor_msgs/msg/LaserScan", msgdef=definition, md5sum="0123456789abcdef0123456789abcdef"
+        )
     with pytest.raises(FormatError, match="/base_scan.*md5 0123456789abcdef"):
         run_from_bag(bag)

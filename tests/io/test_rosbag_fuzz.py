@@ -34,7 +34,9 @@ def _record() -> RunRecord:
         odometry=np.cumsum(rng.normal(0, 0.1, (n, 3)), axis=0),
         truth=np.cumsum(rng.normal(0, 0.1, (n, 3)), axis=0),
         stalled=rng.random(n) < 0.3,
-        laser=LaserGeometry.from_dict({"angle_min": -1.0, "angle_increment": 0.1, "range_min": 0.0, "range_max": 30.0, "mount": [0.1, 0.0, 0.2]}),
+        laser=LaserGeometry.from_dict(
+            {"angle_min": -1.0, "angle_increment": 0.1, "range_min": 0.0, "range_max": 30.0, "mount": [0.1, 0.0, 0.2]}
+        ),
         metadata={"seed": 7, "sim_config": {"dt": 0.1}},
     )
 
@@ -125,10 +127,15 @@ def test_garbled_bags_raise_format_error(kind, edits):
 
 
 @FUZZ
-@given(kind=st.sampled_from(["bag", "bag-lz4", "mcap", "mcap-zstd"]), start=st.integers(0, 2**31), length=st.integers(1, 64), seed=st.integers(0, 2**32 - 1))
+@given(
+    kind=st.sampled_from(["bag", "bag-lz4", "mcap", "mcap-zstd"]),
+    start=st.integers(0, 2**31),
+    length=st.integers(1, 64),
+    seed=st.integers(0, 2**32 - 1),
+)
 def test_garbled_runs_of_bytes_raise_format_error(kind, start, length, seed):
     data = bytearray(_source(kind))
     start %= len(data)
     noise = np.random.default_rng(seed).integers(0, 256, length, dtype=np.uint8).tobytes()
-    data[start:start + length] = noise[: len(data) - start]
+    data[start : start + length] = noise[: len(data) - start]
     _check(kind, bytes(data))

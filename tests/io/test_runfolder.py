@@ -9,11 +9,13 @@ import pytest
 
 from slamtrials.errors import FormatError
 from slamtrials.io.runfolder import RUN_FORMAT, RunFolder, read_run, write_run
-
-FRAMES_FILE, RUN_FILE = RunFolder.FRAMES, RunFolder.RUN
 from slamtrials.record import LaserGeometry, RunRecord
 
-LASER = LaserGeometry.from_dict({"angle_min": -2.356, "angle_increment": 0.0087, "range_min": 0.0, "range_max": 30.0, "mount": [0.1, 0.0, 0.0]})
+FRAMES_FILE, RUN_FILE = RunFolder.FRAMES, RunFolder.RUN
+
+LASER = LaserGeometry.from_dict(
+    {"angle_min": -2.356, "angle_increment": 0.0087, "range_min": 0.0, "range_max": 30.0, "mount": [0.1, 0.0, 0.0]}
+)
 
 
 def _record(n: int = 20, beams: int = 11, seed: int = 0) -> RunRecord:

@@ -56,13 +56,53 @@ CHANGING_LOG = (  # ROBOTLASER1 beam counts changing on one grid, ODOM lines bet
     "ROBOTLASER1 0 -0.5 1.25 0.25 30.0 0.01 0 6 1 2 3 4 5 6 0 1.2 2 0.2 1.2 2 0.2 0.1 0 0 0 0 5.2 host 0.3\n"
 )
 TUM_FILE = "# t x y z qx qy qz qw\n1.0 0.5 -0.5 0.0 0.0 0.0 0.3826834323650898 0.9238795325112867\n1.1 0.6 -0.4 0.0 0.0 0.0 0.0 1.0\n"
-RELATIONS_FILE = "1134864645.90321 1134864646.32420 0.31293 0.02935 0.00000  0.00000 0.00000 0.24198\n1 2 0.1 0.2 0 0 0 -0.1\n"
+RELATIONS_FILE = (
+    "1134864645.90321 1134864646.32420 0.31293 0.02935 0.00000  0.00000 0.00000 0.24198\n1 2 0.1 0.2 0 0 0 -0.1\n"
+)
 
 TOKENS = [
-    "nan", "NaN", "inf", "-inf", "Infinity", "1e308", "-1e308", "1e400", "-1e400", "1e-400", "0", "-0", "1", "-1", "4",
-    "361", "0.5", "abc", "1.2.3", "1_000", "0x1F", "+", "-", ".", "e5", "FLASER", "ROBOTLASER1", "ODOM", "PARAM",
-    "RLASER", "#", "b21", "\x00", "\u00e9", "\u2028", "\x0b", "9" * 40, "laser_front_laser_fov", "robot_front_laser_max",
-    "laser_front_laser_resolution", "robot_frontlaser_offset", "slamtrials_laser_range_min",
+    "nan",
+    "NaN",
+    "inf",
+    "-inf",
+    "Infinity",
+    "1e308",
+    "-1e308",
+    "1e400",
+    "-1e400",
+    "1e-400",
+    "0",
+    "-0",
+    "1",
+    "-1",
+    "4",
+    "361",
+    "0.5",
+    "abc",
+    "1.2.3",
+    "1_000",
+    "0x1F",
+    "+",
+    "-",
+    ".",
+    "e5",
+    "FLASER",
+    "ROBOTLASER1",
+    "ODOM",
+    "PARAM",
+    "RLASER",
+    "#",
+    "b21",
+    "\x00",
+    "\u00e9",
+    "\u2028",
+    "\x0b",
+    "9" * 40,
+    "laser_front_laser_fov",
+    "robot_front_laser_max",
+    "laser_front_laser_resolution",
+    "robot_frontlaser_offset",
+    "slamtrials_laser_range_min",
 ]
 token = st.one_of(
     st.sampled_from(TOKENS),
@@ -176,7 +216,9 @@ def test_seed_files_read(folder, name):
 
 
 @pytest.mark.filterwarnings("error")
-@pytest.mark.parametrize(("name", "seed"), [(name, i) for name, (_, _, seeds) in READERS.items() for i in range(len(seeds))])
+@pytest.mark.parametrize(
+    ("name", "seed"), [(name, i) for name, (_, _, seeds) in READERS.items() for i in range(len(seeds))]
+)
 @settings(max_examples=300, deadline=None)
 @given(data=st.data())
 def test_mutated_files_raise_only_format_errors(folder, name, seed, data):
@@ -187,7 +229,10 @@ def test_mutated_files_raise_only_format_errors(folder, name, seed, data):
 @pytest.mark.filterwarnings("error")
 @pytest.mark.parametrize("name", READERS)
 @settings(max_examples=200, deadline=None)
-@given(lines=st.lists(st.lists(token, max_size=14), max_size=6), first=st.sampled_from(["", "FLASER", "ROBOTLASER1", "ODOM", "PARAM", "1.0"]))
+@given(
+    lines=st.lists(st.lists(token, max_size=14), max_size=6),
+    first=st.sampled_from(["", "FLASER", "ROBOTLASER1", "ODOM", "PARAM", "1.0"]),
+)
 def test_random_token_lines_raise_only_format_errors(folder, name, lines, first):
     text = "\n".join(" ".join([first, *tokens]) for tokens in lines)
     _only_format_errors(name, folder / f"tokens-{name}", text.encode("utf-8", errors="surrogatepass"))
@@ -203,7 +248,9 @@ def test_random_bytes_raise_only_format_errors(folder, name, data):
 
 @pytest.mark.filterwarnings("error")
 @pytest.mark.parametrize("name", READERS)
-@pytest.mark.parametrize("value", ["1e308", "-1e308", "1e400", "-1e400", "nan", "-nan", "inf", "1e-320", "4e38", "3.4e38"])
+@pytest.mark.parametrize(
+    "value", ["1e308", "-1e308", "1e400", "-1e400", "nan", "-nan", "inf", "1e-320", "4e38", "3.4e38"]
+)
 def test_extreme_numbers_in_every_field(folder, name, value):
     """Every number of every seed file replaced in turn by an extreme value."""
     for s, seed in enumerate(READERS[name][2]):
@@ -233,7 +280,9 @@ def test_mutated_compressed_logs_raise_only_format_errors(folder, compress, data
     """A compressed log with edited, inserted or cut bytes: a FormatError (line or byte offset), or a sane log."""
     seed = data.draw(st.sampled_from(CARMEN_SEEDS))
     packed = compress(seed.encode())
-    edits = data.draw(st.lists(st.tuples(st.integers(min_value=0, max_value=len(packed) - 1), st.integers(0, 255)), max_size=3))
+    edits = data.draw(
+        st.lists(st.tuples(st.integers(min_value=0, max_value=len(packed) - 1), st.integers(0, 255)), max_size=3)
+    )
     for at, value in edits:
         packed = packed[:at] + bytes([value]) + packed[at + 1 :]
     cut = data.draw(st.integers(min_value=0, max_value=len(packed)))

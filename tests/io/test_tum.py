@@ -91,7 +91,12 @@ def _quaternion(roll: float, pitch: float, yaw: float) -> tuple[float, float, fl
     cr, sr = math.cos(roll / 2), math.sin(roll / 2)
     cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
     cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
-    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
+    return (
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+        cr * cp * cy + sr * sp * sy,
+    )
 
 
 @pytest.mark.parametrize(
@@ -108,7 +113,9 @@ def test_three_d_poses_are_projected_to_the_heading_of_the_x_axis(tmp_path, roll
 
 
 def test_comments_blank_lines_and_tabs_are_allowed(tmp_path):
-    (tmp_path / "c.tum").write_text("# timestamp tx ty tz qx qy qz qw\n\n1 0 0 0 0 0 0 1\r\n  # indented comment\n2\t1 0 0 0 0 1 0\n")
+    (tmp_path / "c.tum").write_text(
+        "# timestamp tx ty tz qx qy qz qw\n\n1 0 0 0 0 0 0 1\r\n  # indented comment\n2\t1 0 0 0 0 1 0\n"
+    )
     back = read_tum(tmp_path / "c.tum")
     assert back.t.tolist() == [1.0, 2.0]
     np.testing.assert_allclose(back.poses, [[0, 0, 0], [1, 0, math.pi]])

@@ -21,8 +21,9 @@ def test_a_factor_and_a_set_without_outliers():
     assert d.threshold == pytest.approx(0.2) and not d.diverged.any() and d.share == 0.0
 
 
-@pytest.mark.parametrize(("values", "factor", "match"), [([], 5.0, "no runs"), ([0.1, np.nan], 5.0, "run 1"),
-                                                         ([0.1, 0.2], 1.0, "above 1")])
+@pytest.mark.parametrize(
+    ("values", "factor", "match"), [([], 5.0, "no runs"), ([0.1, np.nan], 5.0, "run 1"), ([0.1, 0.2], 1.0, "above 1")]
+)
 def test_bad_input_is_refused(values, factor, match):
     with pytest.raises(MetricError, match=match):
         divergence(values, factor)

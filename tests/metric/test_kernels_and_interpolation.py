@@ -23,7 +23,9 @@ def test_nearest_matches_brute_force(times, queries, tolerance):
     for k, q in enumerate(queries):
         distances = np.abs(times - q)
         assert gap[k] == distances.min()
-        assert distances[index[k]] == distances.min()  # (ties between the two neighbours go to the earlier, test_matching)
+        assert (
+            distances[index[k]] == distances.min()
+        )  # (ties between the two neighbours go to the earlier, test_matching)
         assert within[k] == (distances.min() <= tolerance + abs(q) * np.finfo(float).eps)
 
 
@@ -38,7 +40,10 @@ def test_nearest_with_clustered_times_and_large_offsets():
 
 
 @settings(deadline=None)  # the first example may load the numba kernels from cache
-@given(hnp.arrays(np.float64, (20, 3), elements=st.floats(-50, 50)), hnp.arrays(np.float64, (20, 3), elements=st.floats(-50, 50)))
+@given(
+    hnp.arrays(np.float64, (20, 3), elements=st.floats(-50, 50)),
+    hnp.arrays(np.float64, (20, 3), elements=st.floats(-50, 50)),
+)
 def test_relative_poses_match_ominus(a, b):
     rows = np.arange(20)
     got = relative_poses(a, rows, b, rows[::-1])

@@ -69,7 +69,9 @@ def test_odometry_carries_the_nearest_pose_to_the_timestamp():
     est = _trajectory([0.0, 10.0], [[5.0, 5.0, np.pi / 2], [0.0, 0.0, 0.0]])
     odo_t = np.arange(0.0, 10.01, 0.5)
     heading = 0.3  # the odometry frame is rotated and shifted against the estimate's
-    odo_poses = np.column_stack([100.0 + odo_t * np.cos(heading), -7.0 + odo_t * np.sin(heading), np.full_like(odo_t, heading)])
+    odo_poses = np.column_stack(
+        [100.0 + odo_t * np.cos(heading), -7.0 + odo_t * np.sin(heading), np.full_like(odo_t, heading)]
+    )
     odo = Trajectory(t=odo_t, poses=odo_poses)
     found = lookup_poses(est, [2.0, 0.05], odometry=odo)
     assert found.corrected.tolist() == [True, False]

@@ -47,7 +47,10 @@ def trajectories_and_pairs(draw):
     n = draw(st.integers(2, 30))
     steps = draw(hnp.arrays(np.float64, n, elements=st.floats(0.2, 5.0)))
     t = 1e9 + np.cumsum(steps)
-    truth = np.column_stack([draw(hnp.arrays(np.float64, n, elements=coordinate)) for _ in range(2)] + [draw(hnp.arrays(np.float64, n, elements=angle))])
+    truth = np.column_stack(
+        [draw(hnp.arrays(np.float64, n, elements=coordinate)) for _ in range(2)]
+        + [draw(hnp.arrays(np.float64, n, elements=angle))]
+    )
     noise = draw(hnp.arrays(np.float64, (n, 3), elements=st.floats(-1.0, 1.0)))
     k = draw(st.integers(1, 20))
     i = np.array(draw(st.lists(st.integers(0, n - 1), min_size=k, max_size=k)))

@@ -27,7 +27,9 @@ def _drive(n: int, seed: int) -> tuple[Trajectory, Trajectory]:
     """A 10 Hz drive (0.05 m steps, wandering heading) and an odometry-like estimate that drifts from it."""
     rng = np.random.default_rng(seed)
     steps = np.column_stack([np.full(n - 1, 0.05), np.zeros(n - 1), rng.normal(0.0, 0.05, n - 1)])
-    noisy = steps * np.array([1.02, 1.0, 1.0]) + np.column_stack([rng.normal(0, 0.004, n - 1), rng.normal(0, 0.004, n - 1), rng.normal(0.002, 0.004, n - 1)])
+    noisy = steps * np.array([1.02, 1.0, 1.0]) + np.column_stack(
+        [rng.normal(0, 0.004, n - 1), rng.normal(0, 0.004, n - 1), rng.normal(0.002, 0.004, n - 1)]
+    )
     truth = np.zeros((n, 3))
     estimate = np.zeros((n, 3))
     for k in range(n - 1):
@@ -39,7 +41,9 @@ def _drive(n: int, seed: int) -> tuple[Trajectory, Trajectory]:
 
 def _all_pairs_errors(truth: Trajectory, estimate: Trajectory) -> tuple[np.ndarray, np.ndarray]:
     i, j = np.triu_indices(len(truth), k=1)
-    return relative_pose_errors(relative_poses(estimate.poses, i, estimate.poses, j), relative_poses(truth.poses, i, truth.poses, j))
+    return relative_pose_errors(
+        relative_poses(estimate.poses, i, estimate.poses, j), relative_poses(truth.poses, i, truth.poses, j)
+    )
 
 
 def test_sample_size_formula():

@@ -50,12 +50,23 @@ def browser() -> str | None:
     return None
 
 
-pytestmark = pytest.mark.skipif(browser() is None, reason="Chromium is not installed (apt-get install chromium chromium-driver)")
+pytestmark = pytest.mark.skipif(
+    browser() is None, reason="Chromium is not installed (apt-get install chromium chromium-driver)"
+)
 
 
 def run_browser(tmp_path: Path, *args: str) -> subprocess.CompletedProcess:
-    command = [browser(), "--headless", "--disable-gpu", "--hide-scrollbars", "--no-first-run", "--disable-extensions",
-               f"--user-data-dir={tmp_path / 'profile'}", "--virtual-time-budget=15000", *args]
+    command = [
+        browser(),
+        "--headless",
+        "--disable-gpu",
+        "--hide-scrollbars",
+        "--no-first-run",
+        "--disable-extensions",
+        f"--user-data-dir={tmp_path / 'profile'}",
+        "--virtual-time-budget=15000",
+        *args,
+    ]
     if hasattr(os, "geteuid") and os.geteuid() == 0:
         command.insert(2, "--no-sandbox")  # Chromium refuses to run as root with its sandbox
     return subprocess.run(command, capture_output=True, text=True, timeout=180)
@@ -92,9 +103,18 @@ def report(tmp_path_factory) -> Path:
     from distributed import Client, LocalCluster
 
     folder = tmp_path_factory.mktemp("browser") / "campaign"
-    config = CampaignConfig.from_dict({"worlds": WORLDS, "seed": 3, "slam": {"algorithm": "odometry", "preset": None},
-                                       "runs": {"initial": 5, "max_runs": 5}})
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster, Client(cluster) as client:
+    config = CampaignConfig.from_dict(
+        {
+            "worlds": WORLDS,
+            "seed": 3,
+            "slam": {"algorithm": "odometry", "preset": None},
+            "runs": {"initial": 5, "max_runs": 5},
+        }
+    )
+    with (
+        LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster,
+        Client(cluster) as client,
+    ):
         run_campaign(config, folder, scheduler=client, trial_fn=FailingIn("house_small_01"))
     return build_report(folder, repeats=20, pdf=False)
 
@@ -112,7 +132,9 @@ def test_a_broken_image_is_detected(report, tmp_path):
     # the check itself works: one image pointing at a missing file is reported
     original = report.read_text(encoding="utf-8")
     broken = report.with_name("broken.html")
-    broken.write_text(original.replace('src="figures/report_fig5_all_runs.png"', 'src="figures/missing.png"', 1), encoding="utf-8")
+    broken.write_text(
+        original.replace('src="figures/report_fig5_all_runs.png"', 'src="figures/missing.png"', 1), encoding="utf-8"
+    )
     try:
         found = checked_dom(broken, tmp_path, name="broken-check.html")
     finally:

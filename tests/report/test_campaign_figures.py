@@ -46,9 +46,19 @@ def runs() -> pd.DataFrame:
         if world == "school":
             values[3] = 0.9  # a clear outlier
         for k, v in enumerate(values):
-            rows.append({"world": world, "run": 100 + k, "seed": k, "eps_t": v, "eps_r": v / 8, "duration_s": 60.0,
-                         "wall_s": 2.0, "termination": ["map_stable", "timeout", "stuck"][k % 3 if world != "office" else 0],
-                         "mapped": 0.7 + 0.3 * (k % 4) / 3})
+            rows.append(
+                {
+                    "world": world,
+                    "run": 100 + k,
+                    "seed": k,
+                    "eps_t": v,
+                    "eps_r": v / 8,
+                    "duration_s": 60.0,
+                    "wall_s": 2.0,
+                    "termination": ["map_stable", "timeout", "stuck"][k % 3 if world != "office" else 0],
+                    "mapped": 0.7 + 0.3 * (k % 4) / 3,
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -134,7 +144,9 @@ def test_repeated_sampling_means_uses_spawned_seeds() -> None:
         assert means[k] == pytest.approx(sampled.errors.translational.mean())
     assert np.array_equal(means, cf.repeated_sampling_means(truth, estimate, 12, 7, **options))
     from_generator = cf.repeated_sampling_means(truth, estimate, 3, np.random.default_rng(1), **options)
-    assert np.array_equal(from_generator, cf.repeated_sampling_means(truth, estimate, 3, np.random.default_rng(1), **options))
+    assert np.array_equal(
+        from_generator, cf.repeated_sampling_means(truth, estimate, 3, np.random.default_rng(1), **options)
+    )
     rotational = cf.repeated_sampling_means(truth, estimate, 3, 7, component="rotational", **options)
     assert not np.allclose(rotational, means[:3])
     with pytest.raises(ValueError, match="repeats"):
@@ -218,8 +230,12 @@ def test_comparison_forest_plot_and_trap_markers(runs: pd.DataFrame) -> None:
     cf.draw_comparison(ax, comparison, "eps_t")
     drawn = {c.get_label(): c for c in ax.containers}
     assert set(drawn) == {"karto better", "gmapping better", "no significant difference"}
-    assert drawn["karto better"].lines[0].get_xdata() == pytest.approx(rows.loc[rows["world"] == "office", "difference"])
-    assert drawn["gmapping better"].lines[0].get_xdata() == pytest.approx(rows.loc[rows["world"] == "campus", "difference"])
+    assert drawn["karto better"].lines[0].get_xdata() == pytest.approx(
+        rows.loc[rows["world"] == "office", "difference"]
+    )
+    assert drawn["gmapping better"].lines[0].get_xdata() == pytest.approx(
+        rows.loc[rows["world"] == "campus", "difference"]
+    )
     trap = _line(ax, "trap")
     reversed_rows = rows[np.sign(rows["trap_difference"]) == -np.sign(rows["difference"])]
     assert len(trap.get_xdata()) == len(reversed_rows) >= 1

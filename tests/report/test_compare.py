@@ -29,8 +29,17 @@ def _frame(samples: dict[str, list[float]], first_run: int = 0) -> pd.DataFrame:
     rows = []
     for world, values in samples.items():
         for k, v in enumerate(values):
-            rows.append({"world": world, "run": first_run + k, "seed": k, "eps_t": v, "eps_r": v / 10.0,
-                         "termination": "done", "mapped": 1.0})
+            rows.append(
+                {
+                    "world": world,
+                    "run": first_run + k,
+                    "seed": k,
+                    "eps_t": v,
+                    "eps_r": v / 10.0,
+                    "termination": "done",
+                    "mapped": 1.0,
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -112,8 +121,12 @@ def test_reversal_counts_pairs_like_brute_force() -> None:
 def test_compare_campaigns_verdicts_pvalues_and_corrections() -> None:
     rng = np.random.default_rng(11)
     samples_a = {w: list(rng.normal(0.30, 0.02, 15)) for w in ("better", "same", "worse", "only_a")}
-    samples_b = {"better": list(rng.normal(0.20, 0.02, 12)), "same": list(np.array(samples_a["same"][:10]) + 0.001),
-                 "worse": list(rng.normal(0.45, 0.03, 14)), "only_b": [0.1, 0.2]}
+    samples_b = {
+        "better": list(rng.normal(0.20, 0.02, 12)),
+        "same": list(np.array(samples_a["same"][:10]) + 0.001),
+        "worse": list(rng.normal(0.45, 0.03, 14)),
+        "only_b": [0.1, 0.2],
+    }
     a, b = _frame(samples_a), _frame(samples_b)
     c = compare_campaigns(a, b, alpha=0.05, labels=("gmapping", "karto"))
     assert c.only_a == ("only_a",) and c.only_b == ("only_b",)

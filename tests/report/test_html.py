@@ -70,13 +70,25 @@ class Page(HTMLParser):
             self._cell.append(data)
 
 
-def fake_campaign(folder: Path, trial, worlds=WORLDS, *, initial: int = 6, max_runs: int = 8, seed: int = 5, **changes) -> Path:
+def fake_campaign(
+    folder: Path, trial, worlds=WORLDS, *, initial: int = 6, max_runs: int = 8, seed: int = 5, **changes
+) -> Path:
     """A campaign with a stand-in trial, on an in-process Dask cluster (fast)."""
     from distributed import Client, LocalCluster
 
-    config = CampaignConfig.from_dict({"worlds": list(worlds), "seed": seed, "slam": {"algorithm": "odometry", "preset": None},
-                                       "runs": {"initial": initial, "max_runs": max_runs}, **changes})
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster, Client(cluster) as client:
+    config = CampaignConfig.from_dict(
+        {
+            "worlds": list(worlds),
+            "seed": seed,
+            "slam": {"algorithm": "odometry", "preset": None},
+            "runs": {"initial": initial, "max_runs": max_runs},
+            **changes,
+        }
+    )
+    with (
+        LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster,
+        Client(cluster) as client,
+    ):
         run_campaign(config, folder, scheduler=client, trial_fn=trial)
     return folder
 
@@ -127,10 +139,17 @@ def test_report_page_has_table_one_and_every_figure(campaign, report):
     names = {Path(src).name for src in page.images}
     for i, world in enumerate(WORLDS[:2]):
         assert f"report_fig1_{i:03d}_{world}.png" in names and f"report_fig4_{i:03d}_{world}.png" in names
-    assert {"report_fig5_all_runs.png", "report_fig3_sampling.png", "report_termination.png", "report_fig6_trap.png"} <= names
+    assert {
+        "report_fig5_all_runs.png",
+        "report_fig3_sampling.png",
+        "report_termination.png",
+        "report_fig6_trap.png",
+    } <= names
     # the runs table: every run with its seed
     runs = page.tables["runs-table"]
-    assert [(r[0], int(r[1]), int(r[2])) for r in runs] == list(zip(data.runs["world"], data.runs["run"], data.runs["seed"]))
+    assert [(r[0], int(r[1]), int(r[2])) for r in runs] == list(
+        zip(data.runs["world"], data.runs["run"], data.runs["seed"])
+    )
 
 
 def test_report_notes_provenance_and_escaping(campaign, report):
@@ -144,7 +163,9 @@ def test_report_notes_provenance_and_escaping(campaign, report):
     assert f"seed: {data.config['seed']}" in joined  # the config as YAML
     versions = page.tables["versions-table"]
     assert sum(int(r[1]) for r in versions) == len(data.done)
-    assert "Fig. 3" in joined and "run #0 of office_small_01" in joined  # default: first finished run of the first world
+    assert (
+        "Fig. 3" in joined and "run #0 of office_small_01" in joined
+    )  # default: first finished run of the first world
     assert "<script" not in text
 
 
@@ -153,8 +174,11 @@ def test_report_of_a_chosen_run_and_bad_choices(campaign, tmp_path):
     text = page.read_text(encoding="utf-8")
     assert "run #3 of lab_small_01" in text and "over 10 independent samplings" in text
     assert not list((tmp_path / "r" / "figures").glob("*.pdf"))
-    for bad, message in (("lab_small_01/99", "has no run lab_small_01/99"), ("house_small_01/0", "is not finished"),
-                         ("nonsense", "WORLD/INDEX")):
+    for bad, message in (
+        ("lab_small_01/99", "has no run lab_small_01/99"),
+        ("house_small_01/0", "is not finished"),
+        ("nonsense", "WORLD/INDEX"),
+    ):
         with pytest.raises(ConfigError, match=message):
             build_report(campaign, tmp_path / "bad", sampling_run=bad)
     assert not (tmp_path / "bad").exists()
@@ -202,8 +226,12 @@ def two_levels(tmp_path_factory) -> tuple[Path, Path]:
     """The same worlds and seeds, B's translational error 0.15 m lower than A's in every run; rotational equal."""
     root = tmp_path_factory.mktemp("compare")
     worlds = WORLDS[:2]
-    a = fake_campaign(root / "algo_a", FakeTrial(mean_t=0.40, std_t=0.08, mean_r=0.05, std_r=0.01), worlds, initial=10, max_runs=10)
-    b = fake_campaign(root / "algo_b", FakeTrial(mean_t=0.25, std_t=0.08, mean_r=0.05, std_r=0.01), worlds, initial=10, max_runs=10)
+    a = fake_campaign(
+        root / "algo_a", FakeTrial(mean_t=0.40, std_t=0.08, mean_r=0.05, std_r=0.01), worlds, initial=10, max_runs=10
+    )
+    b = fake_campaign(
+        root / "algo_b", FakeTrial(mean_t=0.25, std_t=0.08, mean_r=0.05, std_r=0.01), worlds, initial=10, max_runs=10
+    )
     return a, b
 
 
@@ -228,10 +256,14 @@ def test_compare_report_verdicts_statistics_and_trap(two_levels, tmp_path):
         # the trap: the share of (run of A, run of B) pairs where B's run is the worse one, by brute force
         assert row["trap_fraction"] == pytest.approx(np.mean(y[None, :] > x[:, None]))
     p = table_t["p"].to_numpy()
-    assert table_t["p_adjusted"].to_numpy() == pytest.approx(np.minimum(1, np.maximum.accumulate(np.sort(p) * [2, 1]))[np.argsort(np.argsort(p))])
+    assert table_t["p_adjusted"].to_numpy() == pytest.approx(
+        np.minimum(1, np.maximum.accumulate(np.sort(p) * [2, 1]))[np.argsort(np.argsort(p))]
+    )
     # the page and the table file
     page = Page(result.page.read_text(encoding="utf-8"))
-    assert [r[0] for r in page.tables["comparison-table-eps_t"]] == sorted(WORLDS[:2])  # the comparison sorts worlds by name
+    assert [r[0] for r in page.tables["comparison-table-eps_t"]] == sorted(
+        WORLDS[:2]
+    )  # the comparison sorts worlds by name
     assert all((result.page.parent / src).is_file() for src in page.images) and len(page.images) == 3
     assert "Overall verdict" in " ".join(page.text)
     back = pd.read_csv(result.table_csv)
@@ -265,7 +297,7 @@ def two_rooms(folder: Path, name: str, width_m: float) -> str:
     h_, w_ = int(round(height_m / res)) + 6, int(round(width_m / res)) + 6
     occupied = np.zeros((h_, w_), dtype=bool)
     occupied[:3, :] = occupied[-3:, :] = occupied[:, :3] = occupied[:, -3:] = True
-    occupied[: int(h_ * 0.6), w_ // 2 - 1: w_ // 2 + 2] = True
+    occupied[: int(h_ * 0.6), w_ // 2 - 1 : w_ // 2 + 2] = True
     folder.mkdir(parents=True, exist_ok=True)
     world = World(occupied, res, name=name, start=np.array([1.0, 0.7 * height_m, 0.0]))
     return str(save_rosmap(world, folder / f"{name}.yaml"))
@@ -280,9 +312,18 @@ def real_campaign(tmp_path_factory):
 
     root = tmp_path_factory.mktemp("real")
     worlds = [two_rooms(root / "worlds", "rooms_6m", 6.0), two_rooms(root / "worlds", "rooms_5m", 5.0)]
-    config = CampaignConfig.from_dict({"worlds": worlds, "seed": 2, "termination": {"small_period": 60.0, "max_time": 300.0},
-                                       "runs": {"initial": 3, "max_runs": 3}})
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster, Client(cluster) as client:
+    config = CampaignConfig.from_dict(
+        {
+            "worlds": worlds,
+            "seed": 2,
+            "termination": {"small_period": 60.0, "max_time": 300.0},
+            "runs": {"initial": 3, "max_runs": 3},
+        }
+    )
+    with (
+        LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster,
+        Client(cluster) as client,
+    ):
         run_campaign(config, root / "gmapping", scheduler=client)
         replay_campaign(root / "gmapping", root / "odometry", "odometry", scheduler=client)
     return root / "gmapping", root / "odometry"

@@ -36,9 +36,18 @@ def campaign(tmp_path_factory):
     from distributed import Client, LocalCluster
 
     folder = tmp_path_factory.mktemp("load") / "campaign"
-    config = CampaignConfig.from_dict({"worlds": WORLDS, "seed": 5, "slam": {"algorithm": "odometry", "preset": None},
-                                       "runs": {"initial": 6, "max_runs": 8}})
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster, Client(cluster) as client:
+    config = CampaignConfig.from_dict(
+        {
+            "worlds": WORLDS,
+            "seed": 5,
+            "slam": {"algorithm": "odometry", "preset": None},
+            "runs": {"initial": 6, "max_runs": 8},
+        }
+    )
+    with (
+        LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster,
+        Client(cluster) as client,
+    ):
         run_campaign(config, folder, scheduler=client, trial_fn=FailingIn("house_small_01"))
     return folder
 
@@ -52,11 +61,26 @@ def test_runs_frame_equals_the_catalog(campaign):
         rows = store.runs()
         assert len(runs) == len(rows)
         for (_, got), row in zip(runs.iterrows(), rows, strict=True):
-            assert (got["world"], got["run"], got["seed"], got["status"], got["attempts"]) == (row.world, row.idx, row.seed, row.status, row.attempts)
-            for column, value in (("eps_t", row.eps_t), ("eps_r", row.eps_r), ("mapped", row.mapped_fraction),
-                                  ("duration_s", row.sim_duration), ("wall_s", row.wall_time)):
+            assert (got["world"], got["run"], got["seed"], got["status"], got["attempts"]) == (
+                row.world,
+                row.idx,
+                row.seed,
+                row.status,
+                row.attempts,
+            )
+            for column, value in (
+                ("eps_t", row.eps_t),
+                ("eps_r", row.eps_r),
+                ("mapped", row.mapped_fraction),
+                ("duration_s", row.sim_duration),
+                ("wall_s", row.wall_time),
+            ):
                 assert got[column] == value or (value is None and np.isnan(got[column])), column
-            assert (got["termination"], got["folder"], got["worker"]) == (row.termination, row.folder, row.worker) or row.status != "done"
+            assert (got["termination"], got["folder"], got["worker"]) == (
+                row.termination,
+                row.folder,
+                row.worker,
+            ) or row.status != "done"
             if row.status == "failed":
                 assert "SimulationError" in got["error"]
         assert data.meta["config_hash"] == store.meta("config_hash") and data.kind == "campaign"
@@ -78,7 +102,12 @@ def test_worlds_frame_is_the_catalog_and_table_one(campaign):
     summary = {row.world: row for row in load_summary(campaign)}
     with CampaignStore.open(campaign) as store:
         for (_, got), row in zip(worlds.iterrows(), store.worlds(), strict=True):
-            assert (got["world"], got["status"], got["ref"], bool(got["capped"])) == (row.name, row.status, row.ref, bool(row.capped))
+            assert (got["world"], got["status"], got["ref"], bool(got["capped"])) == (
+                row.name,
+                row.status,
+                row.ref,
+                bool(row.capped),
+            )
             assert (pd.isna(got["runs_needed"]) and row.runs_needed is None) or got["runs_needed"] == row.runs_needed
             expected = summary[row.name]
             assert got["runs_done"] == expected.runs and got["runs_failed"] == expected.failed_runs
@@ -89,7 +118,9 @@ def test_worlds_frame_is_the_catalog_and_table_one(campaign):
                 assert got[f"{metric}_mean"] == pytest.approx(stats.mean, rel=1e-12)
                 assert got[f"{metric}_std"] == pytest.approx(stats.std_sample, rel=1e-12)
                 assert got[f"{metric}_std_population"] == pytest.approx(stats.std_population, rel=1e-12)
-                assert (got[f"{metric}_ci_low"], got[f"{metric}_ci_high"]) == pytest.approx((stats.ci_low, stats.ci_high), rel=1e-12)
+                assert (got[f"{metric}_ci_low"], got[f"{metric}_ci_high"]) == pytest.approx(
+                    (stats.ci_low, stats.ci_high), rel=1e-12
+                )
             mine = data.done[data.done["world"] == row.name]
             assert got["eps_t_max"] == mine["eps_t"].max() and got["eps_t_outliers"] == int(mine["outlier_t"].sum())
     assert worlds.set_index("world").loc["house_small_01", "status"] == "failed"
@@ -117,14 +148,19 @@ def test_export_round_trip(campaign, tmp_path, fmt):
     back = pd.read_csv(path) if fmt == "csv" else pd.read_parquet(path)
     assert list(back.columns) == list(data.runs.columns) and len(back) == len(data.runs)
     assert back["seed"].tolist() == data.runs["seed"].tolist()  # 64-bit seeds survive exactly
-    assert back["world"].tolist() == data.runs["world"].tolist() and back["status"].tolist() == data.runs["status"].tolist()
+    assert (
+        back["world"].tolist() == data.runs["world"].tolist()
+        and back["status"].tolist() == data.runs["status"].tolist()
+    )
     np.testing.assert_array_equal(back["eps_t"].to_numpy(dtype=float), data.runs["eps_t"].to_numpy(dtype=float))
     if fmt == "parquet":
         pd.testing.assert_frame_equal(back, data.runs)
     worlds = export_table(campaign, fmt, tmp_path / f"worlds.{fmt}", table="worlds")
     back = pd.read_csv(worlds) if fmt == "csv" else pd.read_parquet(worlds)
     assert back["world"].tolist() == WORLDS
-    np.testing.assert_allclose(back["eps_t_mean"].to_numpy(dtype=float), data.worlds["eps_t_mean"].to_numpy(dtype=float), rtol=1e-15)
+    np.testing.assert_allclose(
+        back["eps_t_mean"].to_numpy(dtype=float), data.worlds["eps_t_mean"].to_numpy(dtype=float), rtol=1e-15
+    )
     # default file: inside the campaign folder
     default = export_table(campaign, fmt)
     assert default == campaign.absolute() / f"runs.{fmt}" and default.is_file()

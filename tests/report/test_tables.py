@@ -23,15 +23,17 @@ Z99 = stats.norm.ppf(0.995)  # 2.5758...
 
 def _runs() -> pd.DataFrame:
     # Worlds out of order on purpose; "b" has a high outlier in eps_t, "c" a single run.
-    return pd.DataFrame({
-        "world": ["b", "a", "b", "a", "b", "a", "b", "a", "b", "c"],
-        "run": [0, 0, 1, 1, 2, 2, 3, 3, 4, 0],
-        "seed": range(10),
-        "eps_t": [1.0, 1.0, 2.0, 2.0, 3.0, 3.0, 4.0, 4.0, 100.0, 0.5],
-        "eps_r": [0.1, 0.2, 0.1, 0.2, 0.1, 0.2, 0.1, 0.2, 0.1, 0.05],
-        "termination": ["done"] * 10,
-        "extra": list("abcdefghij"),
-    })
+    return pd.DataFrame(
+        {
+            "world": ["b", "a", "b", "a", "b", "a", "b", "a", "b", "c"],
+            "run": [0, 0, 1, 1, 2, 2, 3, 3, 4, 0],
+            "seed": range(10),
+            "eps_t": [1.0, 1.0, 2.0, 2.0, 3.0, 3.0, 4.0, 4.0, 100.0, 0.5],
+            "eps_r": [0.1, 0.2, 0.1, 0.2, 0.1, 0.2, 0.1, 0.2, 0.1, 0.05],
+            "termination": ["done"] * 10,
+            "extra": list("abcdefghij"),
+        }
+    )
 
 
 def test_world_summary_matches_hand_computation_and_is_sorted_by_world() -> None:

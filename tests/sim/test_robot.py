@@ -9,9 +9,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from slamtrials.geometry import compose, ominus
+from slamtrials.geometry import compose, compose1, ominus, ominus1
 from slamtrials.sim import RobotConfig, SimConfig, Simulator
-from slamtrials.geometry import compose1, ominus1
 from slamtrials.sim.robot import CollisionChecker, arc_increment, arc_sagitta, limit_velocity
 from slamtrials.worlds.world import World, world_to_map
 
@@ -43,9 +42,13 @@ def test_arc_increment_known_answers():
     np.testing.assert_allclose(arc_increment(0.5, 0.0, 0.1), [0.05, 0.0, 0.0])
     np.testing.assert_allclose(arc_increment(0.0, 1.0, 0.1), [0.0, 0.0, 0.1])
     # A quarter circle of radius 2 / pi.
-    np.testing.assert_allclose(arc_increment(1.0, math.pi / 2, 1.0), [2 / math.pi, 2 / math.pi, math.pi / 2], atol=1e-15)
+    np.testing.assert_allclose(
+        arc_increment(1.0, math.pi / 2, 1.0), [2 / math.pi, 2 / math.pi, math.pi / 2], atol=1e-15
+    )
     # Backwards on the same circle.
-    np.testing.assert_allclose(arc_increment(-1.0, -math.pi / 2, 1.0), [-2 / math.pi, 2 / math.pi, -math.pi / 2], atol=1e-15)
+    np.testing.assert_allclose(
+        arc_increment(-1.0, -math.pi / 2, 1.0), [-2 / math.pi, 2 / math.pi, -math.pi / 2], atol=1e-15
+    )
 
 
 @settings(max_examples=60, deadline=None)
@@ -202,8 +205,10 @@ def cluttered_world() -> World:
 
 
 @settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(commands=st.lists(st.tuples(st.floats(-0.7, 0.7), st.floats(-1.2, 1.2)), min_size=10, max_size=80),
-       repeat=st.integers(1, 8))
+@given(
+    commands=st.lists(st.tuples(st.floats(-0.7, 0.7), st.floats(-1.2, 1.2)), min_size=10, max_size=80),
+    repeat=st.integers(1, 8),
+)
 def test_random_driving_never_overlaps_a_wall(commands, repeat):
     world = cluttered_world()
     sim = Simulator(world, SimConfig(), np.random.default_rng(1), start=[3.0, 3.0, 0.3])

@@ -22,7 +22,9 @@ from slamtrials.slam import (
 )
 from slamtrials.slamrun import run_slam
 
-LASER = LaserGeometry.from_dict({"angle_min": -1.0, "angle_increment": 0.5, "range_min": 0.0, "range_max": 10.0, "mount": [0.0, 0.0, 0.0]})
+LASER = LaserGeometry.from_dict(
+    {"angle_min": -1.0, "angle_increment": 0.5, "range_min": 0.0, "range_max": 10.0, "mount": [0.0, 0.0, 0.0]}
+)
 
 
 class ShiftedOdometry:
@@ -57,8 +59,14 @@ class ShiftedOdometry:
 
 def _record(n: int = 5) -> RunRecord:
     odometry = np.column_stack([np.arange(n) * 0.1, np.zeros(n), np.zeros(n)])
-    return RunRecord(t=np.arange(n) * 0.1, scans=np.full((n, 5), 3.0, np.float32), odometry=odometry, truth=odometry.copy(),
-                     stalled=np.zeros(n, bool), laser=LASER)
+    return RunRecord(
+        t=np.arange(n) * 0.1,
+        scans=np.full((n, 5), 3.0, np.float32),
+        odometry=odometry,
+        truth=odometry.copy(),
+        stalled=np.zeros(n, bool),
+        laser=LASER,
+    )
 
 
 def test_builtin_odometry_is_registered_and_follows_the_protocol():

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from slamtrials.slam.gridmap import GridMap, beam_endpoints
 from slamtrials.record import LaserGeometry
+from slamtrials.slam.gridmap import GridMap, beam_endpoints
 
 RES = 0.05
 HALF = 2.025  # walls through cell centres (cells are anchored at the origin), so no endpoint lies on a cell edge
@@ -65,8 +65,14 @@ def test_max_range_and_too_long_beams_mark_only_free_space_up_to_max_urange():
 
 
 def test_endpoints_classify_returns_cuts_and_ignored_beams():
-    ends, hit = beam_endpoints([1.0, 2.0, np.pi / 2], [1.0, 0.05, 40.0, 3.0], [0.0, 0.0, 0.0, 0.0],
-                               range_min=0.1, range_max=40.0, max_urange=2.5)
+    ends, hit = beam_endpoints(
+        [1.0, 2.0, np.pi / 2],
+        [1.0, 0.05, 40.0, 3.0],
+        [0.0, 0.0, 0.0, 0.0],
+        range_min=0.1,
+        range_max=40.0,
+        max_urange=2.5,
+    )
     np.testing.assert_allclose(ends, [[1.0, 3.0], [1.0, 4.5], [1.0, 4.5]], atol=1e-12)
     assert hit.tolist() == [True, False, False]
 
@@ -95,8 +101,15 @@ def test_growing_keeps_world_coordinates():
 
 def test_mount_and_pose_are_applied():
     ranges, angles = _room_scan(720)
-    laser = LaserGeometry.from_dict({"angle_min": float(angles[0]), "angle_increment": float(angles[1] - angles[0]), "range_min": 0.0,
-             "range_max": 30.0, "mount": [0.3, 0.0, 0.0]})
+    laser = LaserGeometry.from_dict(
+        {
+            "angle_min": float(angles[0]),
+            "angle_increment": float(angles[1] - angles[0]),
+            "range_min": 0.0,
+            "range_max": 30.0,
+            "mount": [0.3, 0.0, 0.0],
+        }
+    )
     gmap = GridMap(RES)
     # the base at (LASER_XY - (0, 0.3)) facing +y puts the laser at LASER_XY, turned by pi/2
     gmap.integrate_frame([LASER_XY[0], LASER_XY[1] - 0.3, np.pi / 2], np.roll(ranges, -180), laser)

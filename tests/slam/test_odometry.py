@@ -27,7 +27,9 @@ def small_world() -> World:
 @pytest.fixture(scope="module")
 def world_and_record():
     world = small_world()
-    record = simulate_waypoints(world, [[5.0, 1.2], [5.6, 2.5], [4.3, 3.4], [1.2, 3.5], [1.0, 1.5]], SimConfig.paper(), seed=5, max_time=120)
+    record = simulate_waypoints(
+        world, [[5.0, 1.2], [5.6, 2.5], [4.3, 3.4], [1.2, 3.5], [1.0, 1.5]], SimConfig.paper(), seed=5, max_time=120
+    )
     assert record.metadata["outcome"] == "completed"
     return world, record
 
@@ -55,7 +57,9 @@ def test_map_from_true_poses_matches_the_walls(world_and_record):
     rows, cols = np.nonzero(grid.grid == 100)
     assert len(rows) > 200
     h = grid.grid.shape[0]
-    xy = np.column_stack([grid.origin[0] + (cols + 0.5) * grid.resolution, grid.origin[1] + (h - rows - 0.5) * grid.resolution])
+    xy = np.column_stack(
+        [grid.origin[0] + (cols + 0.5) * grid.resolution, grid.origin[1] + (h - rows - 0.5) * grid.resolution]
+    )
     wr, wc = world_to_cell(world, xy)
     near_wall = binary_dilation(world.occupied, np.ones((3, 3), bool))
     inside = (wr >= 0) & (wr < world.height) & (wc >= 0) & (wc < world.width)
@@ -64,6 +68,8 @@ def test_map_from_true_poses_matches_the_walls(world_and_record):
     assert hits.mean() >= 0.9
     # and the free cells are free in the world
     frows, fcols = np.nonzero(grid.grid == 0)
-    fxy = np.column_stack([grid.origin[0] + (fcols + 0.5) * grid.resolution, grid.origin[1] + (h - frows - 0.5) * grid.resolution])
+    fxy = np.column_stack(
+        [grid.origin[0] + (fcols + 0.5) * grid.resolution, grid.origin[1] + (h - frows - 0.5) * grid.resolution]
+    )
     fr, fc = world_to_cell(world, fxy)
     assert np.mean(~world.occupied[fr, fc]) > 0.98

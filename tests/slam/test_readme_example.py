@@ -54,7 +54,9 @@ def test_readme_algorithm_through_python_and_cli(readme_algorithm, tmp_path):
     baseline = run_slam(record, "odometry", overrides={"resolution": 0.2})
     np.testing.assert_array_equal(result.occupancy.grid, baseline.occupancy.grid)
     out = tmp_path / "cli"
-    slam = runner_invoke(["slam", "--algorithm", "dead-reckoning", "--preset", "coarse", "--input", str(folder), "--out", str(out)])
+    slam = runner_invoke(
+        ["slam", "--algorithm", "dead-reckoning", "--preset", "coarse", "--input", str(folder), "--out", str(out)]
+    )
     assert slam.exit_code == 0, slam.output
     np.testing.assert_allclose(read_tum(out / "trajectory.tum").poses[:, :2], record.odometry[:, :2], atol=1e-6)
     evaluated = runner_invoke(["evaluate", str(folder), "--estimate", str(out / "trajectory.tum")])

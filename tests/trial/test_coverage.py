@@ -64,7 +64,7 @@ def test_a_bent_map_is_mapped_when_aligned_locally_but_not_through_the_first_pos
 def test_unmapped_places_stay_unmapped_when_aligned_locally():
     world = corridor()
     grid = bent_map(world)
-    grid.grid[:, grid.grid.shape[1] // 2:] = -1  # the map knows nothing beyond x = 10 m
+    grid.grid[:, grid.grid.shape[1] // 2 :] = -1  # the map knows nothing beyond x = 10 m
     x = np.linspace(1.0, 19.0, 400)
     truth = np.column_stack([x, np.full_like(x, 1.0), np.zeros_like(x)])
     fraction = local_mapped_fraction(world, grid, truth.copy(), truth, world.reachable_by_disc(0.15))

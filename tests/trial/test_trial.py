@@ -22,9 +22,9 @@ def two_rooms() -> World:
     occupied = np.zeros((height, width), dtype=bool)
     occupied[:3, :] = occupied[-3:, :] = occupied[:, :3] = occupied[:, -3:] = True
     wall = width // 2
-    occupied[:, wall:wall + 3] = True
+    occupied[:, wall : wall + 3] = True
     door = slice(height // 2 - 10, height // 2 + 10)  # 1.0 m
-    occupied[door, wall:wall + 3] = False
+    occupied[door, wall : wall + 3] = False
     return World(occupied, RES, name="two-rooms", start=np.array([1.5, 2.5, 0.0]))
 
 
@@ -64,10 +64,15 @@ def test_the_map_and_estimate_agree_with_the_truth(record, world):
     grid = record.map
     rows, cols = np.nonzero(grid.grid == OCCUPIED)
     assert rows.size > 100
-    xy_map = np.column_stack([grid.origin[0] + (cols + 0.5) * grid.resolution,
-                              grid.origin[1] + (grid.grid.shape[0] - rows - 0.5) * grid.resolution])
+    xy_map = np.column_stack(
+        [
+            grid.origin[0] + (cols + 0.5) * grid.resolution,
+            grid.origin[1] + (grid.grid.shape[0] - rows - 0.5) * grid.resolution,
+        ]
+    )
     from slamtrials.geometry import transform_points
     from slamtrials.worlds import world_to_cell
+
     wr, wc = world_to_cell(world, transform_points(world_from_map, xy_map))
     inside = (wr >= 0) & (wr < world.height) & (wc >= 0) & (wc < world.width)
     near_wall = np.zeros(rows.size, dtype=bool)
@@ -87,8 +92,9 @@ def test_mapped_fraction_counts_known_cells_of_the_true_free_space(record, world
     assert through_first_pose == info["mapped_fraction_connected"]
     assert through_first_pose > 0.95
     assert abs(through_first_pose - info["mapped_fraction"]) < 0.02
-    blank = type(record.map)(grid=np.full_like(record.map.grid, UNKNOWN), resolution=record.map.resolution,
-                             origin=record.map.origin)
+    blank = type(record.map)(
+        grid=np.full_like(record.map.grid, UNKNOWN), resolution=record.map.resolution, origin=record.map.origin
+    )
     assert mapped_fraction(world, blank, record.estimate[0], record.truth[0]) == 0.0
 
 
@@ -104,7 +110,11 @@ def test_same_seed_same_trial_bit_for_bit(record, world, config):
     assert len(progress) >= 3 and times == sorted(times) and updates == sorted(updates)
     assert 0 < updates[-1] <= record.metadata["trial"]["slam_updates"]
     assert progress[-1].known_free_area > progress[0].known_free_area
-    other = run_trial(world, config.model_copy(update={"termination": config.termination.model_copy(update={"max_time": 30.0})}), seed=5)
+    other = run_trial(
+        world,
+        config.model_copy(update={"termination": config.termination.model_copy(update={"max_time": 30.0})}),
+        seed=5,
+    )
     assert other.metadata["bias"] != record.metadata["bias"]
 
 

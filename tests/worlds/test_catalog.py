@@ -71,8 +71,9 @@ def test_catalog_names_load_through_load_world():
     assert world.name == "office_small_01" and world.metadata["kind"] == "office"
 
 
-@pytest.mark.parametrize("entry", [pytest.param(e, id=e.name, marks=[pytest.mark.slow] if e.name in LARGE else [])
-                                   for e in CATALOG])
+@pytest.mark.parametrize(
+    "entry", [pytest.param(e, id=e.name, marks=[pytest.mark.slow] if e.name in LARGE else []) for e in CATALOG]
+)
 def test_catalog_world_is_regenerated_bit_for_bit(entry):
     stored = load_catalog_world(entry.name)
     fresh = build_entry(entry)

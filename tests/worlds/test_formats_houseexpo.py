@@ -76,8 +76,14 @@ def test_grid_frame_margin_and_metadata(tmp_path):
     # 6 x 4 m plus one cell (edges through cell centres) plus the margin on both sides
     assert world.occupied.shape == (round(4 / res) + 1 + 2 * MARGIN_CELLS, round(6 / res) + 1 + 2 * MARGIN_CELLS)
     np.testing.assert_allclose(world.origin, [-(MARGIN_CELLS + 0.5) * res, -(MARGIN_CELLS + 0.5) * res, 0.0])
-    border = np.concatenate([world.occupied[:MARGIN_CELLS + 1].ravel(), world.occupied[-MARGIN_CELLS - 1:].ravel(),
-                             world.occupied[:, :MARGIN_CELLS + 1].ravel(), world.occupied[:, -MARGIN_CELLS - 1:].ravel()])
+    border = np.concatenate(
+        [
+            world.occupied[: MARGIN_CELLS + 1].ravel(),
+            world.occupied[-MARGIN_CELLS - 1 :].ravel(),
+            world.occupied[:, : MARGIN_CELLS + 1].ravel(),
+            world.occupied[:, -MARGIN_CELLS - 1 :].ravel(),
+        ]
+    )
     assert border.all()
     assert world.name == "0a1b2c"
     assert world.metadata["format"] == "houseexpo" and world.metadata["room_num"] == 2
@@ -87,7 +93,9 @@ def test_grid_frame_margin_and_metadata(tmp_path):
 
 def test_translated_polygon_translates_the_grid(tmp_path):
     base = load_houseexpo(write(tmp_path / "a.json", house_doc()), resolution=0.1)
-    moved = load_houseexpo(write(tmp_path / "b.json", house_doc([[x + 12.5, y - 7.25] for x, y in HOUSE])), resolution=0.1)
+    moved = load_houseexpo(
+        write(tmp_path / "b.json", house_doc([[x + 12.5, y - 7.25] for x, y in HOUSE])), resolution=0.1
+    )
     np.testing.assert_array_equal(base.occupied, moved.occupied)
     np.testing.assert_allclose(moved.origin[:2], base.origin[:2] + [12.5, -7.25])
 

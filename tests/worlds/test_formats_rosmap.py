@@ -18,7 +18,9 @@ from slamtrials.worlds.formats.rosmap_save import save_rosmap
 RAMP = np.tile(np.arange(256, dtype=np.uint8), (2, 1))
 
 
-def write_map(folder: Path, image: np.ndarray | None, yaml_text: str, *, image_name: str = "map.pgm", mode: str | None = None) -> Path:
+def write_map(
+    folder: Path, image: np.ndarray | None, yaml_text: str, *, image_name: str = "map.pgm", mode: str | None = None
+) -> Path:
     if image is not None:
         picture = Image.fromarray(image, mode=mode) if mode else Image.fromarray(image)
         picture.save(folder / image_name)
@@ -28,9 +30,20 @@ def write_map(folder: Path, image: np.ndarray | None, yaml_text: str, *, image_n
 
 
 def std_yaml(**override) -> str:
-    doc = {"image": "map.pgm", "resolution": 0.05, "origin": [0.0, 0.0, 0.0], "negate": 0, "occupied_thresh": 0.65, "free_thresh": 0.196}
+    doc = {
+        "image": "map.pgm",
+        "resolution": 0.05,
+        "origin": [0.0, 0.0, 0.0],
+        "negate": 0,
+        "occupied_thresh": 0.65,
+        "free_thresh": 0.196,
+    }
     doc.update(override)
-    return "".join(f"{k}: {v if not isinstance(v, list) else '[' + ', '.join(map(str, v)) + ']'}\n" for k, v in doc.items() if v is not None)
+    return "".join(
+        f"{k}: {v if not isinstance(v, list) else '[' + ', '.join(map(str, v)) + ']'}\n"
+        for k, v in doc.items()
+        if v is not None
+    )
 
 
 def test_grey_ramp_is_classified_as_map_server_does(tmp_path):

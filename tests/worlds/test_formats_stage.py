@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
-import os
-
 import math
+import os
 import shutil
 from pathlib import Path
 
@@ -17,7 +16,9 @@ from slamtrials.worlds import load_world, world_to_cell
 from slamtrials.worlds.formats.stage import load_stage_world, parse_worldfile, type_chain
 
 # The shared data folder beside the repository, or wherever SLAMTRIALS_SHARED points.
-REAL = Path(os.environ.get("SLAMTRIALS_SHARED", Path(__file__).resolve().parents[2].parent / "shared")) / "worlds" / "real"
+REAL = (
+    Path(os.environ.get("SLAMTRIALS_SHARED", Path(__file__).resolve().parents[2].parent / "shared")) / "worlds" / "real"
+)
 
 # The bitmap: 20 x 10 px, a white margin of 2 px around a 16 x 6 px walled box (the part Stage
 # scales), an interior wall with a door, and an L-shaped notch that makes the plan asymmetric.
@@ -88,8 +89,10 @@ def test_includes_are_read_in_place_relative_to_the_including_file(tmp_path):
     (tmp_path / "inc" / "robots.inc").write_text(
         'include "sub/base.inc"\ndefine pioneer2dx pioneer_base ( color "red" )\nresolution 0.5\n'
     )
-    (tmp_path / "inc" / "sub" / "base.inc").write_text('define pioneer_base position ( size [0.44 0.38 0.22] )\n')
-    text = WORLD.replace('include "missing.inc"', 'include "inc/robots.inc"').replace("mybot( name", 'pioneer2dx( name "p" pose [3 1 0 0] )\nmybot( name')
+    (tmp_path / "inc" / "sub" / "base.inc").write_text("define pioneer_base position ( size [0.44 0.38 0.22] )\n")
+    text = WORLD.replace('include "missing.inc"', 'include "inc/robots.inc"').replace(
+        "mybot( name", 'pioneer2dx( name "p" pose [3 1 0 0] )\nmybot( name'
+    )
     path = write_world(tmp_path, text)
     parsed = parse_worldfile(path)
     assert parsed.missing_includes == []
@@ -140,7 +143,10 @@ def test_yaw_rotates_the_plan_about_its_pose(tmp_path, yaw):
     local = model_frame_centres(0.5, 8, 3)
     a = math.radians(yaw)
     xy = np.stack(
-        [5 + math.cos(a) * local[..., 0] - math.sin(a) * local[..., 1], -3 + math.sin(a) * local[..., 0] + math.cos(a) * local[..., 1]],
+        [
+            5 + math.cos(a) * local[..., 0] - math.sin(a) * local[..., 1],
+            -3 + math.sin(a) * local[..., 0] + math.cos(a) * local[..., 1],
+        ],
         axis=-1,
     )
     rows, cols = world_to_cell(world, xy)
@@ -154,8 +160,12 @@ def test_yaw_rotates_the_plan_about_its_pose(tmp_path, yaw):
 
 
 def test_stage2_pose_and_units(tmp_path):
-    text = WORLD.replace("pose [{px} {py} 0 {yaw}]", "pose [{px} {py} {yaw}]").replace("resolution 0.02", 'unit_length "cm"\nunit_angle "radians"')
-    world = load_stage_world(write_world(tmp_path, text, sx=800, sy=300, px=200, py=100, yaw=0, rx=125, ry=75, ryaw=1.5))
+    text = WORLD.replace("pose [{px} {py} 0 {yaw}]", "pose [{px} {py} {yaw}]").replace(
+        "resolution 0.02", 'unit_length "cm"\nunit_angle "radians"'
+    )
+    world = load_stage_world(
+        write_world(tmp_path, text, sx=800, sy=300, px=200, py=100, yaw=0, rx=125, ry=75, ryaw=1.5)
+    )
     assert world.resolution == pytest.approx(0.5)
     np.testing.assert_allclose(world.origin, [-2.0, -0.5, 0.0])
     np.testing.assert_allclose(world.start, [1.25, 0.75, 1.5])
@@ -180,7 +190,9 @@ def test_position_model_wins_over_a_name_hint(tmp_path):
 
 
 def test_unresolved_robot_type_is_found_by_name(tmp_path):
-    text = WORLD.replace("mybot( name", 'define autorob fancypioneer2dx ( color "red" )\ntable( pose [0 0 0 0] )\nautorob( name')
+    text = WORLD.replace(
+        "mybot( name", 'define autorob fancypioneer2dx ( color "red" )\ntable( pose [0 0 0 0] )\nautorob( name'
+    )
     text = text.replace("define mybot bot", "define mybot model")
     world = load_stage_world(write_world(tmp_path, text))
     np.testing.assert_allclose(world.start, [1.25, 0.75, math.pi / 2])
@@ -219,17 +231,17 @@ def test_missing_bitmap_names_world_file_line_and_bitmap(tmp_path):
 @pytest.mark.parametrize(
     ("text", "line", "fragment"),
     [
-        ("\nfloorplan\n(\n  bitmap \"maps/plan.png\"\n  size [8 3 1]\n", 2, "never closed"),
-        ("floorplan ( bitmap \"maps/plan.png\" size [8 3 1 )\n", 1, "expected a number"),
+        ('\nfloorplan\n(\n  bitmap "maps/plan.png"\n  size [8 3 1]\n', 2, "never closed"),
+        ('floorplan ( bitmap "maps/plan.png" size [8 3 1 )\n', 1, "expected a number"),
         ("resolution 0.02\n)\n", 2, "without a matching"),
         ("resolution 0.02\nsize [1 2 @]\n", 2, "unexpected character"),
         ("include pioneer.inc\n", 1, "quoted include"),
-        ("floorplan ( bitmap \"maps/plan.png\" )\n", 1, "no size"),
-        ("floorplan ( bitmap \"maps/plan.png\" size [8] )\n", 1, "size"),
-        ("floorplan ( bitmap \"maps/plan.png\" size [8 3 1] pose [1 2] )\n", 1, "pose"),
+        ('floorplan ( bitmap "maps/plan.png" )\n', 1, "no size"),
+        ('floorplan ( bitmap "maps/plan.png" size [8] )\n', 1, "size"),
+        ('floorplan ( bitmap "maps/plan.png" size [8 3 1] pose [1 2] )\n', 1, "pose"),
         ("floorplan ( size [8 3 1] )\n", None, "no floorplan"),
         ('unit_length "ft"\nfloorplan ( bitmap "maps/plan.png" size [8 3 1] )\n', 1, "unit_length"),
-        ("unit_length []\nfloorplan ( bitmap \"maps/plan.png\" size [8 3 1] )\n", 1, "unit_length"),
+        ('unit_length []\nfloorplan ( bitmap "maps/plan.png" size [8 3 1] )\n', 1, "unit_length"),
         ("floorplan ( bitmap 5 size [8 3 1] )\n", 1, "bitmap"),
     ],
 )
@@ -270,7 +282,13 @@ def real_layout(tmp_path: Path, folder: str, world_rel: str, image: str, bitmap_
 
 
 def test_real_uoa_robotics_lab(tmp_path):
-    path = real_layout(tmp_path, "uoa_robotics_lab", "worlds/uoa_robotics_lab.world", "uoa_robotics_lab.png", "bitmaps/uoa_robotics_lab.png")
+    path = real_layout(
+        tmp_path,
+        "uoa_robotics_lab",
+        "worlds/uoa_robotics_lab.world",
+        "uoa_robotics_lab.png",
+        "bitmaps/uoa_robotics_lab.png",
+    )
     world = load_stage_world(path)
     # Stage fits the wall bounding box, 505 x 1218 px, to 6.27 x 15.7 m (SOURCES.md)
     assert world.metadata["bitmap_bbox_px"][2:] == [505, 1218]
@@ -285,7 +303,9 @@ def test_real_uoa_robotics_lab(tmp_path):
 
 
 def test_real_willow_garage(tmp_path):
-    path = real_layout(tmp_path, "willow_garage", "worlds/willow-pr2-5cm.world", "willow-full-0.05.pgm", "../maps/willow-full-0.05.pgm")
+    path = real_layout(
+        tmp_path, "willow_garage", "worlds/willow-pr2-5cm.world", "willow-full-0.05.pgm", "../maps/willow-full-0.05.pgm"
+    )
     world = load_stage_world(path)
     assert world.resolution == pytest.approx(0.05)
     # yaw 90: the 1165 x 945 px image stands upright, centred at (-23.625, 29.125)
@@ -296,7 +316,9 @@ def test_real_willow_garage(tmp_path):
 
 
 def test_real_hospital(tmp_path):
-    path = real_layout(tmp_path, "stage_hospital", "benchmark/hospital.world", "hospital.png", "../bitmaps/hospital.png")
+    path = real_layout(
+        tmp_path, "stage_hospital", "benchmark/hospital.world", "hospital.png", "../bitmaps/hospital.png"
+    )
     world = load_stage_world(path)
     assert world.metadata["stage_scale"] == pytest.approx([140 / 3116, 60 / 1188])
     assert world.resolution == pytest.approx(140 / 3116)

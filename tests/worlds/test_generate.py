@@ -6,7 +6,7 @@ only as recorded), corridor widths, no long featureless corridor stretch, furnit
 
 from __future__ import annotations
 
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 import pytest
@@ -21,7 +21,7 @@ from slamtrials.worlds.generate import BUILDING_KINDS, GENERATOR_VERSION, KINDS,
 SMALL = {"office": 150, "school": 250, "lab": 180, "multiwing": 1200, "house": 100}
 
 
-@lru_cache(maxsize=None)
+@cache
 def world(kind: str, area: float, seed: int) -> World:
     return generate_world(kind, area, seed=seed)
 
@@ -139,8 +139,10 @@ def test_small_worlds_of_every_kind_are_valid(kind, fraction, seed):
     check_valid(generate_world(kind, area, seed=seed), area)
 
 
-@pytest.mark.parametrize("kind, area, seed", [("office", 3000, 1), ("school", 4000, 2), ("lab", 1500, 3),
-                                              ("multiwing", 2500, 4), ("house", 400, 5)])
+@pytest.mark.parametrize(
+    "kind, area, seed",
+    [("office", 3000, 1), ("school", 4000, 2), ("lab", 1500, 3), ("multiwing", 2500, 4), ("house", 400, 5)],
+)
 def test_larger_worlds_are_valid_and_near_the_requested_area(kind, area, seed):
     w = world(kind, area, seed)
     check_valid(w, area)
@@ -173,16 +175,21 @@ def test_walls_are_a_fifth_of_a_metre_thick(kind):
     assert 0.1 <= values[np.argmax(counts)] <= 0.3
 
 
-@pytest.mark.parametrize("kind, lo, hi", [("office", 1.6, 2.5), ("school", 2.2, 3.2), ("lab", 1.8, 2.8), ("multiwing", 1.6, 3.2)])
+@pytest.mark.parametrize(
+    "kind, lo, hi", [("office", 1.6, 2.5), ("school", 2.2, 3.2), ("lab", 1.8, 2.8), ("multiwing", 1.6, 3.2)]
+)
 def test_corridors_are_the_width_of_corridors(kind, lo, hi):
     w = world(kind, 4 * SMALL[kind], 2)
-    widths = np.concatenate([side_distances(w, s).sum(axis=0) for s in w.metadata["corridors"]
-                             if np.hypot(s[2] - s[0], s[3] - s[1]) > 8.0])
+    widths = np.concatenate(
+        [side_distances(w, s).sum(axis=0) for s in w.metadata["corridors"] if np.hypot(s[2] - s[0], s[3] - s[1]) > 8.0]
+    )
     values, counts = np.unique(np.round(widths, 1), return_counts=True)
     assert lo <= values[np.argmax(counts)] <= hi  # the commonest width: wall to wall, no door, no furniture
 
 
-@pytest.mark.parametrize("kind, area", [("office", 600), ("school", 1000), ("lab", 800), ("multiwing", 2000), ("house", 150)])
+@pytest.mark.parametrize(
+    "kind, area", [("office", 600), ("school", 1000), ("lab", 800), ("multiwing", 2000), ("house", 150)]
+)
 def test_corridors_have_a_feature_every_few_metres(kind, area):
     for seed in range(2):
         assert longest_bare_stretch(world(kind, area, seed)) <= 8.0
@@ -195,8 +202,10 @@ def corners(w: World) -> int:
     return int(np.count_nonzero((s == 1) | (s == 3)))
 
 
-@pytest.mark.parametrize("kind, factor, share", [("office", 2.0, 0.05), ("school", 2.0, 0.05), ("lab", 2.0, 0.1),
-                                                 ("house", 1.5, 0.05), ("multiwing", 2.0, 0.05)])
+@pytest.mark.parametrize(
+    "kind, factor, share",
+    [("office", 2.0, 0.05), ("school", 2.0, 0.05), ("lab", 2.0, 0.1), ("house", 1.5, 0.05), ("multiwing", 2.0, 0.05)],
+)
 def test_furniture_gives_scan_matching_features(kind, factor, share, monkeypatch):
     from slamtrials.worlds.generate import build
 
@@ -258,14 +267,17 @@ def test_metadata_describes_the_world():
 # ----------------------------------------------------------------------------- bad requests
 
 
-@pytest.mark.parametrize("kwargs, words", [
-    ({"kind": "castle", "area": 300, "seed": 1}, ["kind", "castle", "office"]),
-    ({"kind": "office", "area": 5, "seed": 1}, ["area", "80", "12000"]),
-    ({"kind": "multiwing", "area": 200, "seed": 1}, ["area", "1000"]),
-    ({"kind": "office", "area": 300, "seed": -1}, ["seed"]),
-    ({"kind": "office", "area": 300, "seed": 1.5}, ["seed"]),
-    ({"kind": "office", "area": 300, "seed": 1, "resolution": 0.0}, ["resolution"]),
-])
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        ({"kind": "castle", "area": 300, "seed": 1}, ["kind", "castle", "office"]),
+        ({"kind": "office", "area": 5, "seed": 1}, ["area", "80", "12000"]),
+        ({"kind": "multiwing", "area": 200, "seed": 1}, ["area", "1000"]),
+        ({"kind": "office", "area": 300, "seed": -1}, ["seed"]),
+        ({"kind": "office", "area": 300, "seed": 1.5}, ["seed"]),
+        ({"kind": "office", "area": 300, "seed": 1, "resolution": 0.0}, ["resolution"]),
+    ],
+)
 def test_bad_requests_raise_config_errors_naming_the_option(kwargs, words):
     with pytest.raises(ConfigError) as info:
         generate_world(**kwargs)

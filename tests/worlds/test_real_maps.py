@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +11,9 @@ import pytest
 from slamtrials.worlds import load_world, world_to_cell
 
 # The shared data folder beside the repository, or wherever SLAMTRIALS_SHARED points.
-REAL = Path(os.environ.get("SLAMTRIALS_SHARED", Path(__file__).resolve().parents[2].parent / "shared")) / "worlds" / "real"
+REAL = (
+    Path(os.environ.get("SLAMTRIALS_SHARED", Path(__file__).resolve().parents[2].parent / "shared")) / "worlds" / "real"
+)
 
 # From the table in shared/worlds/real/SOURCES.md (computed independently with map_server's rule):
 # short_name: (resolution m/px, free area m^2, largest connected free area m^2)

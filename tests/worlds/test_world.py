@@ -73,7 +73,7 @@ def _two_rooms(gap_cells: int) -> World:
     """Two 1.9 x 1.9 m rooms (0.05 m cells) joined by a doorway ``gap_cells`` cells wide in the middle wall."""
     occ = _room(40, 81)
     occ[:, 40] = True
-    occ[20 - gap_cells // 2:20 - gap_cells // 2 + gap_cells, 40] = False
+    occ[20 - gap_cells // 2 : 20 - gap_cells // 2 + gap_cells, 40] = False
     return World(occ, 0.05, start=cell_to_world(World(occ, 0.05), 20, 20).tolist() + [0.0])
 
 

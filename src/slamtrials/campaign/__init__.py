@@ -13,7 +13,7 @@ from __future__ import annotations
 from slamtrials.campaign.config import CampaignConfig, MetricSettings, RunSettings
 from slamtrials.campaign.demo import DEMO_WORLDS, small_campaign_config
 from slamtrials.campaign.dump import dump_default_yaml
-from slamtrials.campaign.events import CampaignEvent, CampaignResult, REPLAY_NOTE
+from slamtrials.campaign.events import REPLAY_NOTE, CampaignEvent, CampaignResult
 from slamtrials.campaign.execute import run_campaign
 from slamtrials.campaign.replay import replay_campaign
 from slamtrials.campaign.seeds import run_seed

@@ -37,8 +37,13 @@ def check_workers(workers: int | None) -> int:
 
 
 @contextmanager
-def dask_client(scheduler: Any = None, workers: int | None = None, *, allowed_failures: int | None = None,
-                timeout: float | None = None) -> Iterator[Any]:
+def dask_client(
+    scheduler: Any = None,
+    workers: int | None = None,
+    *,
+    allowed_failures: int | None = None,
+    timeout: float | None = None,
+) -> Iterator[Any]:
     """Yield a ``distributed.Client`` (see the module docstring); close what this function opened.
 
     ``allowed_failures`` sets how many worker deaths a task may cause before the local cluster's

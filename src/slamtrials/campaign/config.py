@@ -23,9 +23,9 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from slamtrials.errors import ConfigError, FormatError, validation_problems
 from slamtrials.explore import ExploreConfig, TerminationConfig
 from slamtrials.explore.config import ROBOT_FIELDS
-from slamtrials.metric.runcount import DEFAULT_MIN_RUNS
 from slamtrials.metric.matching import RUN_TOLERANCE
 from slamtrials.metric.rule import SamplingRule
+from slamtrials.metric.runcount import DEFAULT_MIN_RUNS
 from slamtrials.sim import SimConfig
 from slamtrials.trial import SlamSettings, TrialConfig
 
@@ -47,7 +47,9 @@ class MetricSettings(SamplingRule):
     estimate over the sampled relations (:func:`slamtrials.metric.sample_relations`).
     """
 
-    tolerance: float = Field(RUN_TOLERANCE, gt=0.0, le=10.0, description="matching tolerance of estimate to ground-truth timestamps (s)")
+    tolerance: float = Field(
+        RUN_TOLERANCE, gt=0.0, le=10.0, description="matching tolerance of estimate to ground-truth timestamps (s)"
+    )
 
     @property
     def rule(self) -> SamplingRule:
@@ -66,16 +68,29 @@ class RunSettings(BaseModel):
 
     model_config = _MODEL_CONFIG
 
-    initial: int = Field(DEFAULT_MIN_RUNS, ge=2, le=100_000, description="runs of the first variance estimate (10 in the paper)")
-    max_runs: int = Field(DEFAULT_MAX_RUNS, ge=2, le=100_000, description="cap on the runs of one world; a world that hits it is reported as capped")
+    initial: int = Field(
+        DEFAULT_MIN_RUNS, ge=2, le=100_000, description="runs of the first variance estimate (10 in the paper)"
+    )
+    max_runs: int = Field(
+        DEFAULT_MAX_RUNS,
+        ge=2,
+        le=100_000,
+        description="cap on the runs of one world; a world that hits it is reported as capped",
+    )
     confidence: float = Field(0.99, gt=0.0, lt=1.0, description="confidence level of a world's mean errors")
-    margin_t: float = Field(0.02, gt=0.0, le=100.0, description="margin of error of a world's mean translational error (m)")
-    margin_r: float = Field(0.02, gt=0.0, le=3.2, description="margin of error of a world's mean rotational error (rad)")
+    margin_t: float = Field(
+        0.02, gt=0.0, le=100.0, description="margin of error of a world's mean translational error (m)"
+    )
+    margin_r: float = Field(
+        0.02, gt=0.0, le=3.2, description="margin of error of a world's mean rotational error (rad)"
+    )
     distribution: Literal["normal", "t"] = Field("normal", description="quantile of the confidence level: normal or t")
-    retries: int = Field(2, ge=0, le=100, description="times a run is retried when its worker dies or it fails unexpectedly")
+    retries: int = Field(
+        2, ge=0, le=100, description="times a run is retried when its worker dies or it fails unexpectedly"
+    )
 
     @model_validator(mode="after")
-    def _cap_not_below_initial(self) -> "RunSettings":
+    def _cap_not_below_initial(self) -> RunSettings:
         if self.max_runs < self.initial:
             raise ValueError(f"max_runs ({self.max_runs}) must be at least initial ({self.initial})")
         return self
@@ -126,17 +141,25 @@ class CampaignConfig(BaseModel):
     worlds: list[str] = Field(min_length=1, description="bundled world names, floor-plan files or folders of them")
     sim: SimConfig = Field(default_factory=SimConfig, description="simulated robot, laser and odometry")
     slam: SlamSettings = Field(default_factory=SlamSettings, description="the SLAM algorithm under test")
-    explore: ExploreConfig = Field(default_factory=ExploreConfig, description="frontier explorer (its robot limits come from sim)")
-    termination: TerminationConfig = Field(default_factory=TerminationConfig, description="when a run ends: the paper's map snapshot rule and a time cap")
+    explore: ExploreConfig = Field(
+        default_factory=ExploreConfig, description="frontier explorer (its robot limits come from sim)"
+    )
+    termination: TerminationConfig = Field(
+        default_factory=TerminationConfig, description="when a run ends: the paper's map snapshot rule and a time cap"
+    )
     coverage_stride: int = Field(5, ge=1, le=1000, description="frames between scans traced for the observed area")
     metric: MetricSettings = Field(default_factory=MetricSettings, description="relation sampling of each run")
-    runs: RunSettings = Field(default_factory=RunSettings, description="how many runs each world gets (paper Section III-C)")
+    runs: RunSettings = Field(
+        default_factory=RunSettings, description="how many runs each world gets (paper Section III-C)"
+    )
     seed: int = Field(0, ge=0, le=MAX_SEED, description="root seed of every random draw of the campaign")
     output: str | None = Field(None, description="campaign folder; --out overrides it")
-    replay_of: str | None = Field(None, description="set by 'campaign replay': the campaign whose recorded runs are re-evaluated")
+    replay_of: str | None = Field(
+        None, description="set by 'campaign replay': the campaign whose recorded runs are re-evaluated"
+    )
 
     @model_validator(mode="after")
-    def _worlds_not_blank(self) -> "CampaignConfig":
+    def _worlds_not_blank(self) -> CampaignConfig:
         for i, entry in enumerate(self.worlds):
             if not entry.strip():
                 raise ValueError(f"worlds[{i}] is empty")
@@ -144,8 +167,13 @@ class CampaignConfig(BaseModel):
 
     def trial_config(self) -> TrialConfig:
         """The :class:`~slamtrials.trial.TrialConfig` of every run of the campaign."""
-        return TrialConfig(sim=self.sim, slam=self.slam, explore=self.explore, termination=self.termination,
-                           coverage_stride=self.coverage_stride)
+        return TrialConfig(
+            sim=self.sim,
+            slam=self.slam,
+            explore=self.explore,
+            termination=self.termination,
+            coverage_stride=self.coverage_stride,
+        )
 
     def identity(self) -> dict[str, Any]:
         """The JSON form that decides whether two configs describe the same campaign (``output`` left out)."""
@@ -157,7 +185,7 @@ class CampaignConfig(BaseModel):
         return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
     @classmethod
-    def from_stored(cls, doc: dict[str, Any]) -> "CampaignConfig":
+    def from_stored(cls, doc: dict[str, Any]) -> CampaignConfig:
         """The config of a stored campaign (its JSON form), written by this or an earlier version.
 
         Campaigns stored before the explore section lost its robot fields (:data:`ROBOT_FIELDS`) carry
@@ -166,7 +194,7 @@ class CampaignConfig(BaseModel):
         return cls.model_validate(upgrade_stored_config(doc))
 
     @classmethod
-    def from_dict(cls, data: Any, *, source: str = "campaign config") -> "CampaignConfig":
+    def from_dict(cls, data: Any, *, source: str = "campaign config") -> CampaignConfig:
         """Validate a plain mapping (e.g. parsed YAML), including the SLAM algorithm's parameters.
 
         Parameters
@@ -194,7 +222,7 @@ class CampaignConfig(BaseModel):
         return config
 
     @classmethod
-    def from_yaml(cls, path: str | Path) -> "CampaignConfig":
+    def from_yaml(cls, path: str | Path) -> CampaignConfig:
         """Read and validate a YAML campaign config.
 
         A relative ``worlds`` entry that names a file or folder next to the config file is taken

@@ -23,8 +23,15 @@ DEMO_INITIAL_RUNS = 5
 DEMO_MAX_RUNS = 10
 
 
-def small_campaign_config(worlds: Sequence[str] = DEMO_WORLDS, seed: int = 0, *, initial: int = DEMO_INITIAL_RUNS,
-                          max_runs: int = DEMO_MAX_RUNS, output: str | None = None, **overrides) -> CampaignConfig:
+def small_campaign_config(
+    worlds: Sequence[str] = DEMO_WORLDS,
+    seed: int = 0,
+    *,
+    initial: int = DEMO_INITIAL_RUNS,
+    max_runs: int = DEMO_MAX_RUNS,
+    output: str | None = None,
+    **overrides,
+) -> CampaignConfig:
     """The demo campaign config (see the module docstring).
 
     Parameters
@@ -46,5 +53,7 @@ def small_campaign_config(worlds: Sequence[str] = DEMO_WORLDS, seed: int = 0, *,
         A bad value.
     """
     runs = {"initial": initial, "max_runs": max_runs, **overrides.pop("runs", {})}
-    return CampaignConfig.from_dict({"worlds": list(worlds), "seed": seed, "output": output, "runs": runs, **overrides},
-                                    source="small campaign config")
+    return CampaignConfig.from_dict(
+        {"worlds": list(worlds), "seed": seed, "output": output, "runs": runs, **overrides},
+        source="small campaign config",
+    )

@@ -80,8 +80,16 @@ def _priority(world: WorldInfo) -> int:
     return int(world.reachable_area) if math.isfinite(world.reachable_area) else 0
 
 
-def drive(store: CampaignStore, client: Any, worlds: Sequence[WorldInfo], planner: Planner, *, retries: int,
-          on_event: Callable[[CampaignEvent], None] | None = None, prefix: str = "run") -> DriveCounts:
+def drive(
+    store: CampaignStore,
+    client: Any,
+    worlds: Sequence[WorldInfo],
+    planner: Planner,
+    *,
+    retries: int,
+    on_event: Callable[[CampaignEvent], None] | None = None,
+    prefix: str = "run",
+) -> DriveCounts:
     """Run every world to its end (see the module docstring); return the counts of this call."""
     from distributed import as_completed
 
@@ -98,8 +106,19 @@ def drive(store: CampaignStore, client: Any, worlds: Sequence[WorldInfo], planne
     def advance(world: WorldInfo, plan: Plan, results: dict) -> None:
         targets[world.name] = plan.target
         if plan.final_status is not None:
-            store.record_world(world.name, status=plan.final_status, target=plan.target, decision=plan.decision, note=plan.note)
-            emit(CampaignEvent("world_done", world.name, plan.target, len(results), status=plan.final_status, message=plan.note or ""))
+            store.record_world(
+                world.name, status=plan.final_status, target=plan.target, decision=plan.decision, note=plan.note
+            )
+            emit(
+                CampaignEvent(
+                    "world_done",
+                    world.name,
+                    plan.target,
+                    len(results),
+                    status=plan.final_status,
+                    message=plan.note or "",
+                )
+            )
             return
         new = [i for i in plan.to_run if i not in in_flight[world.name]]
         if not new:
@@ -108,8 +127,14 @@ def drive(store: CampaignStore, client: Any, worlds: Sequence[WorldInfo], planne
         store.mark_submitted(world.name, [(i, seed) for i, _, _, seed in tasks])
         store.record_world(world.name, status="running", target=plan.target, decision=plan.decision)
         for i, function, argument, _ in tasks:
-            future = client.submit(function, argument, key=f"slamtrials-{prefix}-{world.name}-{i}-{token}", retries=retries,
-                                   pure=False, priority=_priority(world))
+            future = client.submit(
+                function,
+                argument,
+                key=f"slamtrials-{prefix}-{world.name}-{i}-{token}",
+                retries=retries,
+                pure=False,
+                priority=_priority(world),
+            )
             futures[future] = (world.name, i)
             in_flight[world.name].add(i)
             queue.add(future)
@@ -136,7 +161,11 @@ def drive(store: CampaignStore, client: Any, worlds: Sequence[WorldInfo], planne
             store.record_done(name, index, result)
             counts.done += 1
             results = store.done_results(name)
-            emit(CampaignEvent("run_done", name, targets[name], len(results), index=index, eps_t=result.eps_t, eps_r=result.eps_r))
+            emit(
+                CampaignEvent(
+                    "run_done", name, targets[name], len(results), index=index, eps_t=result.eps_t, eps_r=result.eps_r
+                )
+            )
         else:
             error = result.error
             log.warning("%s run %d failed: %s", name, index, error)
@@ -147,7 +176,11 @@ def drive(store: CampaignStore, client: Any, worlds: Sequence[WorldInfo], planne
             emit(CampaignEvent("run_failed", name, targets[name], len(results), index=index, message=error))
         if name in failed:
             if not in_flight[name]:
-                emit(CampaignEvent("world_done", name, targets[name], len(results), status="failed", message=failed[name]))
+                emit(
+                    CampaignEvent(
+                        "world_done", name, targets[name], len(results), status="failed", message=failed[name]
+                    )
+                )
             continue
         advance(world, planner.plan(world, results), results)
     return counts

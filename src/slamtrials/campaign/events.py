@@ -11,8 +11,10 @@ __all__ = ["CampaignEvent", "CampaignResult", "EventKind", "REPLAY_NOTE"]
 EventKind = Literal["start", "batch", "run_done", "run_failed", "world_done"]
 
 #: What a replay's output says about the paths of its runs.
-REPLAY_NOTE = ("replay: the robot's paths are those explored with the first algorithm's maps "
-               "(recorded by the source campaign); only the SLAM algorithm was run again")
+REPLAY_NOTE = (
+    "replay: the robot's paths are those explored with the first algorithm's maps "
+    "(recorded by the source campaign); only the SLAM algorithm was run again"
+)
 
 
 @dataclass(frozen=True)

@@ -54,8 +54,17 @@ class CampaignPlanner:
 
     def task(self, world: WorldInfo, index: int) -> tuple[Callable[[Any], dict], RunTask, int]:
         seed = run_seed(self.config.seed, world.name, index)
-        task = RunTask(str(self.folder), world.name, world.ref, index, seed, self.trial, self.config.metric, self.trial_fn,
-                       extra={"root_seed": self.config.seed})
+        task = RunTask(
+            str(self.folder),
+            world.name,
+            world.ref,
+            index,
+            seed,
+            self.trial,
+            self.config.metric,
+            self.trial_fn,
+            extra={"root_seed": self.config.seed},
+        )
         return run_one, task, seed
 
 
@@ -75,7 +84,9 @@ def result_notes(summary: list) -> tuple[str, ...]:
     notes = []
     for row in summary:
         if row.status == "capped":
-            notes.append(f"{row.world}: stopped at the cap of {row.runs} runs; the rule asked for more, the margins are not reached")
+            notes.append(
+                f"{row.world}: stopped at the cap of {row.runs} runs; the rule asked for more, the margins are not reached"
+            )
         elif row.status == "failed":
             notes.append(f"{row.world}: failed ({row.note or 'see the runs table'}); resume to retry")
         elif row.status == "short":
@@ -83,9 +94,15 @@ def result_notes(summary: list) -> tuple[str, ...]:
     return tuple(notes)
 
 
-def run_campaign(config: CampaignConfig | dict | None, folder: str | Path | None = None, *, scheduler: Any = None,
-                 workers: int | None = None, trial_fn: TrialFn | None = None,
-                 on_event: Callable[[CampaignEvent], None] | None = None) -> CampaignResult:
+def run_campaign(
+    config: CampaignConfig | dict | None,
+    folder: str | Path | None = None,
+    *,
+    scheduler: Any = None,
+    workers: int | None = None,
+    trial_fn: TrialFn | None = None,
+    on_event: Callable[[CampaignEvent], None] | None = None,
+) -> CampaignResult:
     """Run (or resume) a campaign and return its per-world summary.
 
     Parameters
@@ -134,7 +151,9 @@ def run_campaign(config: CampaignConfig | dict | None, folder: str | Path | None
         folder = Path(target).absolute()
         worlds = resolve_worlds(config.worlds, robot_radius=config.sim.robot.radius)
     if config.replay_of is not None:
-        raise ConfigError(f"the config is that of a replay of {config.replay_of}; continue it with 'slamtrials campaign replay'")
+        raise ConfigError(
+            f"the config is that of a replay of {config.replay_of}; continue it with 'slamtrials campaign replay'"
+        )
 
     check_campaign_folder(folder, config, worlds, kind="campaign")  # before starting a cluster; touches nothing
     planner = CampaignPlanner(config, folder, trial_fn)
@@ -145,5 +164,12 @@ def run_campaign(config: CampaignConfig | dict | None, folder: str | Path | None
             counts = drive(store, client, worlds, planner, retries=config.runs.retries, on_event=on_event)
             summary = summarize_store(store)
             csv_path = write_summary_csv(folder, summary, config.runs.confidence)
-    return CampaignResult(folder, tuple(summary), csv_path, counts.done, counts.failed, time.perf_counter() - started,
-                          result_notes(summary))
+    return CampaignResult(
+        folder,
+        tuple(summary),
+        csv_path,
+        counts.done,
+        counts.failed,
+        time.perf_counter() - started,
+        result_notes(summary),
+    )

@@ -49,8 +49,10 @@ def open_campaign(folder: Path, config: CampaignConfig, worlds: Sequence[WorldIn
         stored = [w.name for w in store.worlds()]
         given = [w.name for w in worlds]
         if stored != given:
-            raise ConfigError(f"{folder}: the campaign's worlds are {', '.join(stored)} but the config gives {', '.join(given)}; "
-                              "choose another folder")
+            raise ConfigError(
+                f"{folder}: the campaign's worlds are {', '.join(stored)} but the config gives {', '.join(given)}; "
+                "choose another folder"
+            )
     except BaseException:
         store.close()
         raise
@@ -92,5 +94,10 @@ def prepare_resume(store: CampaignStore) -> None:
     if not (store.folder / CONFIG_FILE).is_file():
         store.write_config_file()
     if requeued or partials or unrecorded:
-        log.info("%s: resuming: %d runs queued again, %d partial and %d unrecorded run folders removed",
-                 store.folder, requeued, len(partials), len(unrecorded))
+        log.info(
+            "%s: resuming: %d runs queued again, %d partial and %d unrecorded run folders removed",
+            store.folder,
+            requeued,
+            len(partials),
+            len(unrecorded),
+        )

@@ -54,9 +54,16 @@ class WorldStep:
 
 def decide(eps_t: list[float], eps_r: list[float], settings: RunSettings) -> RunCount:
     """One decision of the rule on the per-run errors ``[n]`` (m and rad) of runs ``0 .. n-1``."""
-    return runs_needed(eps_t, eps_r, margin_t=settings.margin_t, margin_r=settings.margin_r,
-                       confidence=settings.confidence, distribution=settings.distribution,
-                       min_runs=settings.initial, max_runs=settings.max_runs)
+    return runs_needed(
+        eps_t,
+        eps_r,
+        margin_t=settings.margin_t,
+        margin_r=settings.margin_r,
+        confidence=settings.confidence,
+        distribution=settings.distribution,
+        min_runs=settings.initial,
+        max_runs=settings.max_runs,
+    )
 
 
 def next_step(results: Mapping[int, tuple[float, float]], settings: RunSettings) -> WorldStep:

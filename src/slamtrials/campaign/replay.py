@@ -23,7 +23,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-
 from slamtrials.campaign.cluster import check_workers, dask_client
 from slamtrials.campaign.config import CampaignConfig, MetricSettings
 from slamtrials.campaign.driver import Plan, drive
@@ -90,8 +89,17 @@ def replay_slam(record: RunRecord, slam: SlamSettings, seed: int) -> RunRecord:
     estimate = result.estimate_per_frame(record)
     metadata = dict(record.metadata)
     metadata["slam_config"] = result.config.model_dump(mode="json")
-    return RunRecord(t=record.t, scans=record.scans, odometry=record.odometry, truth=record.truth, stalled=record.stalled,
-                     laser=record.laser, metadata=metadata, estimate=estimate, map=result.occupancy)
+    return RunRecord(
+        t=record.t,
+        scans=record.scans,
+        odometry=record.odometry,
+        truth=record.truth,
+        stalled=record.stalled,
+        laser=record.laser,
+        metadata=metadata,
+        estimate=estimate,
+        map=result.occupancy,
+    )
 
 
 def replay_one(task: ReplayTask) -> RunResult:
@@ -105,12 +113,24 @@ def replay_one(task: ReplayTask) -> RunResult:
         score = score_run(record, task.seed, task.metric)
     except SlamtrialsError as exc:
         return failure(task.world, task.index, exc)
-    record.metadata["replay"] = {"source_run": task.source, "algorithm": task.slam.algorithm, "preset": task.slam.preset,
-                                 "params": dict(task.slam.params), "wall_time_s": time.perf_counter() - started,
-                                 "note": REPLAY_NOTE}
-    record.metadata["campaign"] = {"world": task.world, "index": task.index, "seed": task.seed, "eps_t": score.eps_t,
-                                   "eps_r": score.eps_r, "relations": int(score.sampled.count),
-                                   "metric": task.metric.model_dump(mode="json"), **task.extra}
+    record.metadata["replay"] = {
+        "source_run": task.source,
+        "algorithm": task.slam.algorithm,
+        "preset": task.slam.preset,
+        "params": dict(task.slam.params),
+        "wall_time_s": time.perf_counter() - started,
+        "note": REPLAY_NOTE,
+    }
+    record.metadata["campaign"] = {
+        "world": task.world,
+        "index": task.index,
+        "seed": task.seed,
+        "eps_t": score.eps_t,
+        "eps_r": score.eps_r,
+        "relations": int(score.sampled.count),
+        "metric": task.metric.model_dump(mode="json"),
+        **task.extra,
+    }
     publish_run(task.campaign, task.world, task.index, lambda folder: write_scored_run(folder, record, score))
     return outcome(task.world, task.index, record, score, started)
 
@@ -118,7 +138,9 @@ def replay_one(task: ReplayTask) -> RunResult:
 class ReplayPlanner:
     """Every recorded run once; then the run-count rule's verdict on the new errors (no runs added)."""
 
-    def __init__(self, config: CampaignConfig, folder: Path, source: Path, recorded: dict[str, dict[int, tuple[int, str]]]):
+    def __init__(
+        self, config: CampaignConfig, folder: Path, source: Path, recorded: dict[str, dict[int, tuple[int, str]]]
+    ):
         self.config = config
         self.folder = folder
         self.source = source
@@ -132,14 +154,24 @@ class ReplayPlanner:
         step = next_step(results, self.config.runs)
         if step.finished:
             return Plan(step.target, (), "capped" if step.capped else "done", step.decision)
-        note = (f"short of runs: the rule asks for {step.target} runs (runs {', '.join(map(str, step.missing[:5]))}"
-                f"{'...' if len(step.missing) > 5 else ''} missing) but the source campaign recorded {len(recorded)}")
+        note = (
+            f"short of runs: the rule asks for {step.target} runs (runs {', '.join(map(str, step.missing[:5]))}"
+            f"{'...' if len(step.missing) > 5 else ''} missing) but the source campaign recorded {len(recorded)}"
+        )
         return Plan(step.target, (), "short", step.decision, note)
 
     def task(self, world: WorldInfo, index: int) -> tuple[Callable[[Any], dict], ReplayTask, int]:
         seed, folder = self.recorded[world.name][index]
-        task = ReplayTask(str(self.folder), world.name, index, seed, str(self.source / folder), self.config.slam, self.config.metric,
-                          extra={"root_seed": self.config.seed, "replay_of": str(self.source)})
+        task = ReplayTask(
+            str(self.folder),
+            world.name,
+            index,
+            seed,
+            str(self.source / folder),
+            self.config.slam,
+            self.config.metric,
+            extra={"root_seed": self.config.seed, "replay_of": str(self.source)},
+        )
         return replay_one, task, seed
 
 
@@ -158,9 +190,17 @@ def _recorded_runs(store: CampaignStore) -> dict[str, dict[int, tuple[int, str]]
     return recorded
 
 
-def replay_campaign(source: str | Path, folder: str | Path, algorithm: str, preset: str | None = None,
-                    params: dict[str, Any] | None = None, *, scheduler: Any = None, workers: int | None = None,
-                    on_event: Callable[[CampaignEvent], None] | None = None) -> CampaignResult:
+def replay_campaign(
+    source: str | Path,
+    folder: str | Path,
+    algorithm: str,
+    preset: str | None = None,
+    params: dict[str, Any] | None = None,
+    *,
+    scheduler: Any = None,
+    workers: int | None = None,
+    on_event: Callable[[CampaignEvent], None] | None = None,
+) -> CampaignResult:
     """Re-evaluate the recorded runs of campaign ``source`` with ``algorithm`` into a new campaign ``folder``.
 
     Calling it again with the same arguments resumes an interrupted replay.
@@ -199,8 +239,11 @@ def replay_campaign(source: str | Path, folder: str | Path, algorithm: str, pres
         worlds = src.world_infos()
         recorded = _recorded_runs(src)
     data = base.model_dump(mode="json")
-    data.update(slam={"algorithm": algorithm, "preset": preset, "params": dict(params or {})}, replay_of=str(source),
-                output=str(folder))
+    data.update(
+        slam={"algorithm": algorithm, "preset": preset, "params": dict(params or {})},
+        replay_of=str(source),
+        output=str(folder),
+    )
     config = CampaignConfig.from_dict(data, source="replay")
 
     check_campaign_folder(folder, config, worlds, kind="replay")  # before starting a cluster; touches nothing
@@ -209,8 +252,17 @@ def replay_campaign(source: str | Path, folder: str | Path, algorithm: str, pres
         store = open_campaign(folder, config, worlds, kind="replay")
         with store, campaign_lock(folder):
             prepare_resume(store)
-            counts = drive(store, client, worlds, planner, retries=config.runs.retries, on_event=on_event, prefix="replay")
+            counts = drive(
+                store, client, worlds, planner, retries=config.runs.retries, on_event=on_event, prefix="replay"
+            )
             summary = summarize_store(store)
             csv_path = write_summary_csv(folder, summary, config.runs.confidence)
-    return CampaignResult(folder, tuple(summary), csv_path, counts.done, counts.failed, time.perf_counter() - started,
-                          (REPLAY_NOTE, *result_notes(summary)))
+    return CampaignResult(
+        folder,
+        tuple(summary),
+        csv_path,
+        counts.done,
+        counts.failed,
+        time.perf_counter() - started,
+        (REPLAY_NOTE, *result_notes(summary)),
+    )

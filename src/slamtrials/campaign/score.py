@@ -51,6 +51,8 @@ def score_run(record: RunRecord, seed: int, metric: MetricSettings) -> RunScore:
     truth = Trajectory(t=record.t, poses=record.truth)
     estimate = Trajectory(t=record.t, poses=np.asarray(record.estimate, dtype=np.float64))
     odometry = Trajectory(t=record.t, poses=record.odometry)
-    sampled = sample_relations(truth, estimate, rng=int(seed), rule=metric.rule, tolerance=metric.tolerance, odometry=odometry)
+    sampled = sample_relations(
+        truth, estimate, rng=int(seed), rule=metric.rule, tolerance=metric.tolerance, odometry=odometry
+    )
     errors = sampled.errors
     return RunScore(float(np.mean(errors.translational)), float(np.mean(errors.rotational)), sampled)

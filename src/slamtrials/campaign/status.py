@@ -66,5 +66,12 @@ def campaign_status(folder: str | Path) -> CampaignStatus:
         runs: dict[str, Counter] = {w.name: Counter() for w in store.worlds()}
         for row in store.runs():
             runs[row.world][row.status] += 1
-        return CampaignStatus(Path(folder), store.kind, store.config(), tuple(store.worlds()),
-                              {k: dict(v) for k, v in runs.items()}, tuple(summarize_store(store)), store.meta("created"))
+        return CampaignStatus(
+            Path(folder),
+            store.kind,
+            store.config(),
+            tuple(store.worlds()),
+            {k: dict(v) for k, v in runs.items()},
+            tuple(summarize_store(store)),
+            store.meta("created"),
+        )

@@ -45,8 +45,19 @@ from slamtrials.campaign.config import CampaignConfig
 from slamtrials.campaign.results import RunDone
 from slamtrials.errors import ConfigError, FormatError
 
-__all__ = ["CampaignStore", "WorldInfo", "WorldRow", "RunRow", "STORE_FORMAT", "DB_FILE", "CONFIG_FILE", "RUNS_DIR",
-           "is_campaign", "check_new_folder", "config_differences"]
+__all__ = [
+    "CampaignStore",
+    "WorldInfo",
+    "WorldRow",
+    "RunRow",
+    "STORE_FORMAT",
+    "DB_FILE",
+    "CONFIG_FILE",
+    "RUNS_DIR",
+    "is_campaign",
+    "check_new_folder",
+    "config_differences",
+]
 
 STORE_FORMAT = "slamtrials-campaign/1"
 DB_FILE = "campaign.sqlite"
@@ -142,8 +153,10 @@ def check_new_folder(folder: str | Path) -> None:
     if folder.is_dir():
         others = [p.name for p in folder.iterdir() if not p.name.startswith(f".{DB_FILE}")]
         if others:
-            raise ConfigError(f"{folder}: is not empty and holds no campaign ({DB_FILE} missing; found {', '.join(sorted(others)[:3])}); "
-                              "choose a new or empty folder")
+            raise ConfigError(
+                f"{folder}: is not empty and holds no campaign ({DB_FILE} missing; found {', '.join(sorted(others)[:3])}); "
+                "choose a new or empty folder"
+            )
 
 
 def _flatten(value: Any, prefix: str = "") -> dict[str, Any]:
@@ -183,7 +196,9 @@ class CampaignStore:
     # ------------------------------------------------------------------ creating and opening
 
     @classmethod
-    def create(cls, folder: str | Path, config: CampaignConfig, worlds: Sequence[WorldInfo], *, kind: str = "campaign") -> "CampaignStore":
+    def create(
+        cls, folder: str | Path, config: CampaignConfig, worlds: Sequence[WorldInfo], *, kind: str = "campaign"
+    ) -> CampaignStore:
         """Create the catalog of a new campaign in ``folder`` (created if needed; must hold no other files).
 
         Raises
@@ -202,11 +217,19 @@ class CampaignStore:
         try:
             conn.executescript(_SCHEMA)
             conn.execute("BEGIN")
-            meta = {"format": STORE_FORMAT, "kind": kind, "config": json.dumps(config.model_dump(mode="json"), sort_keys=True),
-                    "config_hash": config.digest(), "slamtrials_version": __version__, "created": _now()}
+            meta = {
+                "format": STORE_FORMAT,
+                "kind": kind,
+                "config": json.dumps(config.model_dump(mode="json"), sort_keys=True),
+                "config_hash": config.digest(),
+                "slamtrials_version": __version__,
+                "created": _now(),
+            }
             conn.executemany("INSERT INTO meta VALUES (?, ?)", list(meta.items()))
-            conn.executemany("INSERT INTO worlds (name, ref, position, reachable_area, updated) VALUES (?, ?, ?, ?, ?)",
-                             [(w.name, w.ref, w.position, w.reachable_area, _now()) for w in worlds])
+            conn.executemany(
+                "INSERT INTO worlds (name, ref, position, reachable_area, updated) VALUES (?, ?, ?, ?, ?)",
+                [(w.name, w.ref, w.position, w.reachable_area, _now()) for w in worlds],
+            )
             conn.execute("COMMIT")
             conn.execute("PRAGMA journal_mode=WAL")
         finally:
@@ -219,7 +242,7 @@ class CampaignStore:
         return store
 
     @classmethod
-    def open(cls, folder: str | Path) -> "CampaignStore":
+    def open(cls, folder: str | Path) -> CampaignStore:
         """Open the catalog of an existing campaign.
 
         Raises
@@ -240,14 +263,16 @@ class CampaignStore:
             raise FormatError(path, f"not a readable campaign catalog ({exc})") from None
         if row is None or row[0] != STORE_FORMAT:
             conn.close()
-            raise FormatError(path, f"expected a campaign catalog of format {STORE_FORMAT}, got {row[0] if row else None!r}")
+            raise FormatError(
+                path, f"expected a campaign catalog of format {STORE_FORMAT}, got {row[0] if row else None!r}"
+            )
         return cls(folder, conn)
 
     def close(self) -> None:
         """Close the database connection."""
         self._conn.close()
 
-    def __enter__(self) -> "CampaignStore":
+    def __enter__(self) -> CampaignStore:
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -288,8 +313,10 @@ class CampaignStore:
         if self._stored_by_earlier_version_as(stored, config):
             return
         diff = config_differences(stored, config.identity())
-        raise ConfigError(f"{self.folder}: holds a campaign with a different config ({diff}); "
-                          "resume it with its own config or choose another folder")
+        raise ConfigError(
+            f"{self.folder}: holds a campaign with a different config ({diff}); "
+            "resume it with its own config or choose another folder"
+        )
 
     @staticmethod
     def _stored_by_earlier_version_as(stored: dict[str, Any], config: CampaignConfig) -> bool:
@@ -333,8 +360,10 @@ class CampaignStore:
         """Write ``config.yaml`` (the stored config, commented) atomically."""
         from slamtrials.campaign.dump import dump_config_yaml
 
-        header = (f"# slamtrials {self.kind}: the resolved config of this campaign folder (also in {DB_FILE}).\n"
-                  f"# Resume with: slamtrials campaign {'run' if self.kind == 'campaign' else 'replay'} ... --out {self.folder}\n")
+        header = (
+            f"# slamtrials {self.kind}: the resolved config of this campaign folder (also in {DB_FILE}).\n"
+            f"# Resume with: slamtrials campaign {'run' if self.kind == 'campaign' else 'replay'} ... --out {self.folder}\n"
+        )
         return atomic_write_text(self.folder / CONFIG_FILE, dump_config_yaml(self.config(), header=header))
 
     def prepare_resume(self) -> int:
@@ -342,7 +371,10 @@ class CampaignStore:
         ``pending`` (to be submitted again) and failed worlds ``pending``. Returns the runs put back."""
         with self._transaction() as conn:
             count = conn.execute("UPDATE runs SET status = 'pending' WHERE status IN ('running', 'failed')").rowcount
-            conn.execute("UPDATE worlds SET status = 'pending', note = NULL, updated = ? WHERE status IN ('running', 'failed')", (_now(),))
+            conn.execute(
+                "UPDATE worlds SET status = 'pending', note = NULL, updated = ? WHERE status IN ('running', 'failed')",
+                (_now(),),
+            )
         return count
 
     def mark_submitted(self, world: str, runs: Sequence[tuple[int, int]]) -> None:
@@ -353,8 +385,12 @@ class CampaignStore:
                 conn.execute(
                     "INSERT INTO runs (world, idx, seed, status, attempts, submitted) VALUES (?, ?, ?, 'running', 1, ?) "
                     "ON CONFLICT (world, idx) DO UPDATE SET status = 'running', attempts = attempts + 1, submitted = excluded.submitted, "
-                    "error = NULL", (world, index, seed, now))
-            conn.execute("UPDATE worlds SET status = 'running', updated = ? WHERE name = ? AND status = 'pending'", (now, world))
+                    "error = NULL",
+                    (world, index, seed, now),
+                )
+            conn.execute(
+                "UPDATE worlds SET status = 'running', updated = ? WHERE name = ? AND status = 'pending'", (now, world)
+            )
 
     def record_done(self, world: str, index: int, result: RunDone) -> None:
         """Mark a run done with its outcome (what :func:`slamtrials.campaign.task.run_one` returned)."""
@@ -362,28 +398,60 @@ class CampaignStore:
             conn.execute(
                 "UPDATE runs SET status = 'done', eps_t = ?, eps_r = ?, relations = ?, termination = ?, mapped_fraction = ?, "
                 "sim_duration = ?, wall_time = ?, worker = ?, error = NULL, folder = ?, details = ?, finished = ? WHERE world = ? AND idx = ?",
-                (result.eps_t, result.eps_r, result.relations, result.termination, result.mapped_fraction,
-                 result.sim_duration, result.wall_time, result.worker, result.folder,
-                 json.dumps(asdict(result.details), sort_keys=True), _now(), world, index))
+                (
+                    result.eps_t,
+                    result.eps_r,
+                    result.relations,
+                    result.termination,
+                    result.mapped_fraction,
+                    result.sim_duration,
+                    result.wall_time,
+                    result.worker,
+                    result.folder,
+                    json.dumps(asdict(result.details), sort_keys=True),
+                    _now(),
+                    world,
+                    index,
+                ),
+            )
 
     def record_failed(self, world: str, index: int, error: str, *, worker: str | None = None) -> None:
         """Mark a run failed (with its error text) and its world failed."""
         now = _now()
         with self._transaction() as conn:
-            conn.execute("UPDATE runs SET status = 'failed', error = ?, worker = ?, finished = ? WHERE world = ? AND idx = ?",
-                         (error, worker, now, world, index))
-            conn.execute("UPDATE worlds SET status = 'failed', note = ?, updated = ? WHERE name = ?",
-                         (f"run {index} failed: {error}", now, world))
+            conn.execute(
+                "UPDATE runs SET status = 'failed', error = ?, worker = ?, finished = ? WHERE world = ? AND idx = ?",
+                (error, worker, now, world, index),
+            )
+            conn.execute(
+                "UPDATE worlds SET status = 'failed', note = ?, updated = ? WHERE name = ?",
+                (f"run {index} failed: {error}", now, world),
+            )
 
-    def record_world(self, world: str, *, status: str, target: int | None, decision: Any = None, note: str | None = None) -> None:
+    def record_world(
+        self, world: str, *, status: str, target: int | None, decision: Any = None, note: str | None = None
+    ) -> None:
         """Store a world's status and the last decision of the run-count rule (a :class:`RunCount`)."""
         d = decision
-        values = (status, target, getattr(d, "needed", None), getattr(d, "needed_t", None), getattr(d, "needed_r", None),
-                  _finite(getattr(d, "std_t", None)), _finite(getattr(d, "std_r", None)), int(bool(getattr(d, "capped", False))),
-                  note, _now(), world)
+        values = (
+            status,
+            target,
+            getattr(d, "needed", None),
+            getattr(d, "needed_t", None),
+            getattr(d, "needed_r", None),
+            _finite(getattr(d, "std_t", None)),
+            _finite(getattr(d, "std_r", None)),
+            int(bool(getattr(d, "capped", False))),
+            note,
+            _now(),
+            world,
+        )
         with self._transaction() as conn:
-            conn.execute("UPDATE worlds SET status = ?, runs_target = ?, runs_needed = ?, needed_t = ?, needed_r = ?, std_t = ?, "
-                         "std_r = ?, capped = ?, note = ?, updated = ? WHERE name = ?", values)
+            conn.execute(
+                "UPDATE worlds SET status = ?, runs_target = ?, runs_needed = ?, needed_t = ?, needed_r = ?, std_t = ?, "
+                "std_r = ?, capped = ?, note = ?, updated = ? WHERE name = ?",
+                values,
+            )
 
 
 def _finite(value: float | None) -> float | None:

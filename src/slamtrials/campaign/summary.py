@@ -28,9 +28,26 @@ from slamtrials.metric.stats import EnvironmentStats, environment_stats
 __all__ = ["WorldSummary", "summarize_store", "load_summary", "write_summary_csv", "SUMMARY_FILE", "CSV_COLUMNS"]
 
 SUMMARY_FILE = "summary.csv"
-CSV_COLUMNS = ("world", "status", "runs", "runs_needed", "capped", "eps_t_mean", "eps_t_std", "eps_t_std_population",
-               "eps_t_ci_low", "eps_t_ci_high", "eps_r_mean", "eps_r_std", "eps_r_std_population", "eps_r_ci_low",
-               "eps_r_ci_high", "confidence", "failed_runs", "terminations")
+CSV_COLUMNS = (
+    "world",
+    "status",
+    "runs",
+    "runs_needed",
+    "capped",
+    "eps_t_mean",
+    "eps_t_std",
+    "eps_t_std_population",
+    "eps_t_ci_low",
+    "eps_t_ci_high",
+    "eps_r_mean",
+    "eps_r_std",
+    "eps_r_std_population",
+    "eps_r_ci_low",
+    "eps_r_ci_high",
+    "confidence",
+    "failed_runs",
+    "terminations",
+)
 
 
 @dataclass(frozen=True)
@@ -79,11 +96,27 @@ def summarize_store(store: CampaignStore) -> list[WorldSummary]:
         done = [r for r in mine if r.status == "done"]
         stats_t = stats_r = None
         if done:
-            stats_t = environment_stats([r.eps_t for r in done], confidence=settings.confidence, distribution=settings.distribution)
-            stats_r = environment_stats([r.eps_r for r in done], confidence=settings.confidence, distribution=settings.distribution)
+            stats_t = environment_stats(
+                [r.eps_t for r in done], confidence=settings.confidence, distribution=settings.distribution
+            )
+            stats_r = environment_stats(
+                [r.eps_r for r in done], confidence=settings.confidence, distribution=settings.distribution
+            )
         reasons = Counter(r.termination or "unknown" for r in done)
-        rows.append(WorldSummary(world.name, world.status, len(done), world.runs_needed, bool(world.capped), stats_t, stats_r,
-                                 sum(r.status == "failed" for r in mine), dict(sorted(reasons.items())), world.note))
+        rows.append(
+            WorldSummary(
+                world.name,
+                world.status,
+                len(done),
+                world.runs_needed,
+                bool(world.capped),
+                stats_t,
+                stats_r,
+                sum(r.status == "failed" for r in mine),
+                dict(sorted(reasons.items())),
+                world.note,
+            )
+        )
     return rows
 
 
@@ -100,7 +133,13 @@ def _number(value: float | None) -> str:
 def _stats_cells(stats: EnvironmentStats | None) -> list[str]:
     if stats is None:
         return [""] * 5
-    return [_number(stats.mean), _number(stats.std_sample), _number(stats.std_population), _number(stats.ci_low), _number(stats.ci_high)]
+    return [
+        _number(stats.mean),
+        _number(stats.std_sample),
+        _number(stats.std_population),
+        _number(stats.ci_low),
+        _number(stats.ci_high),
+    ]
 
 
 def write_summary_csv(folder: str | Path, rows: list[WorldSummary], confidence: float) -> Path:
@@ -110,6 +149,18 @@ def write_summary_csv(folder: str | Path, rows: list[WorldSummary], confidence: 
     writer.writerow(CSV_COLUMNS)
     for row in rows:
         terminations = ";".join(f"{k}:{v}" for k, v in row.terminations.items())
-        writer.writerow([row.world, row.status, row.runs, "" if row.runs_needed is None else row.runs_needed, int(row.capped),
-                         *_stats_cells(row.eps_t), *_stats_cells(row.eps_r), repr(confidence), row.failed_runs, terminations])
+        writer.writerow(
+            [
+                row.world,
+                row.status,
+                row.runs,
+                "" if row.runs_needed is None else row.runs_needed,
+                int(row.capped),
+                *_stats_cells(row.eps_t),
+                *_stats_cells(row.eps_r),
+                repr(confidence),
+                row.failed_runs,
+                terminations,
+            ]
+        )
     return atomic_write_text(Path(folder) / SUMMARY_FILE, text.getvalue())

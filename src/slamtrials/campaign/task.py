@@ -138,8 +138,16 @@ def run_one(task: RunTask) -> RunResult:
         score = score_run(record, task.seed, task.metric)
     except SlamtrialsError as exc:
         return failure(task.world, task.index, exc)
-    record.metadata["campaign"] = {"world": task.world, "ref": task.ref, "index": task.index, "seed": task.seed,
-                                   "eps_t": score.eps_t, "eps_r": score.eps_r, "relations": int(score.sampled.count),
-                                   "metric": task.metric.model_dump(mode="json"), **task.extra}
+    record.metadata["campaign"] = {
+        "world": task.world,
+        "ref": task.ref,
+        "index": task.index,
+        "seed": task.seed,
+        "eps_t": score.eps_t,
+        "eps_r": score.eps_r,
+        "relations": int(score.sampled.count),
+        "metric": task.metric.model_dump(mode="json"),
+        **task.extra,
+    }
     publish_run(task.campaign, task.world, task.index, lambda folder: write_scored_run(folder, record, score))
     return outcome(task.world, task.index, record, score, started)

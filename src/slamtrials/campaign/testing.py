@@ -59,17 +59,36 @@ class FakeTrial:
         t = np.array([0.0, 1.0])
         truth = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
         estimate = np.array([[0.0, 0.0, 0.0], [1.0 + e_t, 0.0, e_r]])
-        record = RunRecord(t=t, scans=np.full((2, 3), 5.0, dtype=np.float32), odometry=truth.copy(), truth=truth,
-                           stalled=np.zeros(2, dtype=bool), laser=_LASER)
+        record = RunRecord(
+            t=t,
+            scans=np.full((2, 3), 5.0, dtype=np.float32),
+            odometry=truth.copy(),
+            truth=truth,
+            stalled=np.zeros(2, dtype=bool),
+            laser=_LASER,
+        )
         record.estimate = estimate
         record.map = OccupancyGrid(np.zeros((4, 4), dtype=np.int8), 0.5, np.zeros(3))
         record.metadata = {
             "world": getattr(world, "name", "world"),
             "seed": int(seed),
-            "trial": TrialSummary(termination_reason="fake", mapped_fraction=1.0, mapped_fraction_global=1.0,
-                                  observed_fraction=1.0, reachable_area_m2=1.0, mapped_fraction_connected=1.0,
-                                  connected_free_area_m2=1.0, mapped_free_area_m2=1.0, distance_m=1.0, turning_rad=0.0,
-                                  duration_s=1.0, wall_time_s=self.sleep, realtime_factor=1.0, slam_updates=1,
-                                  slam_seconds=0.0, stalled_frames=0).to_dict(),
+            "trial": TrialSummary(
+                termination_reason="fake",
+                mapped_fraction=1.0,
+                mapped_fraction_global=1.0,
+                observed_fraction=1.0,
+                reachable_area_m2=1.0,
+                mapped_fraction_connected=1.0,
+                connected_free_area_m2=1.0,
+                mapped_free_area_m2=1.0,
+                distance_m=1.0,
+                turning_rad=0.0,
+                duration_s=1.0,
+                wall_time_s=self.sleep,
+                realtime_factor=1.0,
+                slam_updates=1,
+                slam_seconds=0.0,
+                stalled_frames=0,
+            ).to_dict(),
         }
         return record

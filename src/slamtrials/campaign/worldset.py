@@ -108,7 +108,9 @@ def expand_worlds(entries: Sequence[str], *, base: str | Path | None = None) -> 
     seen: dict[str, str] = {}
     for name, ref, _entry in out:
         if name in seen:
-            raise ConfigError(f"worlds: two worlds are named {name!r} ({seen[name]} and {ref}); rename one of the files")
+            raise ConfigError(
+                f"worlds: two worlds are named {name!r} ({seen[name]} and {ref}); rename one of the files"
+            )
         seen[name] = ref
     return out
 
@@ -119,8 +121,9 @@ def load_world_cached(ref: str) -> World:
     return load_world(ref)
 
 
-def resolve_worlds(entries: Sequence[str], *, base: str | Path | None = None,
-                   robot_radius: float | None = None) -> list[WorldInfo]:
+def resolve_worlds(
+    entries: Sequence[str], *, base: str | Path | None = None, robot_radius: float | None = None
+) -> list[WorldInfo]:
     """Expand the entries and load every world once, before any work starts.
 
     Each world's ``reachable_area`` is what a disc robot of ``robot_radius`` (m) can cover from the start

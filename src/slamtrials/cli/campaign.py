@@ -12,7 +12,6 @@ deviation of eps_t and eps_r, confidence intervals), also saved as ``DIR/summary
 
 from __future__ import annotations
 
-import logging
 from pathlib import Path
 from typing import Annotated
 
@@ -27,8 +26,15 @@ app = make_app(help="Run, resume, watch and replay campaigns: repeat runs until 
 
 EXIT_INTERRUPTED = 130
 
-SchedulerOpt = Annotated[str | None, typer.Option("--scheduler", help="Address of a running Dask scheduler (e.g. tcp://host:8786); default: a local cluster.")]
-WorkersOpt = Annotated[int | None, typer.Option("--workers", "-j", help="Worker processes of the local cluster (default: one per core).")]
+SchedulerOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--scheduler", help="Address of a running Dask scheduler (e.g. tcp://host:8786); default: a local cluster."
+    ),
+]
+WorkersOpt = Annotated[
+    int | None, typer.Option("--workers", "-j", help="Worker processes of the local cluster (default: one per core).")
+]
 
 
 def summary_table(rows, confidence: float, title: str):
@@ -41,7 +47,11 @@ def summary_table(rows, confidence: float, title: str):
                 cells += ["-", "-", "-"]
             else:
                 digits = 3 if stats is row.eps_t else 4
-                cells += [fmt_number(stats.mean, digits), fmt_number(stats.std_sample, digits), fmt_number(stats.half_width, digits)]
+                cells += [
+                    fmt_number(stats.mean, digits),
+                    fmt_number(stats.std_sample, digits),
+                    fmt_number(stats.half_width, digits),
+                ]
         needed = f"/{row.runs_needed}" if row.runs_needed is not None and row.runs_needed > row.runs else ""
         reasons = ", ".join(f"{k} {v}" for k, v in row.terminations.items())
         table.add_row(row.world, row.status, f"{row.runs}{needed}", *cells, reasons)
@@ -55,9 +65,15 @@ class _Progress:
         from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
         self.console = console
-        self.progress = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                                 TextColumn("{task.fields[status]}"), TimeElapsedColumn(), console=console,
-                                 disable=not console.is_terminal)
+        self.progress = Progress(
+            TextColumn("{task.description}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TextColumn("{task.fields[status]}"),
+            TimeElapsedColumn(),
+            console=console,
+            disable=not console.is_terminal,
+        )
         self.tasks: dict[str, int] = {}
 
     def __enter__(self):
@@ -70,14 +86,22 @@ class _Progress:
     def __call__(self, event) -> None:
         task = self.tasks.get(event.world)
         if task is None:
-            task = self.tasks[event.world] = self.progress.add_task(event.world, total=max(event.target, event.done), status="")
+            task = self.tasks[event.world] = self.progress.add_task(
+                event.world, total=max(event.target, event.done), status=""
+            )
         total = max(event.target, event.done)
         if event.kind == "run_failed":
             self.progress.update(task, completed=event.done, total=total, status=f"run {event.index} failed")
         elif event.kind == "world_done":
-            self.progress.update(task, completed=event.done, total=event.done if event.status != "short" else total, status=event.status)
-            self.console.print(f"{event.world}: {event.status} with {event.done} runs"
-                               f"{' (' + event.message + ')' if event.message else ''}", highlight=False, soft_wrap=True)
+            self.progress.update(
+                task, completed=event.done, total=event.done if event.status != "short" else total, status=event.status
+            )
+            self.console.print(
+                f"{event.world}: {event.status} with {event.done} runs"
+                f"{' (' + event.message + ')' if event.message else ''}",
+                highlight=False,
+                soft_wrap=True,
+            )
         else:
             status = "running" if event.kind != "start" else (event.status or "")
             self.progress.update(task, completed=event.done, total=total, status=status)
@@ -87,14 +111,26 @@ def _finish(console, result, config_confidence: float, title: str) -> None:
     console.print(summary_table(result.summary, config_confidence, title))
     for note in result.notes:
         console.print(f"note: {note}", highlight=False, soft_wrap=True)
-    console.print(f"{result.runs_done} runs done ({result.runs_failed} failed) in {result.wall_time:.0f} s; "
-                  f"summary: {result.summary_csv}", highlight=False, soft_wrap=True)
+    console.print(
+        f"{result.runs_done} runs done ({result.runs_failed} failed) in {result.wall_time:.0f} s; "
+        f"summary: {result.summary_csv}",
+        highlight=False,
+        soft_wrap=True,
+    )
 
 
 @app.command("run")
 def run(
-    config: Annotated[Path | None, typer.Argument(help="Campaign config YAML ('slamtrials config dump' prints one); omit to resume --out.")] = None,
-    out: Annotated[Path | None, typer.Option("--out", "-o", help="Campaign folder (default: 'output' of the config); an existing one is resumed.")] = None,
+    config: Annotated[
+        Path | None,
+        typer.Argument(help="Campaign config YAML ('slamtrials config dump' prints one); omit to resume --out."),
+    ] = None,
+    out: Annotated[
+        Path | None,
+        typer.Option(
+            "--out", "-o", help="Campaign folder (default: 'output' of the config); an existing one is resumed."
+        ),
+    ] = None,
     scheduler: SchedulerOpt = None,
     workers: WorkersOpt = None,
 ) -> None:
@@ -135,18 +171,35 @@ def status(folder: Annotated[Path, typer.Argument(help="Campaign folder.")]) -> 
     console = make_console()
     config = state.config
     what = f"replay of {config.replay_of}" if state.kind == "replay" else "campaign"
-    console.print(f"{folder}: {what}, algorithm {config.slam.algorithm} (preset {config.slam.preset}), seed {config.seed}, "
-                  f"runs: initial {config.runs.initial}, cap {config.runs.max_runs}, margins {config.runs.margin_t:g} m / "
-                  f"{config.runs.margin_r:g} rad at {100 * config.runs.confidence:g} %; created {state.created}",
-                  highlight=False, soft_wrap=True)
+    console.print(
+        f"{folder}: {what}, algorithm {config.slam.algorithm} (preset {config.slam.preset}), seed {config.seed}, "
+        f"runs: initial {config.runs.initial}, cap {config.runs.max_runs}, margins {config.runs.margin_t:g} m / "
+        f"{config.runs.margin_r:g} rad at {100 * config.runs.confidence:g} %; created {state.created}",
+        highlight=False,
+        soft_wrap=True,
+    )
     table = Table(title="Progress")
-    for column, justify in (("world", "left"), ("status", "left"), ("done", "right"), ("needed", "right"),
-                            ("running", "right"), ("failed", "right"), ("note", "left")):
+    for column, justify in (
+        ("world", "left"),
+        ("status", "left"),
+        ("done", "right"),
+        ("needed", "right"),
+        ("running", "right"),
+        ("failed", "right"),
+        ("note", "left"),
+    ):
         table.add_column(column, justify=justify)
     for world in state.worlds:
         counts = state.runs.get(world.name, {})
-        table.add_row(world.name, world.status, str(counts.get("done", 0)), "-" if world.runs_target is None else str(world.runs_target),
-                      str(counts.get("running", 0)), str(counts.get("failed", 0)), world.note or "")
+        table.add_row(
+            world.name,
+            world.status,
+            str(counts.get("done", 0)),
+            "-" if world.runs_target is None else str(world.runs_target),
+            str(counts.get("running", 0)),
+            str(counts.get("failed", 0)),
+            world.note or "",
+        )
     console.print(table)
     console.print(summary_table(state.summary, config.runs.confidence, "Errors so far"))
     console.print(f"{state.runs_done} runs done; {'finished' if state.finished else 'not finished'}", highlight=False)
@@ -155,10 +208,16 @@ def status(folder: Annotated[Path, typer.Argument(help="Campaign folder.")]) -> 
 @app.command("replay")
 def replay(
     source: Annotated[Path, typer.Argument(help="Folder of the campaign whose recorded runs are re-evaluated.")],
-    algorithm: Annotated[str, typer.Option("--algorithm", "-a", help="SLAM algorithm to evaluate (built-in: gmapping, karto, odometry).")],
-    out: Annotated[Path, typer.Option("--out", "-o", help="Folder of the new campaign (an existing replay is resumed).")],
+    algorithm: Annotated[
+        str, typer.Option("--algorithm", "-a", help="SLAM algorithm to evaluate (built-in: gmapping, karto, odometry).")
+    ],
+    out: Annotated[
+        Path, typer.Option("--out", "-o", help="Folder of the new campaign (an existing replay is resumed).")
+    ],
     preset: Annotated[str | None, typer.Option("--preset", "-p", help="Named parameter set of the algorithm.")] = None,
-    settings: Annotated[list[str] | None, typer.Option("--set", help="Parameter override key=value (value read as YAML); repeatable.")] = None,
+    settings: Annotated[
+        list[str] | None, typer.Option("--set", help="Parameter override key=value (value read as YAML); repeatable.")
+    ] = None,
     scheduler: SchedulerOpt = None,
     workers: WorkersOpt = None,
 ) -> None:
@@ -175,7 +234,9 @@ def replay(
     console.print(f"note: {REPLAY_NOTE}", highlight=False, soft_wrap=True)
     try:
         with _Progress(console) as progress:
-            result = replay_campaign(source, out, algorithm, preset, params, scheduler=scheduler, workers=workers, on_event=progress)
+            result = replay_campaign(
+                source, out, algorithm, preset, params, scheduler=scheduler, workers=workers, on_event=progress
+            )
     except KeyboardInterrupt:
         typer.echo("interrupted; resume with the same command", err=True)
         raise typer.Exit(EXIT_INTERRUPTED) from None

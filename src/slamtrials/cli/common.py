@@ -87,8 +87,11 @@ def table_one(title: str, confidence: float, last_column: str, last_justify: str
     by the caller."""
     from rich.table import Table
 
-    table = Table(title=title, caption=f"eps_t in m, eps_r in rad: mean and sample std over the runs; +-: half width "
-                                       f"of the {100 * confidence:g} % confidence interval of the mean")
+    table = Table(
+        title=title,
+        caption=f"eps_t in m, eps_r in rad: mean and sample std over the runs; +-: half width "
+        f"of the {100 * confidence:g} % confidence interval of the mean",
+    )
     table.add_column("world", no_wrap=True)
     table.add_column("status")
     table.add_column("runs", justify="right")

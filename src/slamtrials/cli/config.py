@@ -16,7 +16,9 @@ app = make_app(help="Campaign configuration: print a complete, commented default
 
 @app.command("dump")
 def dump(
-    out: Annotated[Path | None, typer.Option("--out", "-o", help="Write the YAML to this file instead of printing it.")] = None,
+    out: Annotated[
+        Path | None, typer.Option("--out", "-o", help="Write the YAML to this file instead of printing it.")
+    ] = None,
 ) -> None:
     """Print a complete campaign config of the defaults, every key commented (edit it, then 'campaign run')."""
     from slamtrials.atomicfile import atomic_write_text

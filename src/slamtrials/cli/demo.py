@@ -16,9 +16,19 @@ from slamtrials.cli.common import make_console
 
 
 def demo(
-    out: Annotated[Path, typer.Option("--out", "-o", help="Campaign folder (an existing demo campaign there is resumed).")] = Path("results/demo"),
-    workers: Annotated[int | None, typer.Option("--workers", "-j", help="Worker processes of the local Dask cluster (default: one per core).")] = None,
-    world: Annotated[list[str] | None, typer.Option("--world", "-w", help="Bundled world or floor-plan file (repeatable; default: three small buildings).")] = None,
+    out: Annotated[
+        Path, typer.Option("--out", "-o", help="Campaign folder (an existing demo campaign there is resumed).")
+    ] = Path("results/demo"),
+    workers: Annotated[
+        int | None,
+        typer.Option("--workers", "-j", help="Worker processes of the local Dask cluster (default: one per core)."),
+    ] = None,
+    world: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--world", "-w", help="Bundled world or floor-plan file (repeatable; default: three small buildings)."
+        ),
+    ] = None,
     seed: Annotated[int, typer.Option("--seed", "-s", help="Root seed of the campaign.")] = 0,
 ) -> None:
     """Run a small campaign (online GMapping, autonomous exploration) on bundled worlds and write its HTML report."""
@@ -34,8 +44,10 @@ def demo(
     worlds = tuple(world) if world else DEMO_WORLDS
     quiet_dask()
     console = make_console()
-    intro = [f"Demo campaign in {out}: {', '.join(worlds)}; per world the runs repeat until its mean error is known "
-             "(99 % confidence, +-0.02 m / +-0.02 rad) or the cap of 10 runs."]
+    intro = [
+        f"Demo campaign in {out}: {', '.join(worlds)}; per world the runs repeat until its mean error is known "
+        "(99 % confidence, +-0.02 m / +-0.02 rad) or the cap of 10 runs."
+    ]
 
     def on_event(event, progress) -> None:
         if intro:  # the first event comes after every check, so bad input stays a one-line error
@@ -52,8 +64,12 @@ def demo(
     console.print(summary_table(campaign.summary, result.confidence, f"Demo campaign {campaign.folder}"))
     for note in campaign.notes:
         console.print(f"note: {note}", highlight=False, soft_wrap=True)
-    console.print(f"{campaign.runs_done} runs done ({campaign.runs_failed} failed) in {campaign.wall_time:.0f} s; "
-                  f"summary: {campaign.summary_csv}", highlight=False, soft_wrap=True)
+    console.print(
+        f"{campaign.runs_done} runs done ({campaign.runs_failed} failed) in {campaign.wall_time:.0f} s; "
+        f"summary: {campaign.summary_csv}",
+        highlight=False,
+        soft_wrap=True,
+    )
     console.print(f"Report: {result.report}", highlight=False, soft_wrap=True)
 
 

@@ -24,23 +24,76 @@ DEFAULT_RULE = SamplingRule()
 
 
 def evaluate(
-    run: Annotated[Path | None, typer.Argument(help="Simulated run folder: sample relations from its ground truth and evaluate its estimate.")] = None,
-    estimate: Annotated[Path | None, typer.Option("--estimate", "-e", help="Estimated trajectory: CARMEN log or TUM file.")] = None,
-    relations: Annotated[Path | None, typer.Option("--relations", "-r", help="Relations file 't1 t2 x y z roll pitch yaw' (real datasets).")] = None,
-    odometry: Annotated[Path | None, typer.Option("--odometry", help="CARMEN log (its ODOM lines, else its laser lines' second triple, as the Freiburg program takes them) or TUM file whose odometry carries unmatched relation timestamps to the nearest estimated pose.")] = None,
-    estimate_pose: Annotated[PoseTriple, typer.Option("--estimate-pose", help="Pose triple of a CARMEN estimate: first (laser pose, e.g. SLAM-corrected; slamtrials' trajectory.clf) or second (raw odometry; what the Freiburg metricEvaluator reads). auto: second for a pose-only log (FLASER 0 lines, a Freiburg-style test log), else first.")] = PoseTriple.auto,
-    tolerance: Annotated[float | None, typer.Option("--tolerance", help="Largest gap (s) between a relation timestamp and the matched pose, inclusive. Default: 0.1 (the Freiburg program's) for files; 0.001 for a RUN, whose estimate shares the simulator's clock, so that a ground-truth pose between two estimated poses is reached through the odometry rather than given a neighbour's pose. inf: the nearest pose whatever the gap (the Freiburg program without -o).")] = None,
-    interpolate: Annotated[bool, typer.Option("--interpolate", help="Interpolate between the poses around each relation timestamp.")] = False,
-    squared: Annotated[bool, typer.Option("--squared", help="Report squared errors (m^2, rad^2) instead of absolute ones.")] = False,
-    allow_outside: Annotated[bool, typer.Option("--allow-outside", help="Report relations outside the estimate's time span as unmatched instead of refusing them.")] = False,
-    errors_out: Annotated[Path | None, typer.Option("--errors", help="Write per-relation errors here (.npz, or a text table).")] = None,
+    run: Annotated[
+        Path | None,
+        typer.Argument(help="Simulated run folder: sample relations from its ground truth and evaluate its estimate."),
+    ] = None,
+    estimate: Annotated[
+        Path | None, typer.Option("--estimate", "-e", help="Estimated trajectory: CARMEN log or TUM file.")
+    ] = None,
+    relations: Annotated[
+        Path | None,
+        typer.Option("--relations", "-r", help="Relations file 't1 t2 x y z roll pitch yaw' (real datasets)."),
+    ] = None,
+    odometry: Annotated[
+        Path | None,
+        typer.Option(
+            "--odometry",
+            help="CARMEN log (its ODOM lines, else its laser lines' second triple, as the Freiburg program takes them) or TUM file whose odometry carries unmatched relation timestamps to the nearest estimated pose.",
+        ),
+    ] = None,
+    estimate_pose: Annotated[
+        PoseTriple,
+        typer.Option(
+            "--estimate-pose",
+            help="Pose triple of a CARMEN estimate: first (laser pose, e.g. SLAM-corrected; slamtrials' trajectory.clf) or second (raw odometry; what the Freiburg metricEvaluator reads). auto: second for a pose-only log (FLASER 0 lines, a Freiburg-style test log), else first.",
+        ),
+    ] = PoseTriple.auto,
+    tolerance: Annotated[
+        float | None,
+        typer.Option(
+            "--tolerance",
+            help="Largest gap (s) between a relation timestamp and the matched pose, inclusive. Default: 0.1 (the Freiburg program's) for files; 0.001 for a RUN, whose estimate shares the simulator's clock, so that a ground-truth pose between two estimated poses is reached through the odometry rather than given a neighbour's pose. inf: the nearest pose whatever the gap (the Freiburg program without -o).",
+        ),
+    ] = None,
+    interpolate: Annotated[
+        bool, typer.Option("--interpolate", help="Interpolate between the poses around each relation timestamp.")
+    ] = False,
+    squared: Annotated[
+        bool, typer.Option("--squared", help="Report squared errors (m^2, rad^2) instead of absolute ones.")
+    ] = False,
+    allow_outside: Annotated[
+        bool,
+        typer.Option(
+            "--allow-outside",
+            help="Report relations outside the estimate's time span as unmatched instead of refusing them.",
+        ),
+    ] = False,
+    errors_out: Annotated[
+        Path | None, typer.Option("--errors", help="Write per-relation errors here (.npz, or a text table).")
+    ] = None,
     seed: Annotated[int, typer.Option("--seed", "-s", help="Seed of the relation sampling (RUN).")] = 0,
     pilot: Annotated[int, typer.Option("--pilot", help="Pilot pairs of the sampling (RUN).")] = DEFAULT_RULE.pilot,
-    confidence: Annotated[float, typer.Option("--confidence", help="Confidence level of the margins (RUN).")] = DEFAULT_RULE.confidence,
-    margin_t: Annotated[float, typer.Option("--margin-t", help="Margin of error of the mean translational error, m (RUN).")] = DEFAULT_RULE.margin_t,
-    margin_r: Annotated[float, typer.Option("--margin-r", help="Margin of error of the mean rotational error, rad (RUN).")] = DEFAULT_RULE.margin_r,
-    distribution: Annotated[Quantile, typer.Option("--distribution", "--quantile", help="Critical value: normal or Student t with pilot-1 degrees of freedom (RUN).")] = Quantile(DEFAULT_RULE.distribution),
-    sides: Annotated[int, typer.Option("--sides", help="2 for a two-sided quantile, 1 for one-sided (RUN).")] = DEFAULT_RULE.sides,
+    confidence: Annotated[
+        float, typer.Option("--confidence", help="Confidence level of the margins (RUN).")
+    ] = DEFAULT_RULE.confidence,
+    margin_t: Annotated[
+        float, typer.Option("--margin-t", help="Margin of error of the mean translational error, m (RUN).")
+    ] = DEFAULT_RULE.margin_t,
+    margin_r: Annotated[
+        float, typer.Option("--margin-r", help="Margin of error of the mean rotational error, rad (RUN).")
+    ] = DEFAULT_RULE.margin_r,
+    distribution: Annotated[
+        Quantile,
+        typer.Option(
+            "--distribution",
+            "--quantile",
+            help="Critical value: normal or Student t with pilot-1 degrees of freedom (RUN).",
+        ),
+    ] = Quantile(DEFAULT_RULE.distribution),
+    sides: Annotated[
+        int, typer.Option("--sides", help="2 for a two-sided quantile, 1 for one-sided (RUN).")
+    ] = DEFAULT_RULE.sides,
 ) -> None:
     """Localization error (Kuemmerle et al.) of an estimate: Mean, Std, Min, Max, NumMeasures in m and rad."""
     from slamtrials.evaluation import evaluate_files, evaluate_run, format_report
@@ -52,19 +105,41 @@ def evaluate(
         raise ConfigError(f"--tolerance must be a non-negative number of seconds, got {tolerance}")
     if run is not None:
         if relations is not None or odometry is not None:
-            raise ConfigError("with a RUN folder, relations are sampled from its ground truth and its odometry is used: drop --relations and --odometry")
+            raise ConfigError(
+                "with a RUN folder, relations are sampled from its ground truth and its odometry is used: drop --relations and --odometry"
+            )
         if seed < 0:
             raise ConfigError(f"--seed must be a non-negative integer, got {seed}")
-        rule = sampling_rule(pilot=pilot, confidence=confidence, margin_t=margin_t, margin_r=margin_r,
-                             distribution=distribution.value, sides=sides, squared=squared)
-        result = evaluate_run(run, estimate=estimate, estimate_pose=estimate_pose, seed=seed, rule=rule,
-                              tolerance=tolerance, interpolate=interpolate)
+        rule = sampling_rule(
+            pilot=pilot,
+            confidence=confidence,
+            margin_t=margin_t,
+            margin_r=margin_r,
+            distribution=distribution.value,
+            sides=sides,
+            squared=squared,
+        )
+        result = evaluate_run(
+            run,
+            estimate=estimate,
+            estimate_pose=estimate_pose,
+            seed=seed,
+            rule=rule,
+            tolerance=tolerance,
+            interpolate=interpolate,
+        )
     else:
         if estimate is None or relations is None:
             raise ConfigError("give a RUN folder, or both --estimate FILE and --relations FILE")
         result = evaluate_files(
-            estimate, relations, odometry=odometry, estimate_pose=estimate_pose, tolerance=tolerance,
-            interpolate=interpolate, squared=squared, allow_outside=allow_outside,
+            estimate,
+            relations,
+            odometry=odometry,
+            estimate_pose=estimate_pose,
+            tolerance=tolerance,
+            interpolate=interpolate,
+            squared=squared,
+            allow_outside=allow_outside,
         )
     if errors_out is not None:
         written = write_errors(errors_out, result.relations, result.errors)
@@ -77,8 +152,10 @@ def sampling_rule(**values: object) -> SamplingRule:
     try:
         return SamplingRule.model_validate(values)
     except ValidationError as exc:
-        problems = "; ".join(f"--{'-'.join(str(p) for p in e['loc']).replace('_', '-')} = {e['input']!r}: {e['msg']}"
-                             for e in exc.errors())
+        problems = "; ".join(
+            f"--{'-'.join(str(p) for p in e['loc']).replace('_', '-')} = {e['input']!r}: {e['msg']}"
+            for e in exc.errors()
+        )
         raise ConfigError(problems) from None
 
 

@@ -39,7 +39,9 @@ def _say_compiling(kernel: str) -> None:
 @app.callback()
 def root(
     ctx: typer.Context,
-    version: Annotated[bool, typer.Option("--version", callback=_version, is_eager=True, help="Print the version and exit.")] = False,
+    version: Annotated[
+        bool, typer.Option("--version", callback=_version, is_eager=True, help="Print the version and exit.")
+    ] = False,
     verbose: Annotated[bool, typer.Option("--verbose", "-v", help="Log progress details to stderr.")] = False,
 ) -> None:
     """slamtrials: repeatable SLAM evaluation in simulated buildings."""
@@ -48,18 +50,14 @@ def root(
     from slamtrials.compilewatch import watch_compilation
 
     matplotlib.use("Agg")
-    logging.basicConfig(level=logging.INFO if verbose else logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    logging.basicConfig(
+        level=logging.INFO if verbose else logging.WARNING, format="%(levelname)s %(name)s: %(message)s"
+    )
     ctx.call_on_close(watch_compilation(_say_compiling if sys.stderr.isatty() else None))
 
 
 def _register_commands() -> None:
-    from slamtrials.cli import demo, simulate, worlds
-    from slamtrials.cli import transfer
-    from slamtrials.cli import evaluate
-    from slamtrials.cli import slam
-    from slamtrials.cli import trial
-    from slamtrials.cli import campaign, config
-    from slamtrials.cli import report
+    from slamtrials.cli import campaign, config, demo, evaluate, report, simulate, slam, transfer, trial, worlds
 
     app.add_typer(worlds.app, name="worlds", help="List, show, load and generate floor plans.")
     simulate.register(app)

@@ -49,9 +49,18 @@ def _agg() -> None:
 
 def report(
     campaign: Annotated[Path, typer.Argument(help="Campaign folder (finished or still running; it is only read).")],
-    out: Annotated[Path | None, typer.Option("--out", "-o", help="Folder of the page and its figures (default: CAMPAIGN/report).")] = None,
-    run: Annotated[str | None, typer.Option("--run", help="Run of the relation-sampling check (Fig. 3) as WORLD/IDX (default: the first finished run).")] = None,
-    repeats: Annotated[int, typer.Option("--repeats", help="Samplings of the relation-sampling check (the paper: 200).")] = 200,
+    out: Annotated[
+        Path | None, typer.Option("--out", "-o", help="Folder of the page and its figures (default: CAMPAIGN/report).")
+    ] = None,
+    run: Annotated[
+        str | None,
+        typer.Option(
+            "--run", help="Run of the relation-sampling check (Fig. 3) as WORLD/IDX (default: the first finished run)."
+        ),
+    ] = None,
+    repeats: Annotated[
+        int, typer.Option("--repeats", help="Samplings of the relation-sampling check (the paper: 200).")
+    ] = 200,
     seed: Annotated[int, typer.Option("--seed", help="Seed of those samplings.")] = 0,
     pdf: Annotated[bool, typer.Option("--pdf/--no-pdf", help="Also save every figure as PDF.")] = True,
 ) -> None:
@@ -75,7 +84,9 @@ def worlds_table(data):
     for _, w in data.worlds.iterrows():
         needed = w["runs_needed"]
         runs = f"{w['runs_done']}" + (f"/{needed}" if pd.notna(needed) and int(needed) > w["runs_done"] else "")
-        cells = [fmt_number(w[f"{m}_{s}"], d) for m, d in (("eps_t", 3), ("eps_r", 4)) for s in ("mean", "std", "half_width")]
+        cells = [
+            fmt_number(w[f"{m}_{s}"], d) for m, d in (("eps_t", 3), ("eps_r", 4)) for s in ("mean", "std", "half_width")
+        ]
         outliers = f"{w['eps_t_outliers']}/{w['eps_r_outliers']}" if (done["world"] == w["world"]).any() else "-"
         table.add_row(str(w["world"]), str(w["status"]), runs, *cells, outliers)
     return table
@@ -88,27 +99,55 @@ def comparison_table(comparison, metric: str):
     name_a, name_b = comparison.labels
     unit = "m" if metric == "eps_t" else "rad"
     digits = 3 if metric == "eps_t" else 4
-    table = Table(title=f"{metric} ({unit}): {name_b} vs {name_a}, difference of mean errors B \u2212 A (lower is better)",
-                  caption=f"{1 - comparison.alpha:.0%} Welch interval; p adjusted by {comparison.correction}; trap: share of "
-                          "single-run pairs that reverse the means (paper Fig. 6)")
-    for column, justify in (("world", "left"), ("runs A/B", "right"), ("mean A", "right"), ("mean B", "right"),
-                            ("B \u2212 A [CI]", "right"), ("p adj", "right"), ("verdict", "left"), ("trap", "right")):
+    table = Table(
+        title=f"{metric} ({unit}): {name_b} vs {name_a}, difference of mean errors B \u2212 A (lower is better)",
+        caption=f"{1 - comparison.alpha:.0%} Welch interval; p adjusted by {comparison.correction}; trap: share of "
+        "single-run pairs that reverse the means (paper Fig. 6)",
+    )
+    for column, justify in (
+        ("world", "left"),
+        ("runs A/B", "right"),
+        ("mean A", "right"),
+        ("mean B", "right"),
+        ("B \u2212 A [CI]", "right"),
+        ("p adj", "right"),
+        ("verdict", "left"),
+        ("trap", "right"),
+    ):
         table.add_column(column, justify=justify, no_wrap=column not in ("world", "verdict"))
-    short = {"A better": f"{name_a} better", "B better": f"{name_b} better", "no significant difference": "no sig. difference"}
+    short = {
+        "A better": f"{name_a} better",
+        "B better": f"{name_b} better",
+        "no significant difference": "no sig. difference",
+    }
     for _, r in comparison.for_metric(metric).iterrows():
         trap = "-" if r["trap_fraction"] != r["trap_fraction"] else f"{r['trap_fraction']:.0%}"
-        table.add_row(str(r["world"]), f"{r['n_a']}/{r['n_b']}", fmt_number(r["mean_a"], digits), fmt_number(r["mean_b"], digits),
-                      f"{fmt_number(r['difference'], digits)} [{fmt_number(r['ci_low'], digits)}, {fmt_number(r['ci_high'], digits)}]",
-                      fmt_number(r["p_adjusted"], 4), short.get(r["verdict"], r["verdict"]), trap)
+        table.add_row(
+            str(r["world"]),
+            f"{r['n_a']}/{r['n_b']}",
+            fmt_number(r["mean_a"], digits),
+            fmt_number(r["mean_b"], digits),
+            f"{fmt_number(r['difference'], digits)} [{fmt_number(r['ci_low'], digits)}, {fmt_number(r['ci_high'], digits)}]",
+            fmt_number(r["p_adjusted"], 4),
+            short.get(r["verdict"], r["verdict"]),
+            trap,
+        )
     return table
 
 
 def compare(
     campaign_a: Annotated[Path, typer.Argument(help="Campaign A (e.g. the original).")],
     campaign_b: Annotated[Path, typer.Argument(help="Campaign B (e.g. another algorithm, or a replay of A).")],
-    out: Annotated[Path | None, typer.Option("--out", "-o", help="Folder of compare.html and comparison.csv (default: B/report/compare-<A>).")] = None,
-    alpha: Annotated[float, typer.Option("--alpha", help="Significance level; intervals have confidence 1 - alpha.")] = 0.05,
-    correction: Annotated[CorrectionChoice, typer.Option("--correction", help="Correction for multiple comparisons across worlds.")] = CorrectionChoice.holm,
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", "-o", help="Folder of compare.html and comparison.csv (default: B/report/compare-<A>)."),
+    ] = None,
+    alpha: Annotated[
+        float, typer.Option("--alpha", help="Significance level; intervals have confidence 1 - alpha.")
+    ] = 0.05,
+    correction: Annotated[
+        CorrectionChoice, typer.Option("--correction", help="Correction for multiple comparisons across worlds.")
+    ] = CorrectionChoice.holm,
     pdf: Annotated[bool, typer.Option("--pdf/--no-pdf", help="Also save every figure as PDF.")] = True,
 ) -> None:
     """Compare two campaigns on the same worlds: Welch intervals, corrected p-values, verdicts, the Fig. 6 trap."""
@@ -138,8 +177,12 @@ def compare(
 def export_table(
     campaign: Annotated[Path, typer.Argument(help="Campaign folder.")],
     fmt: Annotated[FormatChoice, typer.Option("--format", "-f", help="File format.")] = FormatChoice.csv,
-    table: Annotated[TableChoice, typer.Option("--table", "-t", help="runs: one row per run; worlds: one row per world (Table I).")] = TableChoice.runs,
-    out: Annotated[Path | None, typer.Option("--out", "-o", help="File to write (default: CAMPAIGN/<table>.<format>).")] = None,
+    table: Annotated[
+        TableChoice, typer.Option("--table", "-t", help="runs: one row per run; worlds: one row per world (Table I).")
+    ] = TableChoice.runs,
+    out: Annotated[
+        Path | None, typer.Option("--out", "-o", help="File to write (default: CAMPAIGN/<table>.<format>).")
+    ] = None,
 ) -> None:
     """Write a campaign's runs (or worlds) table as CSV or Parquet."""
     from slamtrials.report.load import export_table as export

@@ -12,17 +12,30 @@ from slamtrials.cli.common import make_console
 from slamtrials.errors import ConfigError
 
 
-
 def simulate(
     world: Annotated[str, typer.Option("--world", "-w", help="Bundled world name or floor-plan file.")],
     out: Annotated[Path, typer.Option("--out", "-o", help="Run folder to write (frames.npz, run.json, run.png).")],
-    path: Annotated[Path | None, typer.Option("--path", "-p", help="Waypoint YAML ('waypoints: [\\[x, y], ...]', metres, world frame).")] = None,
-    tour: Annotated[bool, typer.Option("--tour", help="Instead of --path, drive an automatic tour to the far corners of the world.")] = False,
-    seed: Annotated[int, typer.Option("--seed", "-s", help="Seed of every random draw of the run (odometry bias, noise).")] = 0,
+    path: Annotated[
+        Path | None,
+        typer.Option("--path", "-p", help="Waypoint YAML ('waypoints: [\\[x, y], ...]', metres, world frame)."),
+    ] = None,
+    tour: Annotated[
+        bool, typer.Option("--tour", help="Instead of --path, drive an automatic tour to the far corners of the world.")
+    ] = False,
+    seed: Annotated[
+        int, typer.Option("--seed", "-s", help="Seed of every random draw of the run (odometry bias, noise).")
+    ] = 0,
     max_time: Annotated[float, typer.Option("--max-time", help="Stop after this much simulated time (s).")] = 3600.0,
-    resolution: Annotated[float | None, typer.Option("--resolution", help="Metres per pixel, for a bare PNG/PGM floor plan.")] = None,
+    resolution: Annotated[
+        float | None, typer.Option("--resolution", help="Metres per pixel, for a bare PNG/PGM floor plan.")
+    ] = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace a run already stored in --out.")] = False,
-    config: Annotated[Path | None, typer.Option("--config", "-c", help="YAML with robot/laser/odometry/dt settings (SI units); default: the paper's.")] = None,
+    config: Annotated[
+        Path | None,
+        typer.Option(
+            "--config", "-c", help="YAML with robot/laser/odometry/dt settings (SI units); default: the paper's."
+        ),
+    ] = None,
 ) -> None:
     """Simulate the robot driving through WAYPOINTS (or a --tour) and record laser, odometry and ground truth."""
     from slamtrials.io.runfolder import RunFolder, write_run

@@ -45,22 +45,55 @@ def parse_settings(settings: list[str]) -> dict[str, Any]:
 
 
 def slam(
-    algorithm: Annotated[str, typer.Option("--algorithm", "-a", help="Registered SLAM algorithm (built-in: gmapping, karto, odometry).")],
-    input_: Annotated[Path, typer.Option("--input", "-i", help="Run folder, CARMEN log (.clf/.log, .gz, .bz2) or ROS bag.")],
-    out: Annotated[Path, typer.Option("--out", "-o", help="Folder for trajectory.tum/.clf, map.yaml/.pgm/.png, timing.csv, slam.json.")],
+    algorithm: Annotated[
+        str, typer.Option("--algorithm", "-a", help="Registered SLAM algorithm (built-in: gmapping, karto, odometry).")
+    ],
+    input_: Annotated[
+        Path, typer.Option("--input", "-i", help="Run folder, CARMEN log (.clf/.log, .gz, .bz2) or ROS bag.")
+    ],
+    out: Annotated[
+        Path,
+        typer.Option("--out", "-o", help="Folder for trajectory.tum/.clf, map.yaml/.pgm/.png, timing.csv, slam.json."),
+    ],
     preset: Annotated[str | None, typer.Option("--preset", "-p", help="Named parameter set of the algorithm.")] = None,
-    settings: Annotated[list[str] | None, typer.Option("--set", help="Parameter override key=value (value read as YAML); repeatable.")] = None,
+    settings: Annotated[
+        list[str] | None, typer.Option("--set", help="Parameter override key=value (value read as YAML); repeatable.")
+    ] = None,
     seed: Annotated[int, typer.Option("--seed", "-s", help="Seed of the algorithm's random draws.")] = 0,
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace SLAM outputs already in --out.")] = False,
-    runs: Annotated[str | None, typer.Option("--runs", help="Repeat with seeds 0..N-1 (N >= 2), or 'auto' for the paper's Section III-C rule; needs --relations.")] = None,
-    relations: Annotated[Path | None, typer.Option("--relations", "-r", help="The dataset's relations file; with --runs every run is scored on it.")] = None,
-    confidence: Annotated[float, typer.Option("--confidence", help="Confidence level of the interval of the mean (and of --runs auto).")] = 0.95,
-    margin_t: Annotated[float, typer.Option("--margin-t", help="--runs auto: margin of the mean translational error (m).")] = 0.02,
-    margin_r: Annotated[float, typer.Option("--margin-r", help="--runs auto: margin of the mean rotational error (rad).")] = 0.02,
+    runs: Annotated[
+        str | None,
+        typer.Option(
+            "--runs",
+            help="Repeat with seeds 0..N-1 (N >= 2), or 'auto' for the paper's Section III-C rule; needs --relations.",
+        ),
+    ] = None,
+    relations: Annotated[
+        Path | None,
+        typer.Option("--relations", "-r", help="The dataset's relations file; with --runs every run is scored on it."),
+    ] = None,
+    confidence: Annotated[
+        float, typer.Option("--confidence", help="Confidence level of the interval of the mean (and of --runs auto).")
+    ] = 0.95,
+    margin_t: Annotated[
+        float, typer.Option("--margin-t", help="--runs auto: margin of the mean translational error (m).")
+    ] = 0.02,
+    margin_r: Annotated[
+        float, typer.Option("--margin-r", help="--runs auto: margin of the mean rotational error (rad).")
+    ] = 0.02,
     max_runs: Annotated[int, typer.Option("--max-runs", help="--runs auto: cap on the runs.")] = 60,
-    tolerance: Annotated[float, typer.Option("--tolerance", help="Largest gap (s) between a relation timestamp and a frame (the Freiburg program's 0.1).")] = 0.1,
-    workers: Annotated[int | None, typer.Option("--workers", help="Local Dask workers for --runs (default: one per core).")] = None,
-    scheduler: Annotated[str | None, typer.Option("--scheduler", help="Address of a running Dask scheduler for --runs.")] = None,
+    tolerance: Annotated[
+        float,
+        typer.Option(
+            "--tolerance", help="Largest gap (s) between a relation timestamp and a frame (the Freiburg program's 0.1)."
+        ),
+    ] = 0.1,
+    workers: Annotated[
+        int | None, typer.Option("--workers", help="Local Dask workers for --runs (default: one per core).")
+    ] = None,
+    scheduler: Annotated[
+        str | None, typer.Option("--scheduler", help="Address of a running Dask scheduler for --runs.")
+    ] = None,
 ) -> None:
     """Run SLAM algorithm ALGORITHM over a recording and write its trajectory, map and timings.
 
@@ -76,9 +109,23 @@ def slam(
     if runs is not None or relations is not None:
         if runs is None or relations is None:
             raise ConfigError("--runs and --relations go together: give both to repeat SLAM on a dataset")
-        _repeat(algorithm, input_, out, preset, parse_settings(settings or []), runs, relations, confidence=confidence,
-                margin_t=margin_t, margin_r=margin_r, max_runs=max_runs, tolerance=tolerance, workers=workers,
-                scheduler=scheduler, overwrite=overwrite)
+        _repeat(
+            algorithm,
+            input_,
+            out,
+            preset,
+            parse_settings(settings or []),
+            runs,
+            relations,
+            confidence=confidence,
+            margin_t=margin_t,
+            margin_r=margin_r,
+            max_runs=max_runs,
+            tolerance=tolerance,
+            workers=workers,
+            scheduler=scheduler,
+            overwrite=overwrite,
+        )
         return
     if seed < 0:
         raise ConfigError(f"--seed must be a non-negative integer, got {seed}")
@@ -93,18 +140,43 @@ def slam(
     columns = (TextColumn(f"{algorithm}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
     with Progress(*columns, console=console, transient=True, disable=not console.is_terminal) as progress:
         task = progress.add_task("slam", total=len(record))
-        result = run_slam(record, algorithm, preset=preset, overrides=overrides, seed=seed, source=str(input_),
-                          on_frame=lambda k, total: progress.update(task, completed=k + 1))
+        result = run_slam(
+            record,
+            algorithm,
+            preset=preset,
+            overrides=overrides,
+            seed=seed,
+            source=str(input_),
+            on_frame=lambda k, total: progress.update(task, completed=k + 1),
+        )
     written = write_slam_outputs(result, out, overwrite=overwrite)
     mean_ms = 1000.0 * float(result.timing.mean())
     names = ", ".join(p.name for p in written)
-    console.print(f"{out}: {len(record)} frames, {result.updates} updates, {mean_ms:.2f} ms per frame; wrote {names}",
-                  soft_wrap=True, highlight=False)
+    console.print(
+        f"{out}: {len(record)} frames, {result.updates} updates, {mean_ms:.2f} ms per frame; wrote {names}",
+        soft_wrap=True,
+        highlight=False,
+    )
 
 
-def _repeat(algorithm: str, input_: Path, out: Path, preset: str | None, overrides: dict[str, Any], runs: str,
-            relations: Path, *, confidence: float, margin_t: float, margin_r: float, max_runs: int, tolerance: float,
-            workers: int | None, scheduler: str | None, overwrite: bool) -> None:
+def _repeat(
+    algorithm: str,
+    input_: Path,
+    out: Path,
+    preset: str | None,
+    overrides: dict[str, Any],
+    runs: str,
+    relations: Path,
+    *,
+    confidence: float,
+    margin_t: float,
+    margin_r: float,
+    max_runs: int,
+    tolerance: float,
+    workers: int | None,
+    scheduler: str | None,
+    overwrite: bool,
+) -> None:
     """``slam --runs``: SLAM repeated on a dataset (:func:`slamtrials.repeat.repeat_slam`)."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
@@ -114,8 +186,17 @@ def _repeat(algorithm: str, input_: Path, out: Path, preset: str | None, overrid
     from slamtrials.slamrun import load_recording
 
     count: int | Literal["auto"] = "auto" if runs.strip().lower() == "auto" else _int_option("--runs", runs)
-    settings = RepeatSettings(algorithm=algorithm, preset=preset, overrides=overrides, runs=count, confidence=confidence,
-                              margin_t=margin_t, margin_r=margin_r, max_runs=max_runs, tolerance=tolerance)
+    settings = RepeatSettings(
+        algorithm=algorithm,
+        preset=preset,
+        overrides=overrides,
+        runs=count,
+        confidence=confidence,
+        margin_t=margin_t,
+        margin_r=margin_r,
+        max_runs=max_runs,
+        tolerance=tolerance,
+    )
     if (out / "summary.json").exists() and not overwrite:
         raise ConfigError(f"{out}: already holds a repeated experiment; choose another --out or pass --overwrite")
     resolve_config(get_algorithm(algorithm), preset=preset, overrides=overrides)  # fail before reading the input
@@ -124,12 +205,25 @@ def _repeat(algorithm: str, input_: Path, out: Path, preset: str | None, overrid
     console = make_console()
     quiet_dask()
     planned = settings.initial if count == "auto" else int(count)
-    with Progress(TextColumn(f"{algorithm} runs"), BarColumn(), MofNCompleteColumn(), console=console, transient=True,
-                  disable=not console.is_terminal) as progress:
+    with Progress(
+        TextColumn(f"{algorithm} runs"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        console=console,
+        transient=True,
+        disable=not console.is_terminal,
+    ) as progress:
         task = progress.add_task("runs", total=planned)
-        result = repeat_slam(record, rel, settings, scheduler=scheduler, workers=workers, source=str(input_),
-                             relations_source=str(relations),
-                             on_run=lambda run, total: progress.update(task, advance=1, total=total))
+        result = repeat_slam(
+            record,
+            rel,
+            settings,
+            scheduler=scheduler,
+            workers=workers,
+            source=str(input_),
+            relations_source=str(relations),
+            on_run=lambda run, total: progress.update(task, advance=1, total=total),
+        )
     written = write_repeat_outputs(result, out, overwrite=overwrite)
     console.print(format_repeat(result), soft_wrap=True, highlight=False)
     console.print(f"wrote {', '.join(p.name for p in written)} to {out}", soft_wrap=True, highlight=False)
@@ -147,17 +241,25 @@ def format_repeat(result: RepeatedSlam) -> str:
     lines = [f"{'seed':>4}  {'eps_t (m)':>10}  {'eps_r (rad)':>11}  {'relations':>9}  {'updates':>7}  {'seconds':>7}"]
     flagged = dict(zip((r.seed for r in result.runs), result.diverged.diverged.tolist()))
     for r in result.runs:
-        lines.append(f"{r.seed:>4}  {r.eps_t:10.6f}  {r.eps_r:11.6f}  {r.relations:>9}  {r.updates:>7}  {r.seconds:7.1f}"
-                     + ("  diverged" if flagged[r.seed] else ""))
+        lines.append(
+            f"{r.seed:>4}  {r.eps_t:10.6f}  {r.eps_r:11.6f}  {r.relations:>9}  {r.updates:>7}  {r.seconds:7.1f}"
+            + ("  diverged" if flagged[r.seed] else "")
+        )
     st, sr, level = result.stats_t, result.stats_r, f"{100 * result.settings.confidence:g} %"
-    lines.append(f"translational: mean {st.mean:.6f} m, std {st.std_sample:.6f} m, {level} interval of the mean "
-                 f"[{st.ci_low:.6f}, {st.ci_high:.6f}] (Student t, {st.n} runs)")
-    lines.append(f"rotational:    mean {sr.mean:.6f} rad, std {sr.std_sample:.6f} rad, {level} interval "
-                 f"[{sr.ci_low:.6f}, {sr.ci_high:.6f}]")
+    lines.append(
+        f"translational: mean {st.mean:.6f} m, std {st.std_sample:.6f} m, {level} interval of the mean "
+        f"[{st.ci_low:.6f}, {st.ci_high:.6f}] (Student t, {st.n} runs)"
+    )
+    lines.append(
+        f"rotational:    mean {sr.mean:.6f} rad, std {sr.std_sample:.6f} rad, {level} interval "
+        f"[{sr.ci_low:.6f}, {sr.ci_high:.6f}]"
+    )
     d = result.diverged
-    lines.append(f"diverged: {int(d.diverged.sum())} of {len(result.runs)} runs ({100 * d.share:.0f} %) above "
-                 f"{d.factor:g} x median = {d.threshold:.6f} m; best seed {result.best.seed} ({result.best.eps_t:.6f} m), "
-                 f"worst seed {result.worst.seed} ({result.worst.eps_t:.6f} m)")
+    lines.append(
+        f"diverged: {int(d.diverged.sum())} of {len(result.runs)} runs ({100 * d.share:.0f} %) above "
+        f"{d.factor:g} x median = {d.threshold:.6f} m; best seed {result.best.seed} ({result.best.eps_t:.6f} m), "
+        f"worst seed {result.worst.seed} ({result.worst.eps_t:.6f} m)"
+    )
     if result.rule:
         lines.append(result.rule)
     return "\n".join(lines)

@@ -37,12 +37,27 @@ class Pairing(str, Enum):
 
 def export_run(
     run: Annotated[Path, typer.Argument(metavar="RUN", help="Run folder (frames.npz + run.json).")],
-    to: Annotated[ExportFormat, typer.Option("--to", "-t", help="bag: ROS 1 .bag; bag2: ROS 2 bag folder (MCAP); carmen: CARMEN log; tum: TUM trajectory.")],
+    to: Annotated[
+        ExportFormat,
+        typer.Option(
+            "--to",
+            "-t",
+            help="bag: ROS 1 .bag; bag2: ROS 2 bag folder (MCAP); carmen: CARMEN log; tum: TUM trajectory.",
+        ),
+    ],
     out: Annotated[Path, typer.Option("--out", "-o", help="File (or ROS 2 bag folder) to write.")],
-    what: Annotated[TumSource | None, typer.Option("--what", help="For --to tum: the ground truth (default) or the odometry.")] = None,
-    time_origin: Annotated[int | None, typer.Option("--time-origin-ns", help="For bags: ROS stamp (ns) of t = 0; default 1 s.")] = None,
-    compress: Annotated[bool, typer.Option("--compress", help="For bags: LZ4 chunks (ROS 1) or zstd MCAP chunks (ROS 2).")] = False,
-    carmen_kind: Annotated[str, typer.Option("--carmen-kind", help="For --to carmen: ROBOTLASER1 (geometry on every line) or FLASER.")] = "ROBOTLASER1",
+    what: Annotated[
+        TumSource | None, typer.Option("--what", help="For --to tum: the ground truth (default) or the odometry.")
+    ] = None,
+    time_origin: Annotated[
+        int | None, typer.Option("--time-origin-ns", help="For bags: ROS stamp (ns) of t = 0; default 1 s.")
+    ] = None,
+    compress: Annotated[
+        bool, typer.Option("--compress", help="For bags: LZ4 chunks (ROS 1) or zstd MCAP chunks (ROS 2).")
+    ] = False,
+    carmen_kind: Annotated[
+        str, typer.Option("--carmen-kind", help="For --to carmen: ROBOTLASER1 (geometry on every line) or FLASER.")
+    ] = "ROBOTLASER1",
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace an existing --out.")] = False,
 ) -> None:
     """Export a run's laser, odometry and ground truth as a ROS bag (Stage topics), a CARMEN log or a TUM file."""
@@ -58,8 +73,14 @@ def export_run(
     record = read_run(run)
     try:
         summary = export_record(
-            record, out, to.value, tum_source=(what or TumSource.truth).value, time_origin_ns=time_origin,
-            compress=compress, carmen_kind=carmen_kind, overwrite=overwrite,
+            record,
+            out,
+            to.value,
+            tum_source=(what or TumSource.truth).value,
+            time_origin_ns=time_origin,
+            compress=compress,
+            carmen_kind=carmen_kind,
+            overwrite=overwrite,
         )
     except ConfigError as exc:
         raise ConfigError(f"{run}: {exc}") from None
@@ -67,15 +88,37 @@ def export_run(
 
 
 def import_run(
-    source: Annotated[Path, typer.Argument(metavar="FILE", help="ROS 1 .bag, ROS 2 bag folder or .mcap, or CARMEN log (.clf, .log, .gz, .bz2).")],
+    source: Annotated[
+        Path,
+        typer.Argument(
+            metavar="FILE", help="ROS 1 .bag, ROS 2 bag folder or .mcap, or CARMEN log (.clf, .log, .gz, .bz2)."
+        ),
+    ],
     out: Annotated[Path, typer.Option("--out", "-o", help="Run folder to write (frames.npz, run.json).")],
-    fmt: Annotated[ImportFormat, typer.Option("--format", "-f", help="Input format; auto: from the name and first bytes.")] = ImportFormat.auto,
-    scan_topic: Annotated[str | None, typer.Option("--scan-topic", help="Bag: sensor_msgs/LaserScan topic \\[default: /base_scan].")] = None,
-    odom_topic: Annotated[str | None, typer.Option("--odom-topic", help="Bag: nav_msgs/Odometry topic \\[default: /odom].")] = None,
-    truth_topic: Annotated[str | None, typer.Option("--truth-topic", help="Bag: ground-truth nav_msgs/Odometry topic \\[default: /base_pose_ground_truth].")] = None,
-    no_truth: Annotated[bool, typer.Option("--no-truth", help="Bag: the recording has no ground truth (truth becomes NaN).")] = False,
-    use_tf: Annotated[bool, typer.Option("--use-tf", help="Bag: odometry from the odom -> base_link transforms on /tf.")] = False,
-    pairing: Annotated[Pairing, typer.Option("--pairing", help="Bag: poses at scan stamps by interpolation or the latest before.")] = Pairing.interpolate,
+    fmt: Annotated[
+        ImportFormat, typer.Option("--format", "-f", help="Input format; auto: from the name and first bytes.")
+    ] = ImportFormat.auto,
+    scan_topic: Annotated[
+        str | None, typer.Option("--scan-topic", help="Bag: sensor_msgs/LaserScan topic \\[default: /base_scan].")
+    ] = None,
+    odom_topic: Annotated[
+        str | None, typer.Option("--odom-topic", help="Bag: nav_msgs/Odometry topic \\[default: /odom].")
+    ] = None,
+    truth_topic: Annotated[
+        str | None,
+        typer.Option(
+            "--truth-topic", help="Bag: ground-truth nav_msgs/Odometry topic \\[default: /base_pose_ground_truth]."
+        ),
+    ] = None,
+    no_truth: Annotated[
+        bool, typer.Option("--no-truth", help="Bag: the recording has no ground truth (truth becomes NaN).")
+    ] = False,
+    use_tf: Annotated[
+        bool, typer.Option("--use-tf", help="Bag: odometry from the odom -> base_link transforms on /tf.")
+    ] = False,
+    pairing: Annotated[
+        Pairing, typer.Option("--pairing", help="Bag: poses at scan stamps by interpolation or the latest before.")
+    ] = Pairing.interpolate,
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace a run already stored in --out.")] = False,
 ) -> None:
     """Import a ROS bag or a CARMEN log as a run folder, so recordings (also of real robots) can be evaluated."""
@@ -99,11 +142,18 @@ def import_run(
             pairing=pairing.value,
         )
     else:
-        bag_options = {"--scan-topic": scan_topic, "--odom-topic": odom_topic, "--truth-topic": truth_topic,
-                       "--no-truth": no_truth or None, "--use-tf": use_tf or None}
+        bag_options = {
+            "--scan-topic": scan_topic,
+            "--odom-topic": odom_topic,
+            "--truth-topic": truth_topic,
+            "--no-truth": no_truth or None,
+            "--use-tf": use_tf or None,
+        }
         given = [name for name, value in bag_options.items() if value is not None]
         if given:
-            raise ConfigError(f"{', '.join(given)} appl{'ies' if len(given) == 1 else 'y'} to ROS bags, not to CARMEN logs")
+            raise ConfigError(
+                f"{', '.join(given)} appl{'ies' if len(given) == 1 else 'y'} to ROS bags, not to CARMEN logs"
+            )
         record = read_carmen_run(source)
     record.metadata.setdefault("imported_from", str(source))
     write_run(out, record)

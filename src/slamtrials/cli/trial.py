@@ -13,13 +13,26 @@ from slamtrials.errors import ConfigError
 __all__ = ["trial", "register"]
 
 
-
 def trial(
     world: Annotated[str, typer.Option("--world", "-w", help="Bundled world name or floor-plan file.")],
-    out: Annotated[Path, typer.Option("--out", "-o", help="Run folder to write (frames.npz, estimate.tum, map.yaml/.pgm/.png, run.json, run.png).")],
-    seed: Annotated[int, typer.Option("--seed", "-s", help="Seed of every random draw of the trial (simulator and SLAM).")] = 0,
-    config: Annotated[Path | None, typer.Option("--config", "-c", help="YAML with sim/slam/explore/termination settings; default: the paper's set-up.")] = None,
-    resolution: Annotated[float | None, typer.Option("--resolution", help="Metres per pixel, for a bare PNG/PGM floor plan.")] = None,
+    out: Annotated[
+        Path,
+        typer.Option(
+            "--out", "-o", help="Run folder to write (frames.npz, estimate.tum, map.yaml/.pgm/.png, run.json, run.png)."
+        ),
+    ],
+    seed: Annotated[
+        int, typer.Option("--seed", "-s", help="Seed of every random draw of the trial (simulator and SLAM).")
+    ] = 0,
+    config: Annotated[
+        Path | None,
+        typer.Option(
+            "--config", "-c", help="YAML with sim/slam/explore/termination settings; default: the paper's set-up."
+        ),
+    ] = None,
+    resolution: Annotated[
+        float | None, typer.Option("--resolution", help="Metres per pixel, for a bare PNG/PGM floor plan.")
+    ] = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace a run already stored in --out.")] = False,
 ) -> None:
     """Let the robot explore WORLD on its own, mapped online by SLAM, until the map stops changing."""
@@ -48,8 +61,11 @@ def trial(
         task = progress.add_task(f"{the_world.name} seed {seed}", total=trial_config.termination.max_time, status="")
 
         def report(p) -> None:
-            progress.update(task, completed=p.t,
-                            status=f"{p.t:6.0f} s simulated, {p.known_free_area:7.0f} of {p.reachable_area:.0f} m^2 mapped")
+            progress.update(
+                task,
+                completed=p.t,
+                status=f"{p.t:6.0f} s simulated, {p.known_free_area:7.0f} of {p.reachable_area:.0f} m^2 mapped",
+            )
 
         record = run_trial(the_world, trial_config, seed, on_progress=report)
     record.metadata.update(world_source=str(world))
@@ -61,7 +77,9 @@ def trial(
         f"{out}: {info.termination_reason} after {info.duration_s:.0f} s simulated in {info.wall_time_s:.1f} s "
         f"({info.realtime_factor:.0f}x real time); mapped {100 * info.mapped_fraction:.1f} % of the reachable "
         f"{info.reachable_area_m2:.0f} m^2, travelled {info.distance_m:.0f} m, {info.slam_updates} SLAM updates",
-        soft_wrap=True, highlight=False)
+        soft_wrap=True,
+        highlight=False,
+    )
 
 
 def register(app: typer.Typer) -> None:

@@ -14,8 +14,16 @@ app = make_app(help="List, show, describe and generate floor plans.")
 
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg")
 
-WorldArg = Annotated[str, typer.Argument(metavar="NAME_OR_FILE", help="Bundled world name (see 'slamtrials worlds list') or floor-plan file (.png/.pgm, .yaml, .world, .json).")]
-ResolutionOpt = Annotated[float | None, typer.Option("--resolution", "-r", help="Metres per pixel, for a bare PNG/PGM floor plan.")]
+WorldArg = Annotated[
+    str,
+    typer.Argument(
+        metavar="NAME_OR_FILE",
+        help="Bundled world name (see 'slamtrials worlds list') or floor-plan file (.png/.pgm, .yaml, .world, .json).",
+    ),
+]
+ResolutionOpt = Annotated[
+    float | None, typer.Option("--resolution", "-r", help="Metres per pixel, for a bare PNG/PGM floor plan.")
+]
 
 
 def _load(source: str, resolution: float | None):
@@ -36,19 +44,34 @@ def list_worlds() -> None:
 
     table = Table(title="Bundled worlds (slamtrials worlds show NAME -o NAME.png)")
     table.add_column("name", no_wrap=True)
-    for column, justify in (("kind", "left"), ("shape", "left"), ("area m\u00b2", "right"),
-                            ("free m\u00b2", "right"), ("size m", "right"), ("rooms", "right")):
+    for column, justify in (
+        ("kind", "left"),
+        ("shape", "left"),
+        ("area m\u00b2", "right"),
+        ("free m\u00b2", "right"),
+        ("size m", "right"),
+        ("rooms", "right"),
+    ):
         table.add_column(column, justify=justify)
     for e in catalog_entries():
-        table.add_row(e["name"], e["kind"], e.get("shape", ""), f"{e['area_m2']:,.0f}", f"{e['free_area_m2']:,.0f}",
-                      f"{e['width_m']:.0f} \u00d7 {e['height_m']:.0f}", str(e.get("rooms", "")))
+        table.add_row(
+            e["name"],
+            e["kind"],
+            e.get("shape", ""),
+            f"{e['area_m2']:,.0f}",
+            f"{e['free_area_m2']:,.0f}",
+            f"{e['width_m']:.0f} \u00d7 {e['height_m']:.0f}",
+            str(e.get("rooms", "")),
+        )
     make_console().print(table)
 
 
 @app.command("show")
 def show(
     world: WorldArg,
-    out: Annotated[Path | None, typer.Option("--out", "-o", help="Picture to write (.png, .pdf, .svg); default NAME.png.")] = None,
+    out: Annotated[
+        Path | None, typer.Option("--out", "-o", help="Picture to write (.png, .pdf, .svg); default NAME.png.")
+    ] = None,
     resolution: ResolutionOpt = None,
     dpi: Annotated[int, typer.Option("--dpi", help="Dots per inch of the picture.", min=30, max=600)] = 120,
 ) -> None:
@@ -58,7 +81,9 @@ def show(
     the_world = _load(world, resolution)
     out = out if out is not None else Path(f"{the_world.name}.png")
     if out.suffix.lower() not in FIGURE_SUFFIXES:
-        raise ConfigError(f"--out {out}: unknown picture format {out.suffix!r}; use one of {', '.join(FIGURE_SUFFIXES)}")
+        raise ConfigError(
+            f"--out {out}: unknown picture format {out.suffix!r}; use one of {', '.join(FIGURE_SUFFIXES)}"
+        )
     save_world_figure(the_world, out, dpi=dpi)
     typer.echo(f"wrote {out}")
 
@@ -83,7 +108,10 @@ def info(world: WorldArg, resolution: ResolutionOpt = None) -> None:
         ("origin", "({:.3f}, {:.3f}, {:.3f})".format(*(float(v) for v in the_world.origin))),
         ("free area", f"{the_world.free_area:,.1f} m^2 in {regions} connected region{'s' if regions != 1 else ''}"),
         ("reachable free area", f"{reachable:,.1f} m^2 (from the start pose)"),
-        ("robot-reachable area", f"{by_robot:,.1f} m^2 (the paper's {radius:g} m robot; trials measure coverage on it)"),
+        (
+            "robot-reachable area",
+            f"{by_robot:,.1f} m^2 (the paper's {radius:g} m robot; trials measure coverage on it)",
+        ),
         ("start pose", f"x {x:.3f} m, y {y:.3f} m, theta {theta:.3f} rad"),
     ]
     meta = the_world.metadata
@@ -99,10 +127,16 @@ def info(world: WorldArg, resolution: ResolutionOpt = None) -> None:
 @app.command("generate")
 def generate(
     kind: Annotated[str, typer.Option("--kind", "-k", help="Building kind: office, school, lab, multiwing or house.")],
-    area: Annotated[float, typer.Option("--area", "-a", help="Requested free floor area in m^2 (e.g. 100 to 12,000 for offices).")],
+    area: Annotated[
+        float, typer.Option("--area", "-a", help="Requested free floor area in m^2 (e.g. 100 to 12,000 for offices).")
+    ],
     out: Annotated[Path, typer.Option("--out", "-o", help="ROS map YAML to write (the PNG is written beside it).")],
-    seed: Annotated[int, typer.Option("--seed", "-s", help="Seed; the same kind, area and seed give the same building.")] = 0,
-    name: Annotated[str | None, typer.Option("--name", "-n", help="World name stored in the map; default KIND_AREA_sSEED.")] = None,
+    seed: Annotated[
+        int, typer.Option("--seed", "-s", help="Seed; the same kind, area and seed give the same building.")
+    ] = 0,
+    name: Annotated[
+        str | None, typer.Option("--name", "-n", help="World name stored in the map; default KIND_AREA_sSEED.")
+    ] = None,
     resolution: Annotated[float, typer.Option("--resolution", "-r", help="Metres per pixel (0.01 to 0.2).")] = 0.05,
 ) -> None:
     """Generate a building floor plan and write it as a ROS map (YAML + PNG)."""
@@ -124,5 +158,7 @@ def generate(
     save_rosmap(world, out)
     width, height = world.size_m
     meta = world.metadata
-    typer.echo(f"wrote {out}: {world.name}, {kind} ({meta['shape']}), {world.free_area:,.0f} m^2 free, "
-               f"{width:.1f} x {height:.1f} m, {meta['rooms']} rooms, {len(meta['doors'])} doors, seed {seed}")
+    typer.echo(
+        f"wrote {out}: {world.name}, {kind} ({meta['shape']}), {world.free_area:,.0f} m^2 free, "
+        f"{width:.1f} x {height:.1f} m, {meta['rooms']} rooms, {len(meta['doors'])} doors, seed {seed}"
+    )

@@ -66,8 +66,14 @@ class RobotLimits:
 
 
 #: Names of the robot's limits that earlier versions took in the explore section; now refused there.
-ROBOT_FIELDS = ("robot_radius", "max_linear_speed", "max_angular_speed", "max_linear_accel", "max_angular_accel",
-                "control_period")
+ROBOT_FIELDS = (
+    "robot_radius",
+    "max_linear_speed",
+    "max_angular_speed",
+    "max_linear_accel",
+    "max_angular_accel",
+    "control_period",
+)
 
 
 def lethal_distance(config: ExploreConfig, robot: RobotLimits) -> float:
@@ -122,55 +128,157 @@ class ExploreConfig(BaseModel):
 
     # --- costmap ---------------------------------------------------------------------------------
     inflation_margin: float = Field(0.05, ge=0.0, le=5.0, description="lethal margin added to the radius (m)")
-    relaxed_margin: float = Field(0.0, ge=0.0, le=5.0, description="lethal margin of the last-resort plan through narrow passages (m)")
-    shut_in_share: float = Field(0.5, ge=0.0, le=1.0, description="plan through narrow passages only when the robot reaches less than this share of the passable cells")
+    relaxed_margin: float = Field(
+        0.0, ge=0.0, le=5.0, description="lethal margin of the last-resort plan through narrow passages (m)"
+    )
+    shut_in_share: float = Field(
+        0.5,
+        ge=0.0,
+        le=1.0,
+        description="plan through narrow passages only when the robot reaches less than this share of the passable cells",
+    )
     wall_cost: float = Field(10.0, ge=0.0, le=100.0, description="extra cost factor at the edge of the lethal zone")
     cost_decay_distance: float = Field(0.25, gt=0.0, le=10.0, description="decay length of the wall cost (m)")
     unknown_traversable: bool = Field(False, description="let paths cross unknown cells (at unknown_cost)")
     unknown_cost: float = Field(5.0, ge=1.0, le=20.0, description="cost factor of an unknown cell when traversable")
-    escape_radius: float = Field(0.6, ge=0.0, le=10.0, description="lethal/unknown cells within this distance of the robot may be crossed to get out (m)")
-    escape_cost: float = Field(50.0, ge=1.0, le=100.0, description="cost factor of crossing a lethal cell while escaping")
+    escape_radius: float = Field(
+        0.6,
+        ge=0.0,
+        le=10.0,
+        description="lethal/unknown cells within this distance of the robot may be crossed to get out (m)",
+    )
+    escape_cost: float = Field(
+        50.0, ge=1.0, le=100.0, description="cost factor of crossing a lethal cell while escaping"
+    )
     # --- frontiers -----------------------------------------------------------------------------------
-    min_frontier_length: float = Field(0.5, ge=0.0, le=100.0, description="smallest frontier kept: cells x resolution (m)")
-    view_distance: float = Field(0.0, ge=0.0, le=30.0, description="last resort: look at frontiers the robot cannot reach from reachable cells this close (m); 0 = never")
-    min_unknown_area: float = Field(3.0, ge=0.0, le=1000.0, description="enclosed unknown pockets smaller than this make no frontier (m^2)")
+    min_frontier_length: float = Field(
+        0.5, ge=0.0, le=100.0, description="smallest frontier kept: cells x resolution (m)"
+    )
+    view_distance: float = Field(
+        0.0,
+        ge=0.0,
+        le=30.0,
+        description="last resort: look at frontiers the robot cannot reach from reachable cells this close (m); 0 = never",
+    )
+    min_unknown_area: float = Field(
+        3.0, ge=0.0, le=1000.0, description="enclosed unknown pockets smaller than this make no frontier (m^2)"
+    )
     # --- path follower ------------------------------------------------------------------------------
     smooth_paths: bool = Field(True, description="straighten the planner's 8-connected paths where that costs no more")
     lookahead_distance: float = Field(1.0, gt=0.0, le=10.0, description="pure-pursuit look-ahead (m)")
-    rotate_in_place_angle: float = Field(math.radians(50.0), gt=0.0, le=math.pi, description="heading error above which the robot turns in place (rad)")
-    max_reverse_distance: float = Field(2.5, ge=0.0, le=100.0, description="back out along the path for at most this far instead of turning round (m); 0 = never")
-    reverse_speed: float = Field(0.35, gt=0.0, le=10.0, description="largest backing speed when backing out along the path (m/s)")
-    reverse_angle: float = Field(math.radians(120.0), ge=math.radians(90.0), le=math.pi, description="back out when the end of the path's first straight stretch lies at least this far from the heading (rad)")
-    narrow_speed: float = Field(0.25, gt=0.0, le=10.0, description="speed limit where the path's clearance is down to the lethal distance (m/s)")
-    narrow_clearance: float = Field(0.25, ge=0.0, le=10.0, description="clearance beyond the lethal distance from which full speed is allowed (m)")
-    obstacle_margin: float = Field(0.03, ge=0.0, le=1.0, description="clearance added to the radius when checking the scan ahead (m)")
+    rotate_in_place_angle: float = Field(
+        math.radians(50.0), gt=0.0, le=math.pi, description="heading error above which the robot turns in place (rad)"
+    )
+    max_reverse_distance: float = Field(
+        2.5,
+        ge=0.0,
+        le=100.0,
+        description="back out along the path for at most this far instead of turning round (m); 0 = never",
+    )
+    reverse_speed: float = Field(
+        0.35, gt=0.0, le=10.0, description="largest backing speed when backing out along the path (m/s)"
+    )
+    reverse_angle: float = Field(
+        math.radians(120.0),
+        ge=math.radians(90.0),
+        le=math.pi,
+        description="back out when the end of the path's first straight stretch lies at least this far from the heading (rad)",
+    )
+    narrow_speed: float = Field(
+        0.25, gt=0.0, le=10.0, description="speed limit where the path's clearance is down to the lethal distance (m/s)"
+    )
+    narrow_clearance: float = Field(
+        0.25, ge=0.0, le=10.0, description="clearance beyond the lethal distance from which full speed is allowed (m)"
+    )
+    obstacle_margin: float = Field(
+        0.03, ge=0.0, le=1.0, description="clearance added to the radius when checking the scan ahead (m)"
+    )
     stop_distance: float = Field(0.05, ge=0.0, le=2.0, description="distance kept from obstacles seen in the scan (m)")
     # --- goals ---------------------------------------------------------------------------------------
-    local_radius: float = Field(10.0, gt=0.0, le=1000.0, description="half-size of the window around the robot searched for a goal first (m)")
-    global_coarsening: int = Field(2, ge=1, le=8, description="whole-map searches look at blocks of this many cells squared first (1 = full resolution only)")
-    global_replan_period: float = Field(15.0, gt=0.0, le=3600.0, description="while heading for a goal outside that window, search the whole map this often (s)")
+    local_radius: float = Field(
+        10.0, gt=0.0, le=1000.0, description="half-size of the window around the robot searched for a goal first (m)"
+    )
+    global_coarsening: int = Field(
+        2,
+        ge=1,
+        le=8,
+        description="whole-map searches look at blocks of this many cells squared first (1 = full resolution only)",
+    )
+    global_replan_period: float = Field(
+        15.0,
+        gt=0.0,
+        le=3600.0,
+        description="while heading for a goal outside that window, search the whole map this often (s)",
+    )
     replan_period: float = Field(3.0, gt=0.0, le=600.0, description="replan at least this often (s)")
-    min_replan_interval: float = Field(1.0, ge=0.0, le=600.0, description="smallest time between event-driven replans (s)")
+    min_replan_interval: float = Field(
+        1.0, ge=0.0, le=600.0, description="smallest time between event-driven replans (s)"
+    )
     goal_tolerance: float = Field(0.3, gt=0.0, le=10.0, description="a goal is reached within this distance (m)")
-    goal_timeout: float = Field(30.0, gt=0.0, le=3600.0, description="blacklist a goal after this long without progress (s)")
-    progress_distance: float = Field(0.25, gt=0.0, le=10.0, description="getting this much closer to the goal is progress (m)")
-    blacklist_radius: float = Field(0.5, ge=0.0, le=20.0, description="frontier cells this close to a failed or reached goal are skipped (m)")
-    turn_penalty: float = Field(1.0, ge=0.0, le=100.0, description="the turn needed to set off towards a goal counts as this much extra path per radian (m/rad); 0 = closest goal only")
-    goal_hysteresis: float = Field(0.75, gt=0.0, le=1.0, description="switch goal only if the new one costs less than this fraction of the current one")
-    blacklist_resets: int = Field(1, ge=0, le=100, description="times the failed-goal blacklist is cleared when nothing else is left")
-    initial_spin: bool = Field(True, description="turn a full circle at the start, to see behind the laser's blind sector")
+    goal_timeout: float = Field(
+        30.0, gt=0.0, le=3600.0, description="blacklist a goal after this long without progress (s)"
+    )
+    progress_distance: float = Field(
+        0.25, gt=0.0, le=10.0, description="getting this much closer to the goal is progress (m)"
+    )
+    blacklist_radius: float = Field(
+        0.5, ge=0.0, le=20.0, description="frontier cells this close to a failed or reached goal are skipped (m)"
+    )
+    turn_penalty: float = Field(
+        1.0,
+        ge=0.0,
+        le=100.0,
+        description="the turn needed to set off towards a goal counts as this much extra path per radian (m/rad); 0 = closest goal only",
+    )
+    goal_hysteresis: float = Field(
+        0.75,
+        gt=0.0,
+        le=1.0,
+        description="switch goal only if the new one costs less than this fraction of the current one",
+    )
+    blacklist_resets: int = Field(
+        1, ge=0, le=100, description="times the failed-goal blacklist is cleared when nothing else is left"
+    )
+    initial_spin: bool = Field(
+        True, description="turn a full circle at the start, to see behind the laser's blind sector"
+    )
     # --- stuck detection and recovery ----------------------------------------------------------------
     stuck_time: float = Field(3.0, gt=0.0, le=600.0, description="window of the stuck test (s)")
-    stuck_ratio: float = Field(0.3, gt=0.0, lt=1.0, description="stuck when moving less than this fraction of the commanded distance")
-    stuck_min_command: float = Field(0.15, gt=0.0, le=100.0, description="commanded distance over the window needed before the stuck test applies (m)")
-    idle_time: float = Field(8.0, gt=0.0, le=600.0, description="recover after following a path this long without moving idle_distance (s)")
+    stuck_ratio: float = Field(
+        0.3, gt=0.0, lt=1.0, description="stuck when moving less than this fraction of the commanded distance"
+    )
+    stuck_min_command: float = Field(
+        0.15,
+        gt=0.0,
+        le=100.0,
+        description="commanded distance over the window needed before the stuck test applies (m)",
+    )
+    idle_time: float = Field(
+        8.0, gt=0.0, le=600.0, description="recover after following a path this long without moving idle_distance (s)"
+    )
     idle_distance: float = Field(0.1, gt=0.0, le=10.0, description="see idle_time (m)")
-    stall_steps: int = Field(3, ge=1, le=1000, description="recover after this many consecutive steps the caller reports as stalled (collisions)")
-    blocked_time: float = Field(2.0, gt=0.0, le=600.0, description="recover after being held still by the scan this long (s)")
-    backoff_distance: float = Field(0.25, ge=0.0, le=5.0, description="distance moved away (or backed off) in a recovery (m)")
+    stall_steps: int = Field(
+        3,
+        ge=1,
+        le=1000,
+        description="recover after this many consecutive steps the caller reports as stalled (collisions)",
+    )
+    blocked_time: float = Field(
+        2.0, gt=0.0, le=600.0, description="recover after being held still by the scan this long (s)"
+    )
+    backoff_distance: float = Field(
+        0.25, ge=0.0, le=5.0, description="distance moved away (or backed off) in a recovery (m)"
+    )
     backoff_speed: float = Field(0.15, gt=0.0, le=10.0, description="backing speed (m/s)")
-    recovery_turn: float = Field(math.radians(90.0), ge=0.0, le=2.0 * math.pi, description="turn in place after backing off, when not touching anything (rad)")
-    max_recoveries_per_goal: int = Field(2, ge=1, le=100, description="blacklist a goal after this many recoveries on the way")
+    recovery_turn: float = Field(
+        math.radians(90.0),
+        ge=0.0,
+        le=2.0 * math.pi,
+        description="turn in place after backing off, when not touching anything (rad)",
+    )
+    max_recoveries_per_goal: int = Field(
+        2, ge=1, le=100, description="blacklist a goal after this many recoveries on the way"
+    )
 
     @model_validator(mode="before")
     @classmethod
@@ -178,14 +286,18 @@ class ExploreConfig(BaseModel):
         if isinstance(data, dict):
             found = [name for name in ROBOT_FIELDS if name in data]
             if found:
-                raise ValueError(f"{found[0]} is a property of the robot: set it in sim.robot (radius, speeds, "
-                                 "accelerations) or sim.dt (control period), not in the explore section")
+                raise ValueError(
+                    f"{found[0]} is a property of the robot: set it in sim.robot (radius, speeds, "
+                    "accelerations) or sim.dt (control period), not in the explore section"
+                )
         return data
 
     @model_validator(mode="after")
     def _consistent(self) -> ExploreConfig:
         if self.min_replan_interval > self.replan_period:
-            raise ValueError(f"min_replan_interval ({self.min_replan_interval:g} s) must not exceed replan_period ({self.replan_period:g} s)")
+            raise ValueError(
+                f"min_replan_interval ({self.min_replan_interval:g} s) must not exceed replan_period ({self.replan_period:g} s)"
+            )
         return self
 
     @classmethod
@@ -214,9 +326,15 @@ class TerminationConfig(BaseModel):
 
     small_period: float = Field(120.0, gt=0.0, le=1e5, description="snapshot period of small environments (s)")
     large_period: float = Field(600.0, gt=0.0, le=1e5, description="snapshot period of large environments (s)")
-    size_threshold: float = Field(1000.0, gt=0.0, le=1e7, description="free area from which an environment is large (m^2)")
-    mse_threshold: float = Field(10.0, ge=0.0, le=1e6, description="stop when the snapshot MSE is below this (grey^2, summed over channels)")
-    channels: int = Field(3, ge=1, le=4, description="colour channels the MSE is summed over (grey images: identical channels)")
+    size_threshold: float = Field(
+        1000.0, gt=0.0, le=1e7, description="free area from which an environment is large (m^2)"
+    )
+    mse_threshold: float = Field(
+        10.0, ge=0.0, le=1e6, description="stop when the snapshot MSE is below this (grey^2, summed over channels)"
+    )
+    channels: int = Field(
+        3, ge=1, le=4, description="colour channels the MSE is summed over (grey images: identical channels)"
+    )
     downscale: int = Field(4, ge=1, le=64, description="block size of the downscaling (cells)")
     max_snapshots: int = Field(19, ge=2, le=100000, description="stop after this many snapshots")
     max_time: float = Field(10800.0, gt=0.0, le=1e7, description="hard cap on simulated time (s)")

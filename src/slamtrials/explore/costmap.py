@@ -125,10 +125,16 @@ def influence_distance(config: ExploreConfig, robot: RobotLimits, resolution: fl
     """Distance (m) from an obstacle beyond which it changes no cost: cells farther than this from the
     edge of a window of the map have the same costs in the window's costmap as in the whole map's."""
     cfg = config
-    return lethal_distance(cfg, robot) + cfg.cost_decay_distance * max(math.log(max(cfg.wall_cost, 1e-12) / _NEGLIGIBLE), 0.0) + 2 * resolution
+    return (
+        lethal_distance(cfg, robot)
+        + cfg.cost_decay_distance * max(math.log(max(cfg.wall_cost, 1e-12) / _NEGLIGIBLE), 0.0)
+        + 2 * resolution
+    )
 
 
-def _cost_table(resolution: float, lethal: float, wall_cost: float, decay: float) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+def _cost_table(
+    resolution: float, lethal: float, wall_cost: float, decay: float
+) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
     """Clearance (m) and cost factor for every squared centre distance ``d2 = 0, 1, ..., n - 1`` (cells^2).
 
     ``n`` is chosen so that beyond it the wall term is below ``_NEGLIGIBLE``; the last entry stands for
@@ -145,8 +151,9 @@ def _cost_table(resolution: float, lethal: float, wall_cost: float, decay: float
 
 
 @njit(cache=True, nogil=True)
-def _costs(grid, d2, resolution, clear_table, cost_table, unknown_traversable, unknown_cost, free_below,
-           lethal, escape_cost):  # pragma: no cover
+def _costs(
+    grid, d2, resolution, clear_table, cost_table, unknown_traversable, unknown_cost, free_below, lethal, escape_cost
+):  # pragma: no cover
     height, width = grid.shape
     n = cost_table.shape[0]
     cost = np.empty((height, width), dtype=np.float32)
@@ -218,14 +225,26 @@ class Costmap:
     escape: NDArray[np.float32]
 
 
-def build_costmap(grid: NDArray[np.int8], resolution: float, config: ExploreConfig, robot: RobotLimits | None = None) -> Costmap:
+def build_costmap(
+    grid: NDArray[np.int8], resolution: float, config: ExploreConfig, robot: RobotLimits | None = None
+) -> Costmap:
     """Costmap of ``grid`` (int8 ``[H, W]``: >= 50 occupied, 0..49 free, < 0 unknown) with cells of ``resolution`` m."""
     lethal = lethal_distance(config, RobotLimits() if robot is None else robot)
     grid = np.ascontiguousarray(grid, dtype=np.int8)
     d2 = squared_distance_transform(grid >= FREE_BELOW)
-    clear_table, cost_table = _cost_table(float(resolution), float(lethal), float(config.wall_cost),
-                                          float(config.cost_decay_distance))
-    cost, kind, clearance, escape = _costs(grid, d2, float(resolution), clear_table, cost_table,
-                                           bool(config.unknown_traversable), float(config.unknown_cost), FREE_BELOW,
-                                           float(lethal), float(config.escape_cost))
+    clear_table, cost_table = _cost_table(
+        float(resolution), float(lethal), float(config.wall_cost), float(config.cost_decay_distance)
+    )
+    cost, kind, clearance, escape = _costs(
+        grid,
+        d2,
+        float(resolution),
+        clear_table,
+        cost_table,
+        bool(config.unknown_traversable),
+        float(config.unknown_cost),
+        FREE_BELOW,
+        float(lethal),
+        float(config.escape_cost),
+    )
     return Costmap(cost=cost, kind=kind, clearance=clearance, resolution=float(resolution), escape=escape)

@@ -184,8 +184,16 @@ class Explorer:
 
     # --- the control step --------------------------------------------------------------------------------
 
-    def command(self, t: float, pose: ArrayLike, ranges: ArrayLike, laser: LaserGeometry, occupancy: Any, *,
-                stalled: bool = False) -> tuple[float, float]:
+    def command(
+        self,
+        t: float,
+        pose: ArrayLike,
+        ranges: ArrayLike,
+        laser: LaserGeometry,
+        occupancy: Any,
+        *,
+        stalled: bool = False,
+    ) -> tuple[float, float]:
         """The velocity command ``(v m/s, w rad/s)`` for the next control period.
 
         Parameters
@@ -216,8 +224,9 @@ class Explorer:
         self._stuck = self._monitor.update(float(t), pose_array, v, self.robot.control_period, self._following)
         return v, w
 
-    def _decide(self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: LaserGeometry,
-                occupancy: Any) -> tuple[float, float]:
+    def _decide(
+        self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: LaserGeometry, occupancy: Any
+    ) -> tuple[float, float]:
         cfg = self.config
         if self._done:
             return 0.0, 0.0
@@ -259,8 +268,11 @@ class Explorer:
                     self._want_plan = True
         # 4. planning
         since = t - self._last_plan
-        if since >= cfg.replan_period or (self._want_plan and since >= cfg.min_replan_interval) or (
-                self._goal is None and since >= cfg.min_replan_interval):
+        if (
+            since >= cfg.replan_period
+            or (self._want_plan and since >= cfg.min_replan_interval)
+            or (self._goal is None and since >= cfg.min_replan_interval)
+        ):
             self._plan(t, pose, occupancy)
             if self._done:
                 return 0.0, 0.0
@@ -288,13 +300,16 @@ class Explorer:
     def _start_spin(self, t: float, pose: NDArray[np.float64]) -> None:
         robot = self.robot
         self._spin_rate = robot.max_angular_speed
-        self._spin_until = t + 2.0 * math.pi / robot.max_angular_speed + robot.max_angular_speed / robot.max_angular_accel
+        self._spin_until = (
+            t + 2.0 * math.pi / robot.max_angular_speed + robot.max_angular_speed / robot.max_angular_accel
+        )
         self._looked.append(pose[:2].copy())
         self.stats.look_arounds += 1
         self._follower.clear()
 
-    def _start_recovery(self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: LaserGeometry,
-                        occupancy: Any) -> tuple[float, float]:
+    def _start_recovery(
+        self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: LaserGeometry, occupancy: Any
+    ) -> tuple[float, float]:
         self.stats.recoveries += 1
         self._stuck = False
         self._stalls = 0
@@ -367,8 +382,14 @@ class Explorer:
         if outcome in ("none", "lost"):
             self._nothing_found(t, pose, any_frontier=outcome == "lost")
 
-    def _last_resorts(self, t: float, pose: NDArray[np.float64], occupancy: Any, grid: NDArray[np.int8],
-                      box: tuple[int, int, int, int]) -> str:
+    def _last_resorts(
+        self,
+        t: float,
+        pose: NDArray[np.float64],
+        occupancy: Any,
+        grid: NDArray[np.int8],
+        box: tuple[int, int, int, int],
+    ) -> str:
         """No frontier is reachable: try narrow passages (the relaxed costmap), then view points."""
         cfg = self.config
         outcome = "none"
@@ -378,17 +399,36 @@ class Explorer:
             outcome = self._try(t, pose, occupancy, grid, box, None, views=True)
         return outcome
 
-    def _try(self, t: float, pose: NDArray[np.float64], occupancy: Any, grid: NDArray[np.int8],
-             box: tuple[int, int, int, int], inner: tuple[int, int, int, int] | None, *,
-             views: bool = False, relaxed: bool = False, coarse: int = 1) -> str:
+    def _try(
+        self,
+        t: float,
+        pose: NDArray[np.float64],
+        occupancy: Any,
+        grid: NDArray[np.int8],
+        box: tuple[int, int, int, int],
+        inner: tuple[int, int, int, int] | None,
+        *,
+        views: bool = False,
+        relaxed: bool = False,
+        coarse: int = 1,
+    ) -> str:
         """One goal search (:meth:`GoalSearch.search`); take its goal. Returns ``"goal"``, ``"edge"``,
         ``"none"`` or ``"lost"``."""
         if inner is None:
             self._last_global = t
-        outcome, found = self._search.search(pose, occupancy, grid, box, inner, visited=self._visited,
-                                             blacklist=self._blacklist,
-                                             current=None if self._goal is None else self._goal.xy,
-                                             views=views, relaxed=relaxed, coarse=coarse)
+        outcome, found = self._search.search(
+            pose,
+            occupancy,
+            grid,
+            box,
+            inner,
+            visited=self._visited,
+            blacklist=self._blacklist,
+            current=None if self._goal is None else self._goal.xy,
+            views=views,
+            relaxed=relaxed,
+            coarse=coarse,
+        )
         if outcome == "undecided" and self._can_keep_goal(pose):
             return "goal"  # the current goal beyond the window may still be the better one
         if found is None:
@@ -412,8 +452,7 @@ class Explorer:
 
     def _can_keep_goal(self, pose: NDArray[np.float64]) -> bool:
         """Whether the robot can keep following its path to the current goal."""
-        return (self._goal is not None and self._follower.has_path
-                and self._search.path_clear(self._follower.path, pose))
+        return self._goal is not None and self._follower.has_path and self._search.path_clear(self._follower.path, pose)
 
     def _nothing_found(self, t: float, pose: NDArray[np.float64], *, any_frontier: bool) -> None:
         """No goal: look around once here, else (with a map) finish."""

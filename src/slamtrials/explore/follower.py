@@ -254,8 +254,10 @@ class PathFollower:
         if self._reverse_from is not None and not len(points):
             self._stop_backing(*(self._previous or self._reverse_from))
         elif self._reverse_from is not None:  # backing out: go on along the new path's leg, if it has one
-            leg = self._leg(self.config.max_reverse_distance - math.hypot(
-                points[0, 0] - self._reverse_from[0], points[0, 1] - self._reverse_from[1]))
+            leg = self._leg(
+                self.config.max_reverse_distance
+                - math.hypot(points[0, 0] - self._reverse_from[0], points[0, 1] - self._reverse_from[1])
+            )
             if leg is None:
                 self._stop_backing(float(points[0, 0]), float(points[0, 1]))
             else:
@@ -282,7 +284,7 @@ class PathFollower:
             return math.inf
         x, y = float(pose[0]), float(pose[1])
         stop = min(self._index + _SEARCH_AHEAD, len(self._path))
-        d = stablemath.hypot(self._path[self._index:stop, 0] - x, self._path[self._index:stop, 1] - y)
+        d = stablemath.hypot(self._path[self._index : stop, 0] - x, self._path[self._index : stop, 1] - y)
         k = int(np.argmin(d))
         return float(d[k] + self._remaining[self._index + k])
 
@@ -298,15 +300,18 @@ class PathFollower:
             return self._limited(0.0, 0.0, finished=True)
         path = self._path
         stop = min(self._index + _SEARCH_AHEAD, len(path))
-        d = stablemath.hypot(path[self._index:stop, 0] - x, path[self._index:stop, 1] - y)
+        d = stablemath.hypot(path[self._index : stop, 0] - x, path[self._index : stop, 1] - y)
         self._index += int(np.argmin(d))
         to_end = float(self._remaining[self._index]) + float(d.min())
         end_dist = math.hypot(path[-1, 0] - x, path[-1, 1] - y)
         if end_dist < cfg.goal_tolerance:
             return self._limited(0.0, 0.0, finished=True)
         points = scan_points(ranges, laser)
-        speed = math.inf if self._previous is None else math.hypot(x - self._previous[0],
-                                                                  y - self._previous[1]) / robot.control_period
+        speed = (
+            math.inf
+            if self._previous is None
+            else math.hypot(x - self._previous[0], y - self._previous[1]) / robot.control_period
+        )
         self._previous = (x, y)
         backing_out = self._backing_out(x, y, theta, speed)
         if backing_out is None:
@@ -333,8 +338,9 @@ class PathFollower:
         v = self._arc_speed(robot.max_linear_speed, v_scan, to_end, curvature)
         return self._limited(v, curvature * v, pure_pursuit=True, curvature=curvature)
 
-    def _arc(self, x: float, y: float, theta: float, offset: float, target: tuple[float, float],
-             points: NDArray[np.float64]) -> tuple[float, float, float]:
+    def _arc(
+        self, x: float, y: float, theta: float, offset: float, target: tuple[float, float], points: NDArray[np.float64]
+    ) -> tuple[float, float, float]:
         """Pure pursuit towards ``target`` with the heading ``theta + offset`` (``offset`` pi: backwards,
         ``points`` then mirrored): heading error (rad), curvature (1/m) and the largest speed (m/s) at which
         the robot can still stop before the scan's points on that arc."""
@@ -367,18 +373,23 @@ class PathFollower:
         if self._reverse_from is not None:
             ex, ey = self._path[self._leg_end]
             backed = math.hypot(x - self._reverse_from[0], y - self._reverse_from[1])
-            if (self._index >= self._leg_end or math.hypot(ex - x, ey - y) < _LEG_ARRIVED
-                    or backed >= cfg.max_reverse_distance):
+            if (
+                self._index >= self._leg_end
+                or math.hypot(ex - x, ey - y) < _LEG_ARRIVED
+                or backed >= cfg.max_reverse_distance
+            ):
                 self._stop_backing(x, y)
                 return False
             return True
         if cfg.max_reverse_distance <= 0.0:
             return False
-        if self._reverse_ended is not None and math.hypot(x - self._reverse_ended[0],
-                                                          y - self._reverse_ended[1]) < _REVERSE_REARM:
+        if (
+            self._reverse_ended is not None
+            and math.hypot(x - self._reverse_ended[0], y - self._reverse_ended[1]) < _REVERSE_REARM
+        ):
             return False
         # cheap test first: most paths lead ahead
-        soon = int(np.searchsorted(self._remaining[self._index] - self._remaining[self._index:], _MIN_LEG))
+        soon = int(np.searchsorted(self._remaining[self._index] - self._remaining[self._index :], _MIN_LEG))
         sx, sy = self._path[min(self._index + soon, len(self._path) - 1)]
         if abs(math.remainder(math.atan2(sy - y, sx - x) - theta, 2.0 * math.pi)) < 0.5 * math.pi:
             return False
@@ -407,7 +418,7 @@ class PathFollower:
             length = math.hypot(dx, dy)
             if length < _MIN_LEG:
                 return None
-            stray = np.abs((path[i0:i0 + j, 0] - x) * dy - (path[i0:i0 + j, 1] - y) * dx) / length
+            stray = np.abs((path[i0 : i0 + j, 0] - x) * dy - (path[i0 : i0 + j, 1] - y) * dx) / length
             if stray.max() <= _LEG_TOLERANCE:
                 return i0 + j
         return None
@@ -417,8 +428,9 @@ class PathFollower:
             self._reverse_from = None
             self._reverse_ended = (x, y)
 
-    def _reverse(self, x: float, y: float, theta: float, points: NDArray[np.float64],
-                 to_end: float) -> FollowCommand | None:
+    def _reverse(
+        self, x: float, y: float, theta: float, points: NDArray[np.float64], to_end: float
+    ) -> FollowCommand | None:
         """Pure pursuit backwards (heading ``theta + pi``), or ``None`` when that needs a turn in place
         or the scan blocks it."""
         cfg = self.config
@@ -439,8 +451,11 @@ class PathFollower:
         if abs(error) > _CREEP_ALIGN:
             return self._limited(0.0, turn_rate(error, robot.max_angular_speed, robot.max_angular_accel))
         free = free_travel(points, 0.0, robot.radius + _CREEP_MARGIN)
-        v = min(_CREEP_SPEED, math.sqrt(2.0 * robot.max_linear_accel * max(free - 0.01, 0.0)),
-                math.sqrt(2.0 * robot.max_linear_accel * to_end))
+        v = min(
+            _CREEP_SPEED,
+            math.sqrt(2.0 * robot.max_linear_accel * max(free - 0.01, 0.0)),
+            math.sqrt(2.0 * robot.max_linear_accel * to_end),
+        )
         if v < _BLOCKED_SPEED:
             return self._limited(0.0, 0.0, blocked=True)
         return self._limited(v, 0.0)
@@ -450,7 +465,7 @@ class PathFollower:
         cfg, robot = self.config, self.robot
         if self._clearance is None or self._clearance.shape[0] != self._path.shape[0] or cfg.narrow_clearance <= 0.0:
             return robot.max_linear_speed
-        least = float(self._clearance[self._index:self._narrow_end[self._index] + 1].min())
+        least = float(self._clearance[self._index : self._narrow_end[self._index] + 1].min())
         share = min(max((least - lethal_distance(cfg, robot)) / cfg.narrow_clearance, 0.0), 1.0)
         return cfg.narrow_speed + share * (robot.max_linear_speed - cfg.narrow_speed)
 
@@ -460,14 +475,22 @@ class PathFollower:
         end = int(self._window_end[self._index]) + 1
         if last is not None:
             end = min(end, last + 1)
-        path = self._path[self._index:end]
+        path = self._path[self._index : end]
         ahead = stablemath.hypot(path[:, 0] - x, path[:, 1] - y)
         beyond = np.flatnonzero(ahead >= lookahead)
         tx, ty = path[int(beyond[0])] if beyond.size else path[-1]
         return float(tx), float(ty)
 
-    def _limited(self, v: float, w: float, *, blocked: bool = False, finished: bool = False,
-                 pure_pursuit: bool = False, curvature: float = 0.0) -> FollowCommand:
+    def _limited(
+        self,
+        v: float,
+        w: float,
+        *,
+        blocked: bool = False,
+        finished: bool = False,
+        pure_pursuit: bool = False,
+        curvature: float = 0.0,
+    ) -> FollowCommand:
         robot = self.robot
         dt = robot.control_period
         if v > 0.0:

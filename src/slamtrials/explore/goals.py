@@ -72,4 +72,4 @@ def exclude_discs(mask: NDArray[np.bool_], frame: GridFrame, points: list[NDArra
         if r1 <= 0 or c1 <= 0 or r0 >= height or c0 >= width:
             continue
         cr0, cr1, cc0, cc1 = max(r0, 0), min(r1, height), max(c0, 0), min(c1, width)
-        mask[cr0:cr1, cc0:cc1] &= ~disc[cr0 - r0:cr1 - r0, cc0 - c0:cc1 - c0]
+        mask[cr0:cr1, cc0:cc1] &= ~disc[cr0 - r0 : cr1 - r0, cc0 - c0 : cc1 - c0]

@@ -127,8 +127,9 @@ class GoalSearch:
             self._box = known_box(grid, CROP_MARGIN)
         return self._box
 
-    def prepare(self, occupancy: Any, grid: NDArray[np.int8], box: Box, relaxed: bool = False,
-                coarse: int = 1) -> Prepared:
+    def prepare(
+        self, occupancy: Any, grid: NDArray[np.int8], box: Box, relaxed: bool = False, coarse: int = 1
+    ) -> Prepared:
         """Costmap and frontiers of the window ``box`` of the map (cached per map object and window).
 
         ``relaxed`` uses ``relaxed_margin`` instead of ``inflation_margin``; ``coarse`` > 1 works on a
@@ -148,18 +149,32 @@ class GoalSearch:
             resolution *= coarse
             frame = GridFrame(window.shape[0], window.shape[1], resolution, frame.origin)
         costmap = build_costmap(window, resolution, cfg, self.robot)
-        frontiers = find_frontiers(window, min_cells=max(1, math.ceil(cfg.min_frontier_length / resolution - 1e-9)),
-                                   min_unknown_cells=math.ceil(cfg.min_unknown_area / resolution**2 - 1e-9))
+        frontiers = find_frontiers(
+            window,
+            min_cells=max(1, math.ceil(cfg.min_frontier_length / resolution - 1e-9)),
+            min_unknown_cells=math.ceil(cfg.min_unknown_area / resolution**2 - 1e-9),
+        )
         prepared = Prepared(frame, costmap, frontiers)
         self._cache[key] = (box, occupancy, prepared)
         if coarse == 1:
             self.latest = prepared
         return prepared
 
-    def search(self, pose: NDArray[np.float64], occupancy: Any, grid: NDArray[np.int8], box: Box,
-               inner: Box | None, *, visited: list[NDArray[np.float64]], blacklist: list[NDArray[np.float64]],
-               current: NDArray[np.float64] | None, views: bool = False, relaxed: bool = False,
-               coarse: int = 1) -> tuple[str, Found | None]:
+    def search(
+        self,
+        pose: NDArray[np.float64],
+        occupancy: Any,
+        grid: NDArray[np.int8],
+        box: Box,
+        inner: Box | None,
+        *,
+        visited: list[NDArray[np.float64]],
+        blacklist: list[NDArray[np.float64]],
+        current: NDArray[np.float64] | None,
+        views: bool = False,
+        relaxed: bool = False,
+        coarse: int = 1,
+    ) -> tuple[str, Found | None]:
         """Look for a goal in window ``box`` of the map; with ``inner``, only as far as that part of it.
 
         Parameters
@@ -207,8 +222,16 @@ class GoalSearch:
             near = candidates.copy()
             exclude_discs(near, frame, [current], cfg.blacklist_radius)
             keep = candidates & ~near
-        result = dijkstra(costmap.cost, (row, col), goal=candidates, keep=keep, ratio=cfg.goal_hysteresis,
-                          escape=costmap.escape, escape_radius=cfg.escape_radius / frame.resolution, interior=inner)
+        result = dijkstra(
+            costmap.cost,
+            (row, col),
+            goal=candidates,
+            keep=keep,
+            ratio=cfg.goal_hysteresis,
+            escape=costmap.escape,
+            escape_radius=cfg.escape_radius / frame.resolution,
+            interior=inner,
+        )
         outcome = "goal"
         if result.boundary_cost is not None:  # the window's edge came first
             if result.goal is None:
@@ -236,8 +259,9 @@ class GoalSearch:
         clearance = costmap.clearance[cells[:, 0], cells[:, 1]].astype(np.float64)
         return outcome, Found(path=path, clearance=clearance, target=target, kept=result.kept)
 
-    def _path(self, prepared: Prepared, result: PlanResult, pose: NDArray[np.float64]
-              ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    def _path(
+        self, prepared: Prepared, result: PlanResult, pose: NDArray[np.float64]
+    ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
         """The cells (int64 ``[N, 2]``) and map-frame points (float64 ``[N, 2]``) of the path to the
         goal of ``result``, straightened if ``smooth_paths``."""
         costmap, frame = prepared.costmap, prepared.frame
@@ -263,9 +287,16 @@ class GoalSearch:
         turn = abs(math.remainder(math.atan2(ty - pose[1], tx - pose[0]) - pose[2], 2.0 * math.pi))
         return cfg.turn_penalty * turn / resolution
 
-    def _ahead(self, prepared: Prepared, pose: NDArray[np.float64], start: tuple[int, int],
-               candidates: NDArray[np.bool_], inner: Box | None, first_cost: float, path: NDArray[np.float64]
-               ) -> tuple[PlanResult, NDArray[np.int64], NDArray[np.float64]] | None:
+    def _ahead(
+        self,
+        prepared: Prepared,
+        pose: NDArray[np.float64],
+        start: tuple[int, int],
+        candidates: NDArray[np.bool_],
+        inner: Box | None,
+        first_cost: float,
+        path: NDArray[np.float64],
+    ) -> tuple[PlanResult, NDArray[np.int64], NDArray[np.float64]] | None:
         """A goal in front of the robot that beats the closest one once turning is paid for, or ``None``.
 
         The closest goal's cost plus its turn cost bounds a second search among the goal cells in the
@@ -284,8 +315,15 @@ class GoalSearch:
             return None
         ahead = np.zeros_like(candidates)
         ahead[rows[front], cols[front]] = True
-        result = dijkstra(costmap.cost, start, goal=ahead, escape=costmap.escape,
-                          escape_radius=cfg.escape_radius / frame.resolution, interior=inner, max_cost=current)
+        result = dijkstra(
+            costmap.cost,
+            start,
+            goal=ahead,
+            escape=costmap.escape,
+            escape_radius=cfg.escape_radius / frame.resolution,
+            interior=inner,
+            max_cost=current,
+        )
         if result.goal is None or result.first_cost is None or result.boundary_cost is not None:
             return None
         cells, path_ahead = self._path(prepared, result, pose)
@@ -311,8 +349,9 @@ class GoalSearch:
         blocked = (kind == OCCUPIED) | (kind == UNKNOWN) | (clearance < self.robot.radius)
         return not bool(blocked.any())
 
-    def _candidates(self, prepared: Prepared, visited: list[NDArray[np.float64]],
-                    views: bool) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+    def _candidates(
+        self, prepared: Prepared, visited: list[NDArray[np.float64]], views: bool
+    ) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
         """Goal cells before the blacklist, and the unreachable frontier cells (for view points)."""
         cfg = self.config
         frame, costmap, frontiers = prepared.frame, prepared.costmap, prepared.frontiers
@@ -331,12 +370,14 @@ class GoalSearch:
         return candidates, unreachable
 
 
-def _nearest_cell(mask: NDArray[np.bool_], frame: GridFrame, cell: tuple[int, int], radius: float) -> NDArray[np.float64]:
+def _nearest_cell(
+    mask: NDArray[np.bool_], frame: GridFrame, cell: tuple[int, int], radius: float
+) -> NDArray[np.float64]:
     """Map-frame centre of the True cell of ``mask`` nearest ``cell`` within ``radius`` m (else ``cell``'s)."""
     n = math.ceil(radius / frame.resolution)
     r, c = cell
     r0, c0 = max(r - n, 0), max(c - n, 0)
-    rows, cols = np.nonzero(mask[r0:r + n + 1, c0:c + n + 1])
+    rows, cols = np.nonzero(mask[r0 : r + n + 1, c0 : c + n + 1])
     if rows.size == 0:
         return frame.to_xy(r, c)
     k = int(np.argmin((rows + r0 - r) ** 2 + (cols + c0 - c) ** 2))

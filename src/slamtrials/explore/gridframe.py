@@ -65,7 +65,9 @@ class GridFrame:
     def of(cls, occupancy: Any) -> GridFrame:
         """The frame of a map object with ``grid``, ``resolution`` and ``origin``."""
         grid, resolution, origin = map_arrays(occupancy)
-        return cls(int(grid.shape[0]), int(grid.shape[1]), resolution, (float(origin[0]), float(origin[1]), float(origin[2])))
+        return cls(
+            int(grid.shape[0]), int(grid.shape[1]), resolution, (float(origin[0]), float(origin[1]), float(origin[2]))
+        )
 
     def to_cell(self, xy: ArrayLike) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
         """Integer cells ``(rows, cols)`` holding map-frame points ``[..., 2]`` (m); may lie outside the grid."""

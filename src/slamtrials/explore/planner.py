@@ -37,8 +37,9 @@ UNREACHED = _UNREACHED
 
 
 @njit(cache=True, nogil=True)
-def _dijkstra(cost, escape, sr, sc, goal, keep, use_goal, use_keep, ratio, escape_r2, max_cost,
-              ir0, ir1, ic0, ic1):  # pragma: no cover
+def _dijkstra(
+    cost, escape, sr, sc, goal, keep, use_goal, use_keep, ratio, escape_r2, max_cost, ir0, ir1, ic0, ic1
+):  # pragma: no cover
     """Dijkstra with a circular bucket queue (Dial) over integer costs in units of 1 / 256.
 
     Each open cell sits in exactly one bucket (a doubly linked list threaded through per-cell arrays),
@@ -231,10 +232,18 @@ def extract_path(parent: NDArray[np.int64], index: int, width: int, reached: boo
     return np.column_stack([chain // width, chain % width])
 
 
-def dijkstra(cost: NDArray[np.float32], start: tuple[int, int], *, goal: NDArray[np.bool_] | None = None,
-             keep: NDArray[np.bool_] | None = None, ratio: float = 1.0, escape: NDArray[np.float32] | None = None,
-             escape_radius: float = 0.0, max_cost: float = math.inf,
-             interior: tuple[int, int, int, int] | None = None) -> PlanResult:
+def dijkstra(
+    cost: NDArray[np.float32],
+    start: tuple[int, int],
+    *,
+    goal: NDArray[np.bool_] | None = None,
+    keep: NDArray[np.bool_] | None = None,
+    ratio: float = 1.0,
+    escape: NDArray[np.float32] | None = None,
+    escape_radius: float = 0.0,
+    max_cost: float = math.inf,
+    interior: tuple[int, int, int, int] | None = None,
+) -> PlanResult:
     """Cost-to-come from ``start`` over the costmap, optionally stopping at the cheapest goal cell.
 
     Parameters
@@ -272,11 +281,29 @@ def dijkstra(cost: NDArray[np.float32], start: tuple[int, int], *, goal: NDArray
         escape, escape_radius = cost, -1.0
     ir0, ir1, ic0, ic1 = (-1, height + 1, -1, width + 1) if interior is None else (int(v) for v in interior)
     dist, parent, found, kept, first_cost, boundary = _dijkstra(
-        np.ascontiguousarray(cost, dtype=np.float32), np.ascontiguousarray(escape, dtype=np.float32), sr, sc,
-        np.ascontiguousarray(goal) if use_goal else dummy, np.ascontiguousarray(keep) if use_keep else dummy,
-        use_goal, use_keep, float(ratio), math.copysign(float(escape_radius) ** 2, escape_radius), float(max_cost),
-        ir0, ir1, ic0, ic1)
+        np.ascontiguousarray(cost, dtype=np.float32),
+        np.ascontiguousarray(escape, dtype=np.float32),
+        sr,
+        sc,
+        np.ascontiguousarray(goal) if use_goal else dummy,
+        np.ascontiguousarray(keep) if use_keep else dummy,
+        use_goal,
+        use_keep,
+        float(ratio),
+        math.copysign(float(escape_radius) ** 2, escape_radius),
+        float(max_cost),
+        ir0,
+        ir1,
+        ic0,
+        ic1,
+    )
     where = None if found < 0 else (int(found // width), int(found % width))
-    return PlanResult(cost_to_come=dist, parent=parent, goal=where, kept=bool(kept), width=width,
-                      first_cost=None if first_cost < 0 else first_cost / _SCALE,
-                      boundary_cost=None if boundary < 0 else boundary / _SCALE)
+    return PlanResult(
+        cost_to_come=dist,
+        parent=parent,
+        goal=where,
+        kept=bool(kept),
+        width=width,
+        first_cost=None if first_cost < 0 else first_cost / _SCALE,
+        boundary_cost=None if boundary < 0 else boundary / _SCALE,
+    )

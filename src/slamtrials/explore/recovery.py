@@ -109,8 +109,9 @@ def segment_clear(occupancy: Any, a: ArrayLike, b: ArrayLike, radius: float) -> 
     pa = np.asarray(a, dtype=np.float64)[:2]
     pb = np.asarray(b, dtype=np.float64)[:2]
     reach = radius + resolution
-    corners = np.array([[min(pa[0], pb[0]) - reach, max(pa[1], pb[1]) + reach],
-                        [max(pa[0], pb[0]) + reach, min(pa[1], pb[1]) - reach]])
+    corners = np.array(
+        [[min(pa[0], pb[0]) - reach, max(pa[1], pb[1]) + reach], [max(pa[0], pb[0]) + reach, min(pa[1], pb[1]) - reach]]
+    )
     rows, cols = frame.to_cell(corners)
     r0, r1 = int(max(rows.min(), 0)), int(min(rows.max() + 1, grid.shape[0]))
     c0, c1 = int(max(cols.min(), 0)), int(min(cols.max() + 1, grid.shape[1]))
@@ -183,7 +184,10 @@ class Recovery:
             phases.append((abs(turn) / rate, 0.0, math.copysign(rate, turn)))
             phases.append((length / cfg.backoff_speed, direction * cfg.backoff_speed, 0.0))
         else:
-            behind = (x - (cfg.backoff_distance + 0.05) * math.cos(theta), y - (cfg.backoff_distance + 0.05) * math.sin(theta))
+            behind = (
+                x - (cfg.backoff_distance + 0.05) * math.cos(theta),
+                y - (cfg.backoff_distance + 0.05) * math.sin(theta),
+            )
             if cfg.backoff_distance > 0.0 and segment_clear(occupancy, (x, y), behind, robot.radius):
                 phases.append((cfg.backoff_distance / cfg.backoff_speed, -cfg.backoff_speed, 0.0))
             if cfg.recovery_turn > 0.0:

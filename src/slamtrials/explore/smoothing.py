@@ -128,8 +128,12 @@ def shortcut_path(cells: NDArray[np.integer], cost: NDArray[np.floating], max_sp
     cells = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
     if cells.shape[0] == 0:
         return np.zeros(0, dtype=np.int64)
-    return _shortcut(np.ascontiguousarray(cost, dtype=np.float64), np.ascontiguousarray(cells[:, 0]),
-                     np.ascontiguousarray(cells[:, 1]), int(max(max_span, 2)))
+    return _shortcut(
+        np.ascontiguousarray(cost, dtype=np.float64),
+        np.ascontiguousarray(cells[:, 0]),
+        np.ascontiguousarray(cells[:, 1]),
+        int(max(max_span, 2)),
+    )
 
 
 def resample_polyline(points: NDArray[np.floating], spacing: float) -> NDArray[np.float64]:

@@ -93,7 +93,7 @@ def align_into(older: Snapshot, newer: Snapshot, fill: int = 205) -> NDArray[np.
     r0, r1 = max(dr, 0), min(dr + oh, nh)
     c0, c1 = max(dc, 0), min(dc + ow, nw)
     if r0 < r1 and c0 < c1:
-        out[r0:r1, c0:c1] = older.image[r0 - dr:r1 - dr, c0 - dc:c1 - dc]
+        out[r0:r1, c0:c1] = older.image[r0 - dr : r1 - dr, c0 - dc : c1 - dc]
     return out
 
 
@@ -182,7 +182,9 @@ class SnapshotTermination:
         if t < self._next - 1e-9:
             return None
         grid, resolution, origin = map_arrays(occupancy)
-        snap = Snapshot(float(t), map_image(grid, cfg.unknown_grey), resolution, origin.copy(), free_area(grid, resolution))
+        snap = Snapshot(
+            float(t), map_image(grid, cfg.unknown_grey), resolution, origin.copy(), free_area(grid, resolution)
+        )
         self.snapshots += 1
         if self._last is not None:
             mse = snapshot_mse(self._last, snap, factor=cfg.downscale, channels=cfg.channels, fill=cfg.unknown_grey)

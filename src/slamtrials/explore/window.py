@@ -27,7 +27,7 @@ def crop(grid: NDArray[np.int8], row0: int, row1: int, col0: int, col1: int) -> 
     sr0, sr1 = max(row0, 0), min(row1, grid.shape[0])
     sc0, sc1 = max(col0, 0), min(col1, grid.shape[1])
     if sr0 < sr1 and sc0 < sc1:
-        window[sr0 - row0:sr1 - row0, sc0 - col0:sc1 - col0] = grid[sr0:sr1, sc0:sc1]
+        window[sr0 - row0 : sr1 - row0, sc0 - col0 : sc1 - col0] = grid[sr0:sr1, sc0:sc1]
     return window
 
 

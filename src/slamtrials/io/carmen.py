@@ -63,7 +63,9 @@ __all__ = [
 TRUTH_SOURCE = "carmen first pose triple (may be a SLAM-corrected pose, not ground truth)"
 
 
-def _velocities(t: NDArray[np.float64], odometry: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def _velocities(
+    t: NDArray[np.float64], odometry: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Forward and angular velocity (m/s, rad/s) over the step that ends at each frame (0 at the first)."""
     tv, rv = np.zeros(len(t)), np.zeros(len(t))
     if len(t) > 1:
@@ -108,12 +110,28 @@ def carmen_from_run(record: RunRecord, *, kind: str = "ROBOTLASER1", hostname: s
     params = {name: float_text(value) for name, value in zip(PARAM_MOUNT, laser.mount)}
     params[PARAM_RANGE_MIN] = float_text(laser.range_min)
     return CarmenLog(
-        laser=CarmenLaser(kind=kind, t=t.copy(), logger_t=logger_t, hostname=hostname,
-                          ranges=np.asarray(record.scans, dtype=np.float32), pose=np.asarray(record.truth, dtype=np.float64),
-                          odometry=odometry, angle_min=laser.angle_min, angle_increment=laser.angle_increment,
-                          range_max=laser.range_max, extra=extra),
-        odom=CarmenOdometry(t=t.copy(), logger_t=logger_t.copy(), hostname=hostname, pose=odometry.copy(),
-                            tv=tv, rv=rv, accel=np.zeros(len(t))),
+        laser=CarmenLaser(
+            kind=kind,
+            t=t.copy(),
+            logger_t=logger_t,
+            hostname=hostname,
+            ranges=np.asarray(record.scans, dtype=np.float32),
+            pose=np.asarray(record.truth, dtype=np.float64),
+            odometry=odometry,
+            angle_min=laser.angle_min,
+            angle_increment=laser.angle_increment,
+            range_max=laser.range_max,
+            extra=extra,
+        ),
+        odom=CarmenOdometry(
+            t=t.copy(),
+            logger_t=logger_t.copy(),
+            hostname=hostname,
+            pose=odometry.copy(),
+            tv=tv,
+            rv=rv,
+            accel=np.zeros(len(t)),
+        ),
         params=params,
     )
 
@@ -133,9 +151,18 @@ def carmen_from_trajectory(trajectory: Trajectory, *, hostname: str = "slamtrial
     """
     t = np.asarray(trajectory.t, dtype=np.float64)
     poses = np.asarray(trajectory.poses, dtype=np.float64)
-    laser = CarmenLaser(kind="FLASER", t=t.copy(), logger_t=t - t[0] if len(t) else t.copy(), hostname=hostname,
-                        ranges=np.zeros((len(t), 0), dtype=np.float32), pose=poses.copy(), odometry=poses.copy(),
-                        angle_min=0.0, angle_increment=0.0, range_max=0.0)
+    laser = CarmenLaser(
+        kind="FLASER",
+        t=t.copy(),
+        logger_t=t - t[0] if len(t) else t.copy(),
+        hostname=hostname,
+        ranges=np.zeros((len(t), 0), dtype=np.float32),
+        pose=poses.copy(),
+        odometry=poses.copy(),
+        angle_min=0.0,
+        angle_increment=0.0,
+        range_max=0.0,
+    )
     return CarmenLog(laser=laser)
 
 
@@ -158,9 +185,13 @@ def run_from_carmen(log: CarmenLog) -> RunRecord:
     """
     laser, params = log.laser, log.params
     mount = [_param_float(params, name) for name in PARAM_MOUNT]
-    geometry = LaserGeometry(angle_min=float(laser.angle_min), angle_increment=float(laser.angle_increment),
-                             range_min=_param_float(params, PARAM_RANGE_MIN), range_max=float(laser.range_max),
-                             mount=(mount[0], mount[1], mount[2]))
+    geometry = LaserGeometry(
+        angle_min=float(laser.angle_min),
+        angle_increment=float(laser.angle_increment),
+        range_min=_param_float(params, PARAM_RANGE_MIN),
+        range_max=float(laser.range_max),
+        mount=(mount[0], mount[1], mount[2]),
+    )
     hosts = sorted(set(laser.hostnames()))
     metadata: dict[str, Any] = {
         "source_format": "carmen",
@@ -174,5 +205,12 @@ def run_from_carmen(log: CarmenLog) -> RunRecord:
         "field_of_view_deg": math.degrees(laser.angle_increment * max(laser.beams - 1, 0)),
     }
     n = len(laser)
-    return RunRecord(t=laser.t.copy(), scans=laser.ranges.astype(np.float32, copy=True), odometry=laser.odometry.copy(),
-                     truth=laser.pose.copy(), stalled=np.zeros(n, dtype=bool), laser=geometry, metadata=metadata)
+    return RunRecord(
+        t=laser.t.copy(),
+        scans=laser.ranges.astype(np.float32, copy=True),
+        odometry=laser.odometry.copy(),
+        truth=laser.pose.copy(),
+        stalled=np.zeros(n, dtype=bool),
+        laser=geometry,
+        metadata=metadata,
+    )

@@ -57,8 +57,9 @@ def _same_everywhere(geometry: NDArray[np.float64], counts: NDArray[np.int64]) -
     return bool((counts == counts[0]).all() and (geometry == geometry[0]).all())
 
 
-def common_grid(path: Path, kind: str, numbers: list[int], ranges: list[NDArray[np.float64]],
-                geometry: NDArray[np.float64]) -> CommonGrid:
+def common_grid(
+    path: Path, kind: str, numbers: list[int], ranges: list[NDArray[np.float64]], geometry: NDArray[np.float64]
+) -> CommonGrid:
     """Stack the readings of ``N`` lines on their common angular grid (see the module docstring).
 
     Parameters
@@ -81,13 +82,20 @@ def common_grid(path: Path, kind: str, numbers: list[int], ranges: list[NDArray[
     none = np.zeros(0, dtype=np.int64)
     if _same_everywhere(geometry, counts):
         stacked = np.stack(ranges) if counts[0] else np.zeros((n, 0))
-        return CommonGrid(stacked.astype(np.float32), float(geometry[0, 0]), float(geometry[0, 1]), float(geometry[0, 2]),
-                          none, none)
+        return CommonGrid(
+            stacked.astype(np.float32), float(geometry[0, 0]), float(geometry[0, 1]), float(geometry[0, 2]), none, none
+        )
     range_max = float(geometry[:, 2].max())
     with_readings = np.flatnonzero(counts > 0)
     if with_readings.size == 0:
-        return CommonGrid(np.zeros((n, 0), np.float32), float(geometry[0, 0]), float(geometry[0, 1]), range_max, none,
-                          np.flatnonzero(geometry[:, 2] < range_max))
+        return CommonGrid(
+            np.zeros((n, 0), np.float32),
+            float(geometry[0, 0]),
+            float(geometry[0, 1]),
+            range_max,
+            none,
+            np.flatnonzero(geometry[:, 2] < range_max),
+        )
     ref = int(with_readings[0])
     start0, increment = float(geometry[ref, 0]), float(geometry[ref, 1])
     offsets = np.zeros(n, dtype=np.int64)
@@ -99,17 +107,25 @@ def common_grid(path: Path, kind: str, numbers: list[int], ranges: list[NDArray[
         near = abs(steps) <= widest + 1  # finite and small enough to round; shifts beyond the widest line refused
         on_grid = same_increment and near and abs(steps - round(steps)) <= _OFFSET_TOL and abs(round(steps)) <= widest
         if not on_grid:
-            raise FormatError(path, f"{kind} has {counts[i]} readings from {start!r} rad every {inc!r} rad, not on the angular "
-                              f"grid of line {numbers[ref]} ({counts[ref]} from {start0!r} every {increment!r}): slamtrials "
-                              "stacks scans on one grid (slamtrials evaluate reads only the poses of such a log)", line=numbers[i])
+            raise FormatError(
+                path,
+                f"{kind} has {counts[i]} readings from {start!r} rad every {inc!r} rad, not on the angular "
+                f"grid of line {numbers[ref]} ({counts[ref]} from {start0!r} every {increment!r}): slamtrials "
+                "stacks scans on one grid (slamtrials evaluate reads only the poses of such a log)",
+                line=numbers[i],
+            )
         offsets[i] = round(steps)
     low = int(offsets[with_readings].min())
     high = int((offsets + counts - 1)[with_readings].max())
     beams = high - low + 1
     if beams > 2 * widest:
         i = int(with_readings[np.argmax((offsets != offsets[ref])[with_readings])])
-        raise FormatError(path, f"{kind} lines on one angular grid would span {beams} beams, more than twice the widest "
-                          f"line ({widest}): not one laser (slamtrials evaluate reads only the poses of such a log)", line=numbers[i])
+        raise FormatError(
+            path,
+            f"{kind} lines on one angular grid would span {beams} beams, more than twice the widest "
+            f"line ({widest}): not one laser (slamtrials evaluate reads only the poses of such a log)",
+            line=numbers[i],
+        )
     out = np.full((n, beams), range_max, dtype=np.float64)
     for i in with_readings.tolist():
         row = ranges[i]

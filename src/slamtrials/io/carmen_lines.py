@@ -16,8 +16,20 @@ from numpy.typing import NDArray
 from slamtrials.errors import FormatError
 from slamtrials.io.textfile import parse_floats, parse_int
 
-__all__ = ["LaserLine", "parse_flaser", "parse_robotlaser", "parse_odom", "parse_param", "param_number",
-           "POSES", "ROBOT_POSES", "EXTRA", "CONFIG", "ODOM_FIELDS", "STAMP_COLUMNS"]
+__all__ = [
+    "LaserLine",
+    "parse_flaser",
+    "parse_robotlaser",
+    "parse_odom",
+    "parse_param",
+    "param_number",
+    "POSES",
+    "ROBOT_POSES",
+    "EXTRA",
+    "CONFIG",
+    "ODOM_FIELDS",
+    "STAMP_COLUMNS",
+]
 
 POSES = ("x", "y", "theta", "odom_x", "odom_y", "odom_theta")
 ROBOT_POSES = ("laser_pose_x", "laser_pose_y", "laser_pose_theta", "robot_pose_x", "robot_pose_y", "robot_pose_theta")
@@ -60,8 +72,12 @@ def parse_flaser(path: Path, line: int, tokens: list[str]) -> LaserLine:
         raise FormatError(path, "FLASER line ends before num_readings", line=line)
     n = parse_int(path, line, tokens[1], 2, "num_readings")
     if len(tokens) != n + 11:
-        raise FormatError(path, f"FLASER with num_readings {n} needs {n + 11} fields (FLASER n, {n} ranges, "
-                          f"6 pose numbers, ipc_timestamp ipc_hostname logger_timestamp), got {len(tokens)}", line=line)
+        raise FormatError(
+            path,
+            f"FLASER with num_readings {n} needs {n + 11} fields (FLASER n, {n} ranges, "
+            f"6 pose numbers, ipc_timestamp ipc_hostname logger_timestamp), got {len(tokens)}",
+            line=line,
+        )
     ranges = parse_floats(path, line, tokens[2 : n + 2], 3, "range")
     tail = parse_floats(path, line, tokens[n + 2 : n + 9], n + 3, (*POSES, "ipc_timestamp"))
     logger = parse_floats(path, line, tokens[-1:], n + 11, "logger_timestamp")
@@ -79,16 +95,22 @@ def parse_robotlaser(path: Path, line: int, tokens: list[str]) -> LaserLine:
     remission_mode = parse_int(path, line, tokens[7], 8, "remission_mode")
     n = parse_int(path, line, tokens[8], 9, "num_readings")
     if len(tokens) < n + 10:
-        raise FormatError(path, f"ROBOTLASER1 with num_readings {n} ends after {len(tokens)} fields, before num_remissions",
-                          line=line)
+        raise FormatError(
+            path, f"ROBOTLASER1 with num_readings {n} ends after {len(tokens)} fields, before num_remissions", line=line
+        )
     m = parse_int(path, line, tokens[n + 9], n + 10, "num_remissions")
     if len(tokens) != n + m + 24:
-        raise FormatError(path, f"ROBOTLASER1 with num_readings {n} and num_remissions {m} needs {n + m + 24} fields, "
-                          f"got {len(tokens)}", line=line)
+        raise FormatError(
+            path,
+            f"ROBOTLASER1 with num_readings {n} and num_remissions {m} needs {n + m + 24} fields, got {len(tokens)}",
+            line=line,
+        )
     config = parse_floats(path, line, tokens[2:7], 3, CONFIG)
     ranges = parse_floats(path, line, tokens[9 : n + 9], 10, "range")
     parse_floats(path, line, tokens[n + 10 : n + m + 10], n + 11, "remission")
-    tail = parse_floats(path, line, tokens[n + m + 10 : n + m + 22], n + m + 11, (*ROBOT_POSES, *EXTRA, "ipc_timestamp"))
+    tail = parse_floats(
+        path, line, tokens[n + m + 10 : n + m + 22], n + m + 11, (*ROBOT_POSES, *EXTRA, "ipc_timestamp")
+    )
     logger = parse_floats(path, line, tokens[-1:], n + m + 24, "logger_timestamp")
     return LaserLine(np.array(ranges), np.array(tail + logger), np.array(config), (laser_type, remission_mode))
 
@@ -96,9 +118,15 @@ def parse_robotlaser(path: Path, line: int, tokens: list[str]) -> LaserLine:
 def parse_odom(path: Path, line: int, tokens: list[str]) -> list[float]:
     """``ODOM x y theta tv rv accel ipc_timestamp ipc_hostname logger_timestamp`` -> the 8 numbers."""
     if len(tokens) != 10:
-        raise FormatError(path, "expected 10 fields 'ODOM x y theta tv rv accel ipc_timestamp ipc_hostname logger_timestamp', "
-                          f"got {len(tokens)}", line=line)
-    return parse_floats(path, line, tokens[1:8], 2, ODOM_FIELDS[:7]) + parse_floats(path, line, tokens[9:], 10, "logger_timestamp")
+        raise FormatError(
+            path,
+            "expected 10 fields 'ODOM x y theta tv rv accel ipc_timestamp ipc_hostname logger_timestamp', "
+            f"got {len(tokens)}",
+            line=line,
+        )
+    return parse_floats(path, line, tokens[1:8], 2, ODOM_FIELDS[:7]) + parse_floats(
+        path, line, tokens[9:], 10, "logger_timestamp"
+    )
 
 
 def _is_number(token: str) -> bool:
@@ -128,7 +156,9 @@ def parse_param(path: Path, line: int, tokens: list[str]) -> tuple[str, str]:
     return tokens[1], " ".join(rest)
 
 
-def param_number(path: Path, params: dict[str, str], where: dict[str, int], name: str, positive: bool = True) -> float | None:
+def param_number(
+    path: Path, params: dict[str, str], where: dict[str, int], name: str, positive: bool = True
+) -> float | None:
     """The numeric PARAM ``name`` (None if absent): its value's first token, so that trailing fields a
     logger appended are tolerated. FormatError at its line if that is not a finite (positive) number."""
     if name not in params:

@@ -95,8 +95,12 @@ class CarmenLaser:
         n = len(self.t)
         if np.ndim(self.ranges) != 2 or len(self.ranges) != n:
             raise ValueError(f"CarmenLaser.ranges has shape {np.shape(self.ranges)}, expected [{n}, B]")
-        shapes = {"t": (self.t, (n,)), "logger_t": (self.logger_t, (n,)),
-                  "pose": (self.pose, (n, 3)), "odometry": (self.odometry, (n, 3))}
+        shapes = {
+            "t": (self.t, (n,)),
+            "logger_t": (self.logger_t, (n,)),
+            "pose": (self.pose, (n, 3)),
+            "odometry": (self.odometry, (n, 3)),
+        }
         if self.extra is not None:
             shapes["extra"] = (self.extra, (n, len(ROBOTLASER_EXTRA)))
         if self.line_readings is not None:
@@ -161,11 +165,18 @@ class CarmenOdometry:
         return len(self.t)
 
     @classmethod
-    def empty(cls) -> "CarmenOdometry":
+    def empty(cls) -> CarmenOdometry:
         """A log without ODOM lines."""
         zeros = np.zeros(0)
-        return cls(t=zeros, logger_t=zeros.copy(), hostname=[], pose=np.zeros((0, 3)),
-                   tv=zeros.copy(), rv=zeros.copy(), accel=zeros.copy())
+        return cls(
+            t=zeros,
+            logger_t=zeros.copy(),
+            hostname=[],
+            pose=np.zeros((0, 3)),
+            tv=zeros.copy(),
+            rv=zeros.copy(),
+            accel=zeros.copy(),
+        )
 
     def hostnames(self) -> list[str]:
         """The ``ipc_hostname`` of every line, a list of ``M`` strings."""

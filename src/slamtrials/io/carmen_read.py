@@ -30,11 +30,28 @@ from numpy.typing import NDArray
 
 from slamtrials.errors import FormatError
 from slamtrials.io.carmen_grid import common_grid
-from slamtrials.io.carmen_lines import CONFIG, EXTRA, LaserLine, param_number, parse_flaser, parse_odom, parse_param, parse_robotlaser
+from slamtrials.io.carmen_lines import (
+    CONFIG,
+    EXTRA,
+    LaserLine,
+    param_number,
+    parse_flaser,
+    parse_odom,
+    parse_param,
+    parse_robotlaser,
+)
 from slamtrials.io.carmen_log import LASER_KINDS, CarmenLaser, CarmenLog, CarmenOdometry
 from slamtrials.io.textfile import data_lines, first_bad_row, last_line, read_lines
 
-__all__ = ["read_carmen", "PARAM_RANGE_MAX", "PARAM_FOV", "PARAM_RESOLUTION", "PARAM_MOUNT", "PARAM_RANGE_MIN", "TOLERATED"]
+__all__ = [
+    "read_carmen",
+    "PARAM_RANGE_MAX",
+    "PARAM_FOV",
+    "PARAM_RESOLUTION",
+    "PARAM_MOUNT",
+    "PARAM_RANGE_MIN",
+    "TOLERATED",
+]
 
 log = logging.getLogger(__name__)
 
@@ -106,11 +123,19 @@ def _check_ranges(path: Path, kind: str, ranges: list[NDArray[np.float64]], numb
         if bad.any():
             col = int(np.argmax(bad))
             value = values[col]
-            problem = "is not finite" if not np.isfinite(value) else "is negative" if value < 0 else "is too large for float32"
+            problem = (
+                "is not finite"
+                if not np.isfinite(value)
+                else "is negative"
+                if value < 0
+                else "is too large for float32"
+            )
             raise FormatError(path, f"{kind} range {col + 1} {problem}: {value}", line=numbers[row])
 
 
-def _order(t: NDArray[np.float64], numbers: NDArray[np.int64], tally: _Tally, what: str, unique: bool) -> NDArray[np.int64]:
+def _order(
+    t: NDArray[np.float64], numbers: NDArray[np.int64], tally: _Tally, what: str, unique: bool
+) -> NDArray[np.int64]:
     """Indices that put ``t`` in order (stable); with ``unique``, the first of equal timestamps only."""
     late = np.flatnonzero(t[1:] < np.maximum.accumulate(t)[:-1]) + 1
     tally.add(f"{what}_reordered", numbers[late])
@@ -176,11 +201,16 @@ def read_carmen(path: str | Path, *, ranges: bool = True) -> CarmenLog:
     for number, tokens in data_lines(lines):
         name = tokens[0]
         if name in LASER_KINDS and kind is not None and name != kind:
-            raise FormatError(path, f"{name} line in a log of {kind} lines (line {numbers[0]}); slamtrials reads one front laser",
-                              line=number)
+            raise FormatError(
+                path,
+                f"{name} line in a log of {kind} lines (line {numbers[0]}); slamtrials reads one front laser",
+                line=number,
+            )
         try:
             if name in LASER_KINDS:
-                parsed = parse_flaser(path, number, tokens) if name == "FLASER" else parse_robotlaser(path, number, tokens)
+                parsed = (
+                    parse_flaser(path, number, tokens) if name == "FLASER" else parse_robotlaser(path, number, tokens)
+                )
                 kind = name
                 laser_lines.append(parsed)
                 numbers.append(number)
@@ -202,12 +232,21 @@ def read_carmen(path: str | Path, *, ranges: bool = True) -> CarmenLog:
     for key in (*PARAM_MOUNT, PARAM_RANGE_MIN):
         param_number(path, params, param_lines, key, positive=False)
     if kind is None:
-        rear = f" ({skipped['RLASER']} RLASER lines: slamtrials reads the front laser, as the Freiburg evaluator does)" if skipped["RLASER"] else ""
+        rear = (
+            f" ({skipped['RLASER']} RLASER lines: slamtrials reads the front laser, as the Freiburg evaluator does)"
+            if skipped["RLASER"]
+            else ""
+        )
         raise FormatError(path, f"no FLASER or ROBOTLASER1 line: not a CARMEN log with a front laser{rear}", line=final)
     laser = _laser(path, kind, laser_lines, numbers, hosts, params, param_lines, tally, ranges)
     odom = _odometry(path, odom_rows, odom_numbers, odom_hosts, tally)
-    tally.warn(kind, {"laser_padded": f" to {laser.beams} beams ({laser.range_max:g} m)",
-                      "laser_range_raised": f" ({laser.range_max:g} m)"})
+    tally.warn(
+        kind,
+        {
+            "laser_padded": f" to {laser.beams} beams ({laser.range_max:g} m)",
+            "laser_range_raised": f" ({laser.range_max:g} m)",
+        },
+    )
     return CarmenLog(laser=laser, odom=odom, params=params, skipped=dict(skipped), tolerated=dict(tally.counts))
 
 
@@ -215,8 +254,9 @@ def _one_or_all(hosts: list[str]) -> str | list[str]:
     return hosts[0] if hosts and hosts.count(hosts[0]) == len(hosts) else hosts
 
 
-def _geometry(path: Path, kind: str, kept: list[LaserLine], numbers: list[int], params: dict[str, str],
-              where: dict[str, int]) -> NDArray[np.float64]:
+def _geometry(
+    path: Path, kind: str, kept: list[LaserLine], numbers: list[int], params: dict[str, str], where: dict[str, int]
+) -> NDArray[np.float64]:
     """float64 ``[N, 3]`` angle of the first beam, increment (rad) and maximum range (m) of each line."""
     n = len(kept)
     geometry = np.empty((n, 3))
@@ -228,13 +268,17 @@ def _geometry(path: Path, kind: str, kept: list[LaserLine], numbers: list[int], 
         small = np.flatnonzero(~((config[:, 3] > 0) & (config[:, 3] <= _FLOAT32_MAX)))
         if small.size:
             i = int(small[0])
-            raise FormatError(path, f"ROBOTLASER1 maximum_range must be positive (and a float32), got {config[i, 3]}", line=numbers[i])
+            raise FormatError(
+                path, f"ROBOTLASER1 maximum_range must be positive (and a float32), got {config[i, 3]}", line=numbers[i]
+            )
         geometry[:, 0], geometry[:, 1], geometry[:, 2] = config[:, 0], config[:, 2], config[:, 3]
         return geometry
     counts = [len(line.ranges) for line in kept]
     range_max = param_number(path, params, where, PARAM_RANGE_MAX)
     if range_max is not None and range_max > _FLOAT32_MAX:
-        raise FormatError(path, f"PARAM {PARAM_RANGE_MAX} is too large for float32: {range_max}", line=where[PARAM_RANGE_MAX])
+        raise FormatError(
+            path, f"PARAM {PARAM_RANGE_MAX} is too large for float32: {range_max}", line=where[PARAM_RANGE_MAX]
+        )
     if range_max is None:
         usable = [line.ranges[np.isfinite(line.ranges) & (line.ranges <= _FLOAT32_MAX)] for line in kept]
         top = max((float(r.max()) for r in usable if len(r)), default=0.0)
@@ -245,8 +289,17 @@ def _geometry(path: Path, kind: str, kept: list[LaserLine], numbers: list[int], 
     return geometry
 
 
-def _laser(path: Path, kind: str, parsed: list[LaserLine], numbers_list: list[int], hosts: list[str],
-           params: dict[str, str], where: dict[str, int], tally: _Tally, with_ranges: bool) -> CarmenLaser:
+def _laser(
+    path: Path,
+    kind: str,
+    parsed: list[LaserLine],
+    numbers_list: list[int],
+    hosts: list[str],
+    params: dict[str, str],
+    where: dict[str, int],
+    tally: _Tally,
+    with_ranges: bool,
+) -> CarmenLaser:
     numbers = np.asarray(numbers_list, dtype=np.int64)
     stamps = np.stack([line.stamps for line in parsed])
     finite = np.isfinite(stamps).all(axis=1)
@@ -272,15 +325,28 @@ def _laser(path: Path, kind: str, parsed: list[LaserLine], numbers_list: list[in
     rows = stamps[order]
     first = kept[0]
     integers = first.integers if first.integers is not None else (0, 0)  # ROBOTLASER1's laser_type, remission_mode
-    return CarmenLaser(kind=kind, t=rows[:, -2].copy(), logger_t=rows[:, -1].copy(),
-                       hostname=_one_or_all([hosts[i] for i in order.tolist()]), ranges=scans, pose=rows[:, :3].copy(),
-                       odometry=rows[:, 3:6].copy(), angle_min=angle_min, angle_increment=increment, range_max=range_max,
-                       laser_type=integers[0], accuracy=float(first.config[4]) if first.config is not None else 0.0,
-                       remission_mode=integers[1], extra=rows[:, 6 : 6 + len(EXTRA)].copy() if kind == "ROBOTLASER1" else None,
-                       line_readings=np.array([len(r) for r in readings], dtype=np.int64))
+    return CarmenLaser(
+        kind=kind,
+        t=rows[:, -2].copy(),
+        logger_t=rows[:, -1].copy(),
+        hostname=_one_or_all([hosts[i] for i in order.tolist()]),
+        ranges=scans,
+        pose=rows[:, :3].copy(),
+        odometry=rows[:, 3:6].copy(),
+        angle_min=angle_min,
+        angle_increment=increment,
+        range_max=range_max,
+        laser_type=integers[0],
+        accuracy=float(first.config[4]) if first.config is not None else 0.0,
+        remission_mode=integers[1],
+        extra=rows[:, 6 : 6 + len(EXTRA)].copy() if kind == "ROBOTLASER1" else None,
+        line_readings=np.array([len(r) for r in readings], dtype=np.int64),
+    )
 
 
-def _odometry(path: Path, rows: list[list[float]], numbers_list: list[int], hosts: list[str], tally: _Tally) -> CarmenOdometry:
+def _odometry(
+    path: Path, rows: list[list[float]], numbers_list: list[int], hosts: list[str], tally: _Tally
+) -> CarmenOdometry:
     if not rows:
         return CarmenOdometry.empty()
     values = np.array(rows, dtype=np.float64)
@@ -292,6 +358,12 @@ def _odometry(path: Path, rows: list[list[float]], numbers_list: list[int], host
         return CarmenOdometry.empty()
     order = keep[_order(values[keep, 6], numbers[keep], tally, "odom", unique=False)]
     values = values[order]
-    return CarmenOdometry(t=values[:, 6].copy(), logger_t=values[:, 7].copy(), hostname=_one_or_all([hosts[i] for i in order.tolist()]),
-                          pose=values[:, :3].copy(), tv=values[:, 3].copy(), rv=values[:, 4].copy(), accel=values[:, 5].copy())
-
+    return CarmenOdometry(
+        t=values[:, 6].copy(),
+        logger_t=values[:, 7].copy(),
+        hostname=_one_or_all([hosts[i] for i in order.tolist()]),
+        pose=values[:, :3].copy(),
+        tv=values[:, 3].copy(),
+        rv=values[:, 4].copy(),
+        accel=values[:, 5].copy(),
+    )

@@ -65,10 +65,14 @@ def _geometry_params(laser: CarmenLaser) -> dict[str, str]:
         return {}
     params = {PARAM_RANGE_MAX: float_text(laser.range_max)}
     if beams > 1:
-        if not increment > 0 or not math.isclose(laser.angle_min, -increment * (beams - 1) / 2, rel_tol=1e-12, abs_tol=1e-12):
-            raise ValueError("write_carmen: FLASER lines need a counter-clockwise scan centred on the heading "
-                             f"(angle_min = -angle_increment * (B - 1) / 2); got angle_min {laser.angle_min}, "
-                             f"angle_increment {increment}: write ROBOTLASER1 instead")
+        if not increment > 0 or not math.isclose(
+            laser.angle_min, -increment * (beams - 1) / 2, rel_tol=1e-12, abs_tol=1e-12
+        ):
+            raise ValueError(
+                "write_carmen: FLASER lines need a counter-clockwise scan centred on the heading "
+                f"(angle_min = -angle_increment * (B - 1) / 2); got angle_min {laser.angle_min}, "
+                f"angle_increment {increment}: write ROBOTLASER1 instead"
+            )
         params[PARAM_RESOLUTION] = float_text(math.degrees(increment))
         params[PARAM_FOV] = float_text(math.degrees(increment * (beams - 1)))
     return params
@@ -90,12 +94,16 @@ def _check(log: CarmenLog) -> None:
         raise ValueError("write_carmen: laser.ranges holds negative ranges")
     for name in ("t", "logger_t", "pose", "tv", "rv", "accel"):
         _finite(f"odom.{name}", getattr(odom, name))
-    for host in sorted(set(laser.hostnames()) | set(odom.hostnames())):  # sorted: the same host named first on every run
+    for host in sorted(
+        set(laser.hostnames()) | set(odom.hostnames())
+    ):  # sorted: the same host named first on every run
         _token("hostname", host)
     for key, value in log.params.items():
         _token("PARAM name", key)
         if not value or " ".join(value.split()) != value:
-            raise ValueError(f"write_carmen: PARAM {key} value must be non-empty words separated by single spaces, got {value!r}")
+            raise ValueError(
+                f"write_carmen: PARAM {key} value must be non-empty words separated by single spaces, got {value!r}"
+            )
 
 
 def _laser_lines(laser: CarmenLaser, stamps: list[str]) -> Iterator[str]:
@@ -106,7 +114,13 @@ def _laser_lines(laser: CarmenLaser, stamps: list[str]) -> Iterator[str]:
         fmt = f"FLASER {beams} " + ranges * beams + number * 6 + "%s %s " + NUMBER_FORMAT + "\n"
         tails: NDArray[np.float64] = np.hstack([laser.pose, laser.odometry])
     else:
-        config = (laser.angle_min, laser.angle_increment * (beams - 1), laser.angle_increment, laser.range_max, laser.accuracy)
+        config = (
+            laser.angle_min,
+            laser.angle_increment * (beams - 1),
+            laser.angle_increment,
+            laser.range_max,
+            laser.accuracy,
+        )
         numbers = " ".join(float_text(v) for v in config)
         head = f"ROBOTLASER1 {int(laser.laser_type)} {numbers} {int(laser.remission_mode)} {beams} "
         fmt = head + ranges * beams + "0 " + number * (6 + len(ROBOTLASER_EXTRA)) + "%s %s " + NUMBER_FORMAT + "\n"

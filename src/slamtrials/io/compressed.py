@@ -49,8 +49,12 @@ def _decompress(path: Path, data: bytes, kind: str) -> bytes:
             member = len(data) - len(rest)  # where the compressed stream that fails starts
             raise FormatError(path, f"not a readable {kind} file ({exc})", offset=member) from None
         if not engine.eof:
-            log.warning("%s: the %s stream ends early (file cut short?): read the %d bytes decompressed so far",
-                        path, kind, sum(len(p) for p in parts))
+            log.warning(
+                "%s: the %s stream ends early (file cut short?): read the %d bytes decompressed so far",
+                path,
+                kind,
+                sum(len(p) for p in parts),
+            )
             break
         rest = engine.unused_data
         if rest and compression_of(rest[:4]) != kind:

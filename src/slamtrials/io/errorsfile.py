@@ -24,13 +24,22 @@ def write_errors(path: str | Path, relations: Relations, errors) -> Path:
     t1, t2 = relations.t1[errors.index], relations.t2[errors.index]
     if path.suffix == ".npz":
         arrays = dict(
-            t1=t1, t2=t2, translational=errors.translational, rotational=errors.rotational, index=errors.index,
-            unmatched=errors.unmatched, corrected=errors.corrected, squared=np.array(errors.squared),
+            t1=t1,
+            t2=t2,
+            translational=errors.translational,
+            rotational=errors.rotational,
+            index=errors.index,
+            unmatched=errors.unmatched,
+            corrected=errors.corrected,
+            squared=np.array(errors.squared),
         )
         return atomic_write(path, lambda handle: np.savez(handle, **arrays))
     unit_t, unit_r = errors.units
     lines = [f"# t1 t2 translational_error[{unit_t}] rotational_error[{unit_r}]\n"]
-    lines += [f"{a!r} {b!r} {e!r} {r!r}\n" for a, b, e, r in zip(t1.tolist(), t2.tolist(), errors.translational.tolist(), errors.rotational.tolist())]
+    lines += [
+        f"{a!r} {b!r} {e!r} {r!r}\n"
+        for a, b, e, r in zip(t1.tolist(), t2.tolist(), errors.translational.tolist(), errors.rotational.tolist())
+    ]
     if len(errors.unmatched):
         lines.append(f"# unmatched relations (0-based): {' '.join(str(i) for i in errors.unmatched.tolist())}\n")
     return atomic_write_text(path, "".join(lines))

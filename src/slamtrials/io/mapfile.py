@@ -29,13 +29,24 @@ from numpy.typing import ArrayLike, NDArray
 
 from slamtrials.atomicfile import atomic_write, atomic_write_bytes, atomic_write_text
 from slamtrials.errors import FormatError
-from slamtrials.record import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from slamtrials.io.yamlfile import read_yaml_mapping
+from slamtrials.record import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from slamtrials.worlds.formats.image import read_pixels
 from slamtrials.worlds.formats.rosmap import MAP_MODES, classify_rosmap
 
-__all__ = ["OccupancyGrid", "write_map", "write_map_png", "read_map", "trinary", "FREE", "OCCUPIED", "UNKNOWN",
-           "FREE_GREY", "OCCUPIED_GREY", "UNKNOWN_GREY"]
+__all__ = [
+    "OccupancyGrid",
+    "write_map",
+    "write_map_png",
+    "read_map",
+    "trinary",
+    "FREE",
+    "OCCUPIED",
+    "UNKNOWN",
+    "FREE_GREY",
+    "OCCUPIED_GREY",
+    "UNKNOWN_GREY",
+]
 
 #: Grey levels map_saver writes.
 FREE_GREY, OCCUPIED_GREY, UNKNOWN_GREY = 254, 0, 205
@@ -63,7 +74,9 @@ def trinary(grid: ArrayLike) -> NDArray[np.int8]:
     elif np.issubdtype(grid.dtype, np.floating):
         percent = grid.astype(np.float64) * 100.0
     else:
-        raise ValueError(f"an occupancy grid holds integers (%), floats (probability) or booleans, got dtype {grid.dtype}")
+        raise ValueError(
+            f"an occupancy grid holds integers (%), floats (probability) or booleans, got dtype {grid.dtype}"
+        )
     out = np.full(grid.shape, UNKNOWN, dtype=np.int8)
     known = np.isfinite(percent) & (percent >= 0.0)
     out[known & (percent <= FREE_MAX_PERCENT)] = FREE
@@ -91,8 +104,9 @@ def _check_geometry(resolution: float, origin: ArrayLike) -> tuple[float, list[f
     return resolution, values
 
 
-def write_map(yaml_path: str | Path, grid: ArrayLike, resolution: float, origin: ArrayLike, *,
-              image: str | None = None) -> Path:
+def write_map(
+    yaml_path: str | Path, grid: ArrayLike, resolution: float, origin: ArrayLike, *, image: str | None = None
+) -> Path:
     """Write a SLAM map as map_saver does: a YAML file and a trinary image beside it.
 
     Parameters
@@ -120,7 +134,9 @@ def write_map(yaml_path: str | Path, grid: ArrayLike, resolution: float, origin:
     image_path = yaml_path.parent / image
     grey = _grey(grid)
     if image_path.suffix.lower() == ".pgm":
-        header = f"P5\n# CREATOR: slamtrials {resolution:.3f} m/pix\n{grey.shape[1]} {grey.shape[0]}\n255\n".encode("ascii")
+        header = f"P5\n# CREATOR: slamtrials {resolution:.3f} m/pix\n{grey.shape[1]} {grey.shape[0]}\n255\n".encode(
+            "ascii"
+        )
         atomic_write_bytes(image_path, header + grey.tobytes())
     elif image_path.suffix.lower() == ".png":
         write_map_png(image_path, grid)
@@ -143,7 +159,9 @@ def write_map_png(path: str | Path, grid: ArrayLike) -> Path:
     from PIL import Image
 
     grey = _grey(grid)
-    return atomic_write(Path(path), lambda handle: Image.fromarray(grey, mode="L").save(handle, format="PNG", optimize=True))
+    return atomic_write(
+        Path(path), lambda handle: Image.fromarray(grey, mode="L").save(handle, format="PNG", optimize=True)
+    )
 
 
 def _number(path: Path, doc: dict[str, Any], key: str) -> float:
@@ -177,8 +195,10 @@ def read_map(yaml_path: str | Path) -> OccupancyGrid:
     if resolution <= 0:
         raise FormatError(path, f"resolution: must be > 0 metres per cell, got {resolution!r}")
     origin = doc["origin"]
-    if not isinstance(origin, list) or len(origin) not in (2, 3) or not all(
-        isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in origin
+    if (
+        not isinstance(origin, list)
+        or len(origin) not in (2, 3)
+        or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in origin)
     ):
         raise FormatError(path, f"origin: expected [x, y, yaw], got {origin!r}")
     settings = {"negate": 0, **_YAML_THRESHOLDS, **{k: doc[k] for k in ("negate", *_YAML_THRESHOLDS) if k in doc}}
@@ -186,8 +206,11 @@ def read_map(yaml_path: str | Path) -> OccupancyGrid:
         raise FormatError(path, f"negate: expected 0 or 1, got {settings['negate']!r}")
     free_thresh, occupied_thresh = _number(path, settings, "free_thresh"), _number(path, settings, "occupied_thresh")
     if not 0.0 <= free_thresh < occupied_thresh <= 1.0:
-        raise FormatError(path, "thresholds must satisfy 0 <= free_thresh < occupied_thresh <= 1, "
-                                f"got {free_thresh:g}, {occupied_thresh:g}")
+        raise FormatError(
+            path,
+            "thresholds must satisfy 0 <= free_thresh < occupied_thresh <= 1, "
+            f"got {free_thresh:g}, {occupied_thresh:g}",
+        )
     mode = doc.get("mode", "trinary")
     if mode not in MAP_MODES:
         raise FormatError(path, f"mode: expected one of {', '.join(MAP_MODES)}, got {mode!r}")
@@ -195,8 +218,14 @@ def read_map(yaml_path: str | Path) -> OccupancyGrid:
     if not image_path.is_absolute():
         image_path = path.parent / image_path
     colour, alpha = read_pixels(image_path)
-    free, occupied = classify_rosmap(colour, alpha, negate=bool(settings["negate"]), occupied_thresh=occupied_thresh,
-                                     free_thresh=free_thresh, mode=mode)
+    free, occupied = classify_rosmap(
+        colour,
+        alpha,
+        negate=bool(settings["negate"]),
+        occupied_thresh=occupied_thresh,
+        free_thresh=free_thresh,
+        mode=mode,
+    )
     grid = np.full(free.shape, UNKNOWN, dtype=np.int8)
     grid[free] = FREE
     grid[occupied] = OCCUPIED

@@ -61,7 +61,9 @@ def read_relations(path: str | Path) -> Relations:
     vertical = np.flatnonzero(np.abs(cos_pitch) < 1e-9)
     if vertical.size:
         i = int(vertical[0])
-        raise FormatError(path, f"pitch {pitch[i]!r} points the x axis vertically: the relation has no 2-D heading", line=numbers[i])
+        raise FormatError(
+            path, f"pitch {pitch[i]!r} points the x axis vertically: the relation has no 2-D heading", line=numbers[i]
+        )
     planar = (roll == 0.0) & (pitch == 0.0)
     tilted = stablemath.arctan2(stablemath.sin(yaw) * cos_pitch, stablemath.cos(yaw) * cos_pitch)
     heading = np.where(planar, yaw, tilted)

@@ -46,8 +46,15 @@ __all__ = [
 ]
 
 
-def write_bag(path: str | Path, record: RunRecord, *, ros: int = 1, time_origin_ns: int = DEFAULT_TIME_ORIGIN_NS,
-              overwrite: bool = False, compress: bool = False) -> Path:
+def write_bag(
+    path: str | Path,
+    record: RunRecord,
+    *,
+    ros: int = 1,
+    time_origin_ns: int = DEFAULT_TIME_ORIGIN_NS,
+    overwrite: bool = False,
+    compress: bool = False,
+) -> Path:
     """Write ``record`` as a ROS 1 bag file (``ros=1``) or a ROS 2 MCAP bag folder (``ros=2``).
 
     See :func:`write_rosbag1` and :func:`write_rosbag2`; returns ``path``.

@@ -115,13 +115,26 @@ def run_from_bag(
         else:
             _require(bag, odom_topic, (rm.ODOMETRY,), "odometry")
         if truth_topic is not None:
-            _require(bag, truth_topic, (rm.ODOMETRY,), "ground truth; for a recording without it use truth_topic=None, "
-                                                       "in the CLI --no-truth")
-        wanted = _Wanted(scan_topic, None if use_tf else odom_topic, truth_topic, use_tf, odom_frame.lstrip("/"), base_frame.lstrip("/"))
+            _require(
+                bag,
+                truth_topic,
+                (rm.ODOMETRY,),
+                "ground truth; for a recording without it use truth_topic=None, in the CLI --no-truth",
+            )
+        wanted = _Wanted(
+            scan_topic,
+            None if use_tf else odom_topic,
+            truth_topic,
+            use_tf,
+            odom_frame.lstrip("/"),
+            base_frame.lstrip("/"),
+        )
         try:
             data = _collect(bag, wanted)
         except DECODE_ERRORS as exc:
-            raise FormatError(path, f"damaged {bag.kind} bag while reading messages: {exc or type(exc).__name__}") from None
+            raise FormatError(
+                path, f"damaged {bag.kind} bag while reading messages: {exc or type(exc).__name__}"
+            ) from None
         return _assemble(bag, data, wanted, pairing)
 
 
@@ -158,7 +171,9 @@ def _require(bag: BagSource, topic: str, types: tuple[str, ...], role: str) -> N
     if topic not in bag.topics:
         raise FormatError(bag.path, f"no topic {topic} ({role}); {bag.topic_list()}")
     if bag.topics[topic] not in types:
-        raise FormatError(bag.path, f"topic {topic} ({role}) has type {bag.topics[topic]}, expected {' or '.join(types)}")
+        raise FormatError(
+            bag.path, f"topic {topic} ({role}) has type {bag.topics[topic]}, expected {' or '.join(types)}"
+        )
     bag.check_digest(topic)
 
 
@@ -224,7 +239,9 @@ def _collect_transforms(msg: Any, want: _Wanted, out: _Collected) -> None:
             out.odom_poses.append(_transform6(transform.transform))
 
 
-def _find_mount(bag: BagSource, want: _Wanted, laser_frame: str, out: _Collected) -> tuple[float, float, float, float, float, float] | None:
+def _find_mount(
+    bag: BagSource, want: _Wanted, laser_frame: str, out: _Collected
+) -> tuple[float, float, float, float, float, float] | None:
     """The ``base_frame -> laser_frame`` transform: from what was read, else the first one on ``/tf``."""
     if laser_frame in out.base_children:
         return out.base_children[laser_frame]
@@ -233,7 +250,10 @@ def _find_mount(bag: BagSource, want: _Wanted, laser_frame: str, out: _Collected
     try:
         for _, _, raw in bag.messages([rm.TF_TOPIC]):
             for transform in bag.decode(raw, bag.topics[rm.TF_TOPIC]).transforms:
-                if transform.header.frame_id.lstrip("/") == want.base_frame and transform.child_frame_id.lstrip("/") == laser_frame:
+                if (
+                    transform.header.frame_id.lstrip("/") == want.base_frame
+                    and transform.child_frame_id.lstrip("/") == laser_frame
+                ):
                     return _transform6(transform.transform)
     except DECODE_ERRORS as exc:
         raise FormatError(bag.path, f"damaged {bag.kind} bag while reading /tf: {exc or type(exc).__name__}") from None
@@ -286,7 +306,7 @@ def _parse_run_info(bag: BagSource, text: str | None) -> dict[str, Any] | None:
     except ValueError as exc:
         raise FormatError(bag.path, f"{where}: not valid JSON ({exc})") from None
     if not isinstance(doc, dict) or doc.get("format") != rm.RUN_INFO_FORMAT:
-        raise FormatError(bag.path, f"{where}: expected a JSON object with \"format\": \"{rm.RUN_INFO_FORMAT}\"")
+        raise FormatError(bag.path, f'{where}: expected a JSON object with "format": "{rm.RUN_INFO_FORMAT}"')
     origin, laser, metadata = doc.get("time_origin_ns"), doc.get("laser"), doc.get("metadata")
     if isinstance(origin, bool) or not isinstance(origin, int):
         raise FormatError(bag.path, f"{where}: time_origin_ns must be an integer, got {origin!r}")
@@ -324,13 +344,20 @@ def _laser_from_scans(bag: BagSource, want: _Wanted, data: _Collected, notes: di
     if found is None:
         mount = (0.0, 0.0, 0.0)
         notes["laser_mount"] = f"no transform {want.base_frame} -> {frame} in the bag; assumed zero"
-        log.warning("%s: no transform %s -> %s; assuming the laser sits at the base origin", bag.path, want.base_frame, frame)
+        log.warning(
+            "%s: no transform %s -> %s; assuming the laser sits at the base origin", bag.path, want.base_frame, frame
+        )
     else:
         mount = (float(found[0]), float(found[1]), float(rm.quaternion_yaw(np.asarray(found[2:6]))))
         notes["laser_mount"] = f"transform {want.base_frame} -> {frame}"
     try:
-        return LaserGeometry(angle_min=float(scan.angle_min), angle_increment=float(scan.angle_increment),
-                             range_min=float(scan.range_min), range_max=float(scan.range_max), mount=mount)
+        return LaserGeometry(
+            angle_min=float(scan.angle_min),
+            angle_increment=float(scan.angle_increment),
+            range_min=float(scan.range_min),
+            range_max=float(scan.range_max),
+            mount=mount,
+        )
     except ValueError as exc:
         raise FormatError(bag.path, f"topic {want.scan}: first scan's geometry: {exc}") from None
 
@@ -344,11 +371,16 @@ def _assemble(bag: BagSource, data: _Collected, want: _Wanted, pairing: str) -> 
         raise FormatError(bag.path, f"topic {want.scan}: two scans have the same header stamp")
     odom_source = f"{rm.TF_TOPIC} {want.odom_frame} -> {want.base_frame}" if want.use_tf else want.odom
     if not data.odom_stamps:
-        raise FormatError(bag.path, f"no odometry in {odom_source}" + (f"; /tf has {sorted(data.tf_frames)[:10]}" if want.use_tf else ""))
+        raise FormatError(
+            bag.path,
+            f"no odometry in {odom_source}" + (f"; /tf has {sorted(data.tf_frames)[:10]}" if want.use_tf else ""),
+        )
     odometry = _pair(scan_stamps, *_poses(data.odom_stamps, data.odom_poses), pairing)
     keep = np.isfinite(odometry).all(axis=1)
     if not keep.any():
-        raise FormatError(bag.path, f"no scan of {want.scan} falls within the time span of the odometry ({odom_source})")
+        raise FormatError(
+            bag.path, f"no scan of {want.scan} falls within the time span of the odometry ({odom_source})"
+        )
     scan_stamps, scans, odometry = scan_stamps[keep], scans[keep], odometry[keep]
     if want.truth is not None:
         truth = _pair(scan_stamps, *_poses(data.truth_stamps, data.truth_poses), pairing)

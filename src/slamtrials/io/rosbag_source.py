@@ -48,8 +48,22 @@ def _decode_errors() -> tuple[type[BaseException], ...]:
     # decoding errors of damaged lengths, offsets and strings (struct, KeyError, UnicodeDecodeError, its
     # internal asserts); decompressor errors (bz2: OSError, lz4: RuntimeError, zstd: ZstdError, EOFError);
     # and MemoryError when a damaged size asks for an impossible buffer.
-    return (Reader1Error, Reader2Error, SerdeError, *zstd_errors, struct.error, ValueError, IndexError, KeyError,
-            EOFError, OverflowError, AssertionError, MemoryError, RuntimeError, OSError)
+    return (
+        Reader1Error,
+        Reader2Error,
+        SerdeError,
+        *zstd_errors,
+        struct.error,
+        ValueError,
+        IndexError,
+        KeyError,
+        EOFError,
+        OverflowError,
+        AssertionError,
+        MemoryError,
+        RuntimeError,
+        OSError,
+    )
 
 
 #: Exceptions that mean "this bag is damaged"; :func:`open_bag` and its users turn them into FormatError.
@@ -113,8 +127,11 @@ class BagSource:
         expected = rm.typestore(1).generate_msgdef(known)[1]
         for connection in self._connections.get(topic, []):
             if connection.digest and connection.digest != expected:
-                raise FormatError(self.path, f"topic {topic}: type {msgtype} has md5 {connection.digest}, expected "
-                                             f"{expected} (a different definition of the message)")
+                raise FormatError(
+                    self.path,
+                    f"topic {topic}: type {msgtype} has md5 {connection.digest}, expected "
+                    f"{expected} (a different definition of the message)",
+                )
 
 
 def bag_kind(path: str | Path) -> tuple[int, Path, str]:
@@ -187,7 +204,11 @@ def open_bag(path: str | Path) -> Iterator[BagSource]:
 
 
 def _damaged(ros: int, exc: BaseException) -> str:
-    hint = " (a ROS 1 bag cut short can be repaired with 'rosbag reindex')" if ros == 1 and "index" in str(exc).lower() else ""
+    hint = (
+        " (a ROS 1 bag cut short can be repaired with 'rosbag reindex')"
+        if ros == 1 and "index" in str(exc).lower()
+        else ""
+    )
     detail = str(exc) or type(exc).__name__
     return f"not a readable ROS {ros} bag, damaged or truncated: {detail}{hint}"
 
@@ -220,5 +241,7 @@ def _source(path: Path, ros: int, reader: Any) -> BagSource:
         connections.setdefault(connection.topic, []).append(connection)
         msgtype = _normalise(connection.msgtype)
         if topics.setdefault(connection.topic, msgtype) != msgtype:
-            raise FormatError(path, f"topic {connection.topic} carries two message types, {topics[connection.topic]} and {msgtype}")
+            raise FormatError(
+                path, f"topic {connection.topic} carries two message types, {topics[connection.topic]} and {msgtype}"
+            )
     return BagSource(path, ros, topics, reader, connections)

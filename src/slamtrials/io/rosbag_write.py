@@ -31,8 +31,14 @@ _UINT32_NS = (2**32 - 1) * 1_000_000_000  # ROS 1 time is (uint32 sec, uint32 ns
 _INT32_NS = (2**31 - 1) * 1_000_000_000  # ROS 2 time is (int32 sec, uint32 nanosec)
 
 
-def write_rosbag1(path: str | Path, record: RunRecord, *, time_origin_ns: int = rm.DEFAULT_TIME_ORIGIN_NS,
-                  overwrite: bool = False, compress: bool = False) -> Path:
+def write_rosbag1(
+    path: str | Path,
+    record: RunRecord,
+    *,
+    time_origin_ns: int = rm.DEFAULT_TIME_ORIGIN_NS,
+    overwrite: bool = False,
+    compress: bool = False,
+) -> Path:
     """Write ``record`` as a ROS 1 bag (format 2.0) at ``path`` and return the path.
 
     Parameters
@@ -75,7 +81,9 @@ def write_rosbag1(path: str | Path, record: RunRecord, *, time_origin_ns: int = 
             connections = {}
             for topic, msgtype, latched in _topics(record, ros=1):
                 connections[topic] = (
-                    writer.add_connection(topic, msgtype, typestore=store, callerid="/slamtrials", latching=1 if latched else None),
+                    writer.add_connection(
+                        topic, msgtype, typestore=store, callerid="/slamtrials", latching=1 if latched else None
+                    ),
                     msgtype,
                 )
             for topic, stamp, msg in _messages(record, stamps, time_origin_ns, ros=1):
@@ -84,8 +92,14 @@ def write_rosbag1(path: str | Path, record: RunRecord, *, time_origin_ns: int = 
     return path
 
 
-def write_rosbag2(path: str | Path, record: RunRecord, *, time_origin_ns: int = rm.DEFAULT_TIME_ORIGIN_NS,
-                  overwrite: bool = False, compress: bool = False) -> Path:
+def write_rosbag2(
+    path: str | Path,
+    record: RunRecord,
+    *,
+    time_origin_ns: int = rm.DEFAULT_TIME_ORIGIN_NS,
+    overwrite: bool = False,
+    compress: bool = False,
+) -> Path:
     """Write ``record`` as a ROS 2 bag (a folder with ``metadata.yaml``, version 8, and ``<name>.mcap``).
 
     Parameters
@@ -129,7 +143,10 @@ def write_rosbag2(path: str | Path, record: RunRecord, *, time_origin_ns: int = 
             connections = {}
             for topic, msgtype, latched in _topics(record, ros=2):
                 qos = [_latched_qos()] if latched else []
-                connections[topic] = (writer.add_connection(topic, msgtype, typestore=store, offered_qos_profiles=qos), msgtype)
+                connections[topic] = (
+                    writer.add_connection(topic, msgtype, typestore=store, offered_qos_profiles=qos),
+                    msgtype,
+                )
             for topic, stamp, msg in _messages(record, stamps, time_origin_ns, ros=2):
                 connection, msgtype = connections[topic]
                 writer.write(connection, stamp, store.serialize_cdr(msg, msgtype))
@@ -182,8 +199,9 @@ def _roslz4_frame(data: bytes) -> bytes:
     """
     import lz4.frame
 
-    return lz4.frame.compress(data, block_size=lz4.frame.BLOCKSIZE_MAX4MB, block_linked=False, store_size=False,
-                              content_checksum=True)
+    return lz4.frame.compress(
+        data, block_size=lz4.frame.BLOCKSIZE_MAX4MB, block_linked=False, store_size=False, content_checksum=True
+    )
 
 
 def _latched_qos() -> Any:
@@ -191,8 +209,17 @@ def _latched_qos() -> Any:
     from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime
 
     infinite = QosTime(9223372036, 854775807)  # rmw's "infinite" duration, as Humble stores it
-    return Qos(QosHistory.KEEP_LAST, 1, QosReliability.RELIABLE, QosDurability.TRANSIENT_LOCAL, infinite, infinite,
-               QosLiveliness.AUTOMATIC, infinite, False)
+    return Qos(
+        QosHistory.KEEP_LAST,
+        1,
+        QosReliability.RELIABLE,
+        QosDurability.TRANSIENT_LOCAL,
+        infinite,
+        infinite,
+        QosLiveliness.AUTOMATIC,
+        infinite,
+        False,
+    )
 
 
 class _Factory:
@@ -230,12 +257,16 @@ class _Factory:
             header=header,
             child_frame_id=child,
             pose=self.PoseWithCovariance(
-                pose=self.Pose(position=self.Point(x=pose[0], y=pose[1], z=0.0),
-                               orientation=self.Quaternion(x=quat[0], y=quat[1], z=quat[2], w=quat[3])),
+                pose=self.Pose(
+                    position=self.Point(x=pose[0], y=pose[1], z=0.0),
+                    orientation=self.Quaternion(x=quat[0], y=quat[1], z=quat[2], w=quat[3]),
+                ),
                 covariance=self.zero_covariance,
             ),
             twist=self.TwistWithCovariance(
-                twist=self.Twist(linear=self.Vector3(x=twist[0], y=twist[1], z=0.0), angular=self.Vector3(x=0.0, y=0.0, z=twist[2])),
+                twist=self.Twist(
+                    linear=self.Vector3(x=twist[0], y=twist[1], z=0.0), angular=self.Vector3(x=0.0, y=0.0, z=twist[2])
+                ),
                 covariance=self.zero_covariance,
             ),
         )
@@ -244,8 +275,10 @@ class _Factory:
         return self.TransformStamped(
             header=header,
             child_frame_id=child,
-            transform=self.Transform(translation=self.Vector3(x=pose[0], y=pose[1], z=0.0),
-                                     rotation=self.Quaternion(x=quat[0], y=quat[1], z=quat[2], w=quat[3])),
+            transform=self.Transform(
+                translation=self.Vector3(x=pose[0], y=pose[1], z=0.0),
+                rotation=self.Quaternion(x=quat[0], y=quat[1], z=quat[2], w=quat[3]),
+            ),
         )
 
 
@@ -277,17 +310,21 @@ def _messages(record: RunRecord, stamps: np.ndarray, origin: int, *, ros: int) -
         yield rm.TF_STATIC_TOPIC, first, f.TFMessage(transforms=[laser_tf])
     truth_seq = 0
     for k, stamp in enumerate(stamp_list):
-        yield rm.SCAN_TOPIC, stamp, f.LaserScan(
-            header=f.header(stamp, rm.LASER_FRAME, k),
-            angle_min=angle_min,
-            angle_max=angle_max,
-            angle_increment=increment,
-            time_increment=0.0,
-            scan_time=period,
-            range_min=laser.range_min,
-            range_max=laser.range_max,
-            ranges=scans[k],
-            intensities=no_intensities,
+        yield (
+            rm.SCAN_TOPIC,
+            stamp,
+            f.LaserScan(
+                header=f.header(stamp, rm.LASER_FRAME, k),
+                angle_min=angle_min,
+                angle_max=angle_max,
+                angle_increment=increment,
+                time_increment=0.0,
+                scan_time=period,
+                range_min=laser.range_min,
+                range_max=laser.range_max,
+                ranges=scans[k],
+                intensities=no_intensities,
+            ),
         )
         odom_header = f.header(stamp, rm.ODOM_FRAME, k)
         yield rm.ODOM_TOPIC, stamp, f.odometry(odom_header, rm.BASE_FRAME, odometry[k], odo_q[k], odo_twist[k])
@@ -327,4 +364,3 @@ def _atomic_output(path: Path, *, overwrite: bool) -> Iterator[Path]:
             os.replace(tmp, path)
     finally:
         shutil.rmtree(workdir, ignore_errors=True)
-

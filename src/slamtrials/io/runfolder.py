@@ -50,11 +50,11 @@ _ARRAYS: dict[str, tuple[type, int | None]] = {  # name -> (dtype, size of the l
 _LASER_KEYS = ("angle_min", "angle_increment", "range_min", "range_max")
 
 
-
 def _revision() -> dict[str, str]:
     """``{"source": commit}`` when running from a git checkout (see :func:`source_revision`), else empty."""
     revision = source_revision()
     return {"source": revision} if revision else {}
+
 
 def json_default(value: Any) -> Any:
     """``json.dumps(default=...)`` hook: numpy arrays and scalars, and paths, as plain JSON values."""
@@ -92,9 +92,15 @@ def write_run(folder: str | Path, record: RunRecord) -> Path:
     atomic_write(files.frames, lambda handle: np.savez_compressed(handle, **arrays))
     doc = {
         "format": RUN_FORMAT,
-        "versions": {"slamtrials": __version__, **_revision(), "python": platform.python_version(),
-                     "numpy": np.__version__, "numba": numba.__version__, "libc": " ".join(platform.libc_ver()),
-                     "machine": platform.machine()},
+        "versions": {
+            "slamtrials": __version__,
+            **_revision(),
+            "python": platform.python_version(),
+            "numpy": np.__version__,
+            "numba": numba.__version__,
+            "libc": " ".join(platform.libc_ver()),
+            "machine": platform.machine(),
+        },
         "frames": len(record),
         "beams": int(record.scans.shape[1]) if record.scans.ndim == 2 else 0,
         "laser": record.laser.to_dict(),
@@ -115,7 +121,9 @@ def _read_run_json(path: Path) -> dict[str, Any]:
         raise FormatError(path, "not UTF-8 text") from None
     if not isinstance(doc, dict) or doc.get("format") not in RUN_FORMATS_READ:
         found = doc.get("format") if isinstance(doc, dict) else None
-        raise FormatError(path, f"expected a JSON object with \"format\" one of {', '.join(RUN_FORMATS_READ)}, got {found!r}")
+        raise FormatError(
+            path, f'expected a JSON object with "format" one of {", ".join(RUN_FORMATS_READ)}, got {found!r}'
+        )
     laser = doc.get("laser")
     if not isinstance(laser, dict) or any(not isinstance(laser.get(k), (int, float)) for k in _LASER_KEYS):
         raise FormatError(path, f"field 'laser' must be an object with numbers {', '.join(_LASER_KEYS)}")
@@ -139,7 +147,10 @@ def _read_frames(path: Path) -> dict[str, np.ndarray]:
             raise FormatError(path, f"array '{name}' has shape {arrays[name].shape}, expected [T, {last}]")
     n = len(arrays["t"])
     if "estimate" in arrays and (arrays["estimate"].dtype != np.float64 or arrays["estimate"].shape != (n, 3)):
-        raise FormatError(path, f"array 'estimate' has {arrays['estimate'].dtype} {arrays['estimate'].shape}, expected float64 [{n}, 3]")
+        raise FormatError(
+            path,
+            f"array 'estimate' has {arrays['estimate'].dtype} {arrays['estimate'].shape}, expected float64 [{n}, 3]",
+        )
     if arrays["scans"].ndim != 2 or any(len(a) != n for a in arrays.values()):
         raise FormatError(path, f"arrays disagree on the number of frames: { {k: v.shape for k, v in arrays.items()} }")
     if n > 1 and not np.all(np.diff(arrays["t"]) > 0):

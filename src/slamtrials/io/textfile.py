@@ -15,7 +15,16 @@ from numpy.typing import NDArray
 from slamtrials.errors import FormatError
 from slamtrials.io.compressed import read_maybe_compressed
 
-__all__ = ["read_lines", "data_lines", "parse_floats", "parse_int", "last_line", "first_bad_row", "float_text", "read_number_table"]
+__all__ = [
+    "read_lines",
+    "data_lines",
+    "parse_floats",
+    "parse_int",
+    "last_line",
+    "first_bad_row",
+    "float_text",
+    "read_number_table",
+]
 
 
 def read_lines(path: Path) -> list[str]:
@@ -35,7 +44,9 @@ def read_lines(path: Path) -> list[str]:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = data.count(b"\n", 0, exc.start) + 1
-        raise FormatError(path, f"not UTF-8 text (byte {exc.start}: {data[exc.start:exc.start + 1]!r})", line=line) from None
+        raise FormatError(
+            path, f"not UTF-8 text (byte {exc.start}: {data[exc.start : exc.start + 1]!r})", line=line
+        ) from None
     return text.split("\n")
 
 
@@ -63,7 +74,9 @@ def _bad_token(tokens: Sequence[str]) -> int:
     return -1
 
 
-def parse_floats(path: Path, line: int, tokens: Sequence[str], first_field: int, what: str | Sequence[str]) -> list[float]:
+def parse_floats(
+    path: Path, line: int, tokens: Sequence[str], first_field: int, what: str | Sequence[str]
+) -> list[float]:
     """Convert ``tokens`` to floats; ``first_field`` is the 1-based field number of ``tokens[0]`` on the line
     and ``what`` describes the tokens for error messages (one description, or one name per token).
 
@@ -79,7 +92,9 @@ def parse_floats(path: Path, line: int, tokens: Sequence[str], first_field: int,
     except ValueError:
         i = _bad_token(tokens)
         name = what if isinstance(what, str) else what[i]
-        raise FormatError(path, f"field {first_field + i} ({name}) is not a number: {tokens[i][:40]!r}", line=line) from None
+        raise FormatError(
+            path, f"field {first_field + i} ({name}) is not a number: {tokens[i][:40]!r}", line=line
+        ) from None
 
 
 def parse_int(path: Path, line: int, token: str, field: int, what: str, minimum: int = 0) -> int:

@@ -16,7 +16,14 @@ import numpy as np
 from slamtrials.errors import ConfigError, FormatError
 from slamtrials.record import RunRecord, Trajectory
 
-__all__ = ["EXPORT_FORMATS", "export_record", "detect_recording_format", "read_carmen_run", "CARMEN_SUFFIXES", "BAG_SUFFIXES"]
+__all__ = [
+    "EXPORT_FORMATS",
+    "export_record",
+    "detect_recording_format",
+    "read_carmen_run",
+    "CARMEN_SUFFIXES",
+    "BAG_SUFFIXES",
+]
 
 EXPORT_FORMATS = ("bag", "bag2", "carmen", "tum")
 CARMEN_SUFFIXES = (".clf", ".log", ".carmen")
@@ -81,7 +88,9 @@ def export_record(
         if carmen_kind not in ("ROBOTLASER1", "FLASER"):
             raise ConfigError(f"CARMEN line kind must be ROBOTLASER1 or FLASER, got {carmen_kind!r}")
         if not np.isfinite(record.truth).all():
-            raise ConfigError("the run has no ground truth for every frame; a CARMEN laser line needs it (first pose triple)")
+            raise ConfigError(
+                "the run has no ground truth for every frame; a CARMEN laser line needs it (first pose triple)"
+            )
         try:
             write_carmen(out, carmen_from_run(record, kind=carmen_kind))
         except ValueError as exc:
@@ -98,7 +107,9 @@ def _export_tum(record: RunRecord, out: Path, source: str) -> str:
     poses = record.truth if source == "truth" else record.odometry
     known = np.isfinite(poses).all(axis=1)
     if not known.any():
-        raise ConfigError(f"the run has no {source} (a recording without ground truth?); export the odometry instead (--what odometry)")
+        raise ConfigError(
+            f"the run has no {source} (a recording without ground truth?); export the odometry instead (--what odometry)"
+        )
     write_tum(out, Trajectory(t=np.asarray(record.t)[known], poses=np.asarray(poses)[known]))
     skipped = f" ({np.count_nonzero(~known)} frames without it skipped)" if not known.all() else ""
     frame = "world frame" if source == "truth" else "odometry frame"
@@ -133,8 +144,11 @@ def read_carmen_run(path: str | Path) -> RunRecord:
 
     log = read_carmen(path)
     if log.laser.beams == 0:
-        raise FormatError(path, f"its {log.laser.kind} lines hold no readings (a pose-only trajectory): nothing to map or "
-                          "replay; evaluate it with slamtrials evaluate --estimate")
+        raise FormatError(
+            path,
+            f"its {log.laser.kind} lines hold no readings (a pose-only trajectory): nothing to map or "
+            "replay; evaluate it with slamtrials evaluate --estimate",
+        )
     try:
         return run_from_carmen(log)
     except ValueError as exc:  # a geometry LaserGeometry refuses (one beam, a clockwise scan, no positive range)

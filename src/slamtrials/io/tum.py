@@ -61,8 +61,11 @@ def read_tum(path: str | Path) -> Trajectory:
     step = np.flatnonzero(np.diff(t) <= 0)
     if step.size:
         i = int(step[0])
-        raise FormatError(path, f"timestamps must be strictly increasing: {t[i + 1]!r} after {t[i]!r} (line {numbers[i]})",
-                          line=numbers[i + 1])
+        raise FormatError(
+            path,
+            f"timestamps must be strictly increasing: {t[i + 1]!r} after {t[i]!r} (line {numbers[i]})",
+            line=numbers[i + 1],
+        )
     quat = values[:, 4:8]
     scale = np.abs(quat).max(axis=1)
     zero = np.flatnonzero(scale == 0)
@@ -76,8 +79,11 @@ def read_tum(path: str | Path) -> Trajectory:
     vertical = np.flatnonzero(stablemath.hypot(r00, r10) <= 1e-9 * norm2)
     if vertical.size:
         i = int(vertical[0])
-        raise FormatError(path, f"rotation points the x axis vertically, it has no heading (qx qy qz qw = {values[i, 4:].tolist()})",
-                          line=numbers[i])
+        raise FormatError(
+            path,
+            f"rotation points the x axis vertically, it has no heading (qx qy qz qw = {values[i, 4:].tolist()})",
+            line=numbers[i],
+        )
     poses = np.column_stack([values[:, 1], values[:, 2], stablemath.arctan2(r10, r00)])
     return Trajectory(t=t.copy(), poses=poses)
 
@@ -109,5 +115,7 @@ def write_tum(path: str | Path, trajectory: Trajectory, *, header: bool = True) 
     half = poses[:, 2] / 2.0
     columns = [t, poses[:, 0], poses[:, 1], stablemath.sin(half), stablemath.cos(half)]
     lines = ["# " + " ".join(TUM_FIELDS) + "\n"] if header else []
-    lines += [f"{ti!r} {x!r} {y!r} 0.0 0.0 0.0 {qz!r} {qw!r}\n" for ti, x, y, qz, qw in zip(*(c.tolist() for c in columns))]
+    lines += [
+        f"{ti!r} {x!r} {y!r} 0.0 0.0 0.0 {qz!r} {qw!r}\n" for ti, x, y, qz, qw in zip(*(c.tolist() for c in columns))
+    ]
     return atomic_write_text(path, "".join(lines))

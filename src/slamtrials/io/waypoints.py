@@ -37,12 +37,16 @@ def read_waypoints(path: str | Path) -> NDArray[np.float64]:
         raise FormatError(path, "not UTF-8 text") from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
-        raise FormatError(path, f"not valid YAML ({getattr(exc, 'problem', exc)})", line=mark.line + 1 if mark else None) from None
+        raise FormatError(
+            path, f"not valid YAML ({getattr(exc, 'problem', exc)})", line=mark.line + 1 if mark else None
+        ) from None
     if not isinstance(root, yaml.MappingNode):
         raise FormatError(path, "expected a mapping with a 'waypoints' list of [x, y] pairs (metres)", line=1)
     node = next((value for key, value in root.value if key.value == "waypoints"), None)
     if not isinstance(node, yaml.SequenceNode) or not node.value:
-        raise FormatError(path, "expected a non-empty 'waypoints' list of [x, y] pairs (metres)", line=root.start_mark.line + 1)
+        raise FormatError(
+            path, "expected a non-empty 'waypoints' list of [x, y] pairs (metres)", line=root.start_mark.line + 1
+        )
     points = []
     for item in node.value:
         line = item.start_mark.line + 1

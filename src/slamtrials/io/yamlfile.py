@@ -29,7 +29,9 @@ def read_yaml_mapping(path: str | Path) -> dict[str, Any]:
         raise FormatError(path, "not UTF-8 text") from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
-        raise FormatError(path, f"not valid YAML ({getattr(exc, 'problem', exc)})", line=mark.line + 1 if mark else None) from None
+        raise FormatError(
+            path, f"not valid YAML ({getattr(exc, 'problem', exc)})", line=mark.line + 1 if mark else None
+        ) from None
     if data is None:
         return {}
     if not isinstance(data, dict):

@@ -75,7 +75,9 @@ def _nearest_kernel(times, t, tolerance, index, gap, within):  # pragma: no cove
         within[k] = gap[k] <= tolerance + abs(q) * 2.220446049250313e-16
 
 
-def nearest_indices(times: NDArray[np.float64], t: NDArray[np.float64], tolerance: float) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.bool_]]:
+def nearest_indices(
+    times: NDArray[np.float64], t: NDArray[np.float64], tolerance: float
+) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.bool_]]:
     """Nearest element of sorted ``times`` for each ``t`` (the earlier one on a tie), its gap, and ``gap <= tolerance``.
 
     Parameters
@@ -116,7 +118,9 @@ def _relative_kernel(a, ia, b, ib, out):  # pragma: no cover - compiled
         out[k, 2] = ((b[j, 2] - a[i, 2]) + math.pi) % two_pi - math.pi
 
 
-def relative_poses(a: NDArray[np.float64], ia: NDArray[np.int64], b: NDArray[np.float64], ib: NDArray[np.int64]) -> NDArray[np.float64]:
+def relative_poses(
+    a: NDArray[np.float64], ia: NDArray[np.int64], b: NDArray[np.float64], ib: NDArray[np.int64]
+) -> NDArray[np.float64]:
     """``ominus(a[ia], b[ib])`` without the gathered copies: pose ``b[ib[k]]`` seen from pose ``a[ia[k]]``.
 
     Parameters

@@ -23,11 +23,22 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from slamtrials.errors import MetricError
-from slamtrials.geometry import compose, interpolate as interpolate_poses, ominus
+from slamtrials.geometry import compose, ominus
+from slamtrials.geometry import interpolate as interpolate_poses
 from slamtrials.metric.kernels import EPS, nearest_indices, relative_poses
 from slamtrials.record import Relations, Trajectory
 
-__all__ = ["DEFAULT_TOLERANCE", "RUN_TOLERANCE", "relations_meet", "check_trajectory", "check_relations", "PoseLookup", "lookup_poses", "RelationMatch", "match_relations"]
+__all__ = [
+    "DEFAULT_TOLERANCE",
+    "RUN_TOLERANCE",
+    "relations_meet",
+    "check_trajectory",
+    "check_relations",
+    "PoseLookup",
+    "lookup_poses",
+    "RelationMatch",
+    "match_relations",
+]
 
 #: Largest accepted gap (s) between a relation timestamp and the matched pose: the Freiburg program's 0.1 s.
 DEFAULT_TOLERANCE = 0.1
@@ -75,7 +86,9 @@ def check_trajectory(trajectory: Trajectory, what: str = "estimate") -> None:
     if (steps <= 0).any():
         i = int(np.argmax(steps <= 0)) + 1
         raise MetricError(
-            f"{what}: timestamps must strictly increase, but pose {i} has t={float(t[i])!r} after t={float(t[i - 1])!r}", what=what, index=i
+            f"{what}: timestamps must strictly increase, but pose {i} has t={float(t[i])!r} after t={float(t[i - 1])!r}",
+            what=what,
+            index=i,
         )
 
 
@@ -94,7 +107,11 @@ def check_relations(relations: Relations) -> None:
     same = relations.t1 == relations.t2
     if same.any():
         k = int(np.argmax(same))
-        raise MetricError(f"relation {k} relates a timestamp to itself (t1 == t2 == {float(relations.t1[k])!r})", what="relations", index=k)
+        raise MetricError(
+            f"relation {k} relates a timestamp to itself (t1 == t2 == {float(relations.t1[k])!r})",
+            what="relations",
+            index=k,
+        )
 
 
 @dataclass(frozen=True, eq=False)
@@ -126,7 +143,9 @@ class PoseLookup:
     gap: NDArray[np.float64]
 
 
-def _interpolated(times: NDArray[np.float64], poses: NDArray[np.float64], t: NDArray[np.float64], nearest: NDArray[np.int64]) -> NDArray[np.float64]:
+def _interpolated(
+    times: NDArray[np.float64], poses: NDArray[np.float64], t: NDArray[np.float64], nearest: NDArray[np.int64]
+) -> NDArray[np.float64]:
     """Poses linearly interpolated at ``t`` between the surrounding poses; the nearest pose at the ends."""
     before = nearest - (times[nearest] > t)  # last pose at or before t (-1 if none)
     inside = (before >= 0) & (before < len(times) - 1)
@@ -151,7 +170,9 @@ def _span(trajectory: Trajectory, odometry: Trajectory | None) -> tuple[float, f
     return first, last
 
 
-def _outside(t: NDArray[np.float64], trajectory: Trajectory, odometry: Trajectory | None, tolerance: float) -> NDArray[np.bool_]:
+def _outside(
+    t: NDArray[np.float64], trajectory: Trajectory, odometry: Trajectory | None, tolerance: float
+) -> NDArray[np.bool_]:
     """Timestamps more than ``tolerance`` before the first or after the last time of the data."""
     first, last = _span(trajectory, odometry)
     return ~(_within(np.maximum(first - t, 0.0), t, tolerance) & _within(np.maximum(t - last, 0.0), t, tolerance))
@@ -302,7 +323,9 @@ def match_relations(
         outside_each = _outside(stamps, estimate, None, tolerance)
         found_each, corrected_each, poses = within, np.zeros(2 * k, dtype=bool), None
     else:
-        found = lookup_poses(estimate, stamps, tolerance=tolerance, interpolate=interpolate, odometry=odometry, check=False)
+        found = lookup_poses(
+            estimate, stamps, tolerance=tolerance, interpolate=interpolate, odometry=odometry, check=False
+        )
         outside_each, found_each, corrected_each, poses = found.outside, found.found, found.corrected, found.poses
     outside = outside_each[:k] | outside_each[k:]
     if outside.any() and not allow_outside:

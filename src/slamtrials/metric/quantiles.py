@@ -22,7 +22,9 @@ Distribution = Literal["normal", "t"]
 DISTRIBUTIONS: tuple[str, ...] = ("normal", "t")
 
 
-def critical_value(confidence: float, *, distribution: Distribution = "normal", dof: float | None = None, sides: int = 2) -> float:
+def critical_value(
+    confidence: float, *, distribution: Distribution = "normal", dof: float | None = None, sides: int = 2
+) -> float:
     """The quantile ``q`` such that a (two- or one-sided) interval of ``q`` standard errors has ``confidence``.
 
     Parameters

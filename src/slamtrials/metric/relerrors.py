@@ -32,7 +32,9 @@ from slamtrials.record import Relations, Trajectory
 __all__ = ["relative_pose_errors", "RelationErrors", "evaluate_relations"]
 
 
-def relative_pose_errors(delta: ArrayLike, delta_true: ArrayLike, *, squared: bool = False) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def relative_pose_errors(
+    delta: ArrayLike, delta_true: ArrayLike, *, squared: bool = False
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Translational and rotational error of estimated relative poses against true ones.
 
     Parameters
@@ -132,7 +134,14 @@ def evaluate_relations(
     MetricError
         Bad trajectories or relations (see :func:`~slamtrials.metric.matching.match_relations`).
     """
-    match = match_relations(estimate, relations, tolerance=tolerance, interpolate=interpolate, odometry=odometry, allow_outside=allow_outside)
+    match = match_relations(
+        estimate,
+        relations,
+        tolerance=tolerance,
+        interpolate=interpolate,
+        odometry=odometry,
+        allow_outside=allow_outside,
+    )
     index = np.flatnonzero(match.matched)
     if len(index) == len(relations):  # all matched: no gathered copies
         translational, rotational = relative_pose_errors(match.delta, relations.delta, squared=squared)

@@ -14,8 +14,14 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from slamtrials.metric.quantiles import Distribution
 
-__all__ = ["SamplingRule", "DEFAULT_PILOT", "DEFAULT_CONFIDENCE", "DEFAULT_MARGIN_T", "DEFAULT_MARGIN_R",
-           "DEFAULT_MAX_RELATIONS"]
+__all__ = [
+    "SamplingRule",
+    "DEFAULT_PILOT",
+    "DEFAULT_CONFIDENCE",
+    "DEFAULT_MARGIN_T",
+    "DEFAULT_MARGIN_R",
+    "DEFAULT_MAX_RELATIONS",
+]
 
 DEFAULT_PILOT = 500
 DEFAULT_CONFIDENCE = 0.99
@@ -51,11 +57,24 @@ class SamplingRule(BaseModel):
 
     model_config = ConfigDict(extra="forbid", frozen=True)
 
-    pilot: int = Field(DEFAULT_PILOT, ge=2, le=1_000_000, description="pairs of the pilot sample that estimates the error spread")
-    confidence: float = Field(DEFAULT_CONFIDENCE, gt=0.0, lt=1.0, description="confidence level of a run's relation sampling")
-    margin_t: float = Field(DEFAULT_MARGIN_T, gt=0.0, le=100.0, description="margin of error of a run's mean translational error (m)")
-    margin_r: float = Field(DEFAULT_MARGIN_R, gt=0.0, le=10.0, description="margin of error of a run's mean rotational error (rad; rad^2 when squared)")
-    distribution: Distribution = Field("normal", description="quantile of the confidence level: normal or t (pilot - 1 degrees of freedom)")
+    pilot: int = Field(
+        DEFAULT_PILOT, ge=2, le=1_000_000, description="pairs of the pilot sample that estimates the error spread"
+    )
+    confidence: float = Field(
+        DEFAULT_CONFIDENCE, gt=0.0, lt=1.0, description="confidence level of a run's relation sampling"
+    )
+    margin_t: float = Field(
+        DEFAULT_MARGIN_T, gt=0.0, le=100.0, description="margin of error of a run's mean translational error (m)"
+    )
+    margin_r: float = Field(
+        DEFAULT_MARGIN_R,
+        gt=0.0,
+        le=10.0,
+        description="margin of error of a run's mean rotational error (rad; rad^2 when squared)",
+    )
+    distribution: Distribution = Field(
+        "normal", description="quantile of the confidence level: normal or t (pilot - 1 degrees of freedom)"
+    )
     sides: Literal[1, 2] = Field(2, description="two-sided (2) or one-sided (1) margins")
     min_relations: int = Field(2, ge=1, le=100_000_000, description="floor on a run's relation count")
     max_relations: int = Field(DEFAULT_MAX_RELATIONS, ge=1, le=100_000_000, description="cap on a run's relation count")
@@ -64,5 +83,7 @@ class SamplingRule(BaseModel):
     @model_validator(mode="after")
     def _floor_not_above_cap(self) -> SamplingRule:
         if self.min_relations > self.max_relations:
-            raise ValueError(f"min_relations ({self.min_relations}) must not exceed max_relations ({self.max_relations})")
+            raise ValueError(
+                f"min_relations ({self.min_relations}) must not exceed max_relations ({self.max_relations})"
+            )
         return self

@@ -143,9 +143,13 @@ class SampledRelations:
     rule: SamplingRule
 
 
-def _errors_for(truth: Trajectory, estimated: NDArray[np.float64], corrected: NDArray[np.bool_], i, j, squared: bool) -> tuple[Relations, RelationErrors]:
+def _errors_for(
+    truth: Trajectory, estimated: NDArray[np.float64], corrected: NDArray[np.bool_], i, j, squared: bool
+) -> tuple[Relations, RelationErrors]:
     relations = relations_between(truth, i, j)
-    translational, rotational = relative_pose_errors(ominus(estimated[i], estimated[j]), relations.delta, squared=squared)
+    translational, rotational = relative_pose_errors(
+        ominus(estimated[i], estimated[j]), relations.delta, squared=squared
+    )
     errors = RelationErrors(
         translational=translational,
         rotational=rotational,

@@ -52,7 +52,9 @@ class EnvironmentStats:
     confidence: float
 
 
-def environment_stats(values: ArrayLike, *, confidence: float = 0.99, distribution: Distribution = "normal", sides: int = 2) -> EnvironmentStats:
+def environment_stats(
+    values: ArrayLike, *, confidence: float = 0.99, distribution: Distribution = "normal", sides: int = 2
+) -> EnvironmentStats:
     """Statistics of per-run values ``[R]`` of one environment.
 
     Parameters

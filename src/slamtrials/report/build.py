@@ -47,6 +47,7 @@ from slamtrials.atomicfile import atomic_write_text
 from slamtrials.campaign.config import MetricSettings
 from slamtrials.campaign.events import REPLAY_NOTE
 from slamtrials.errors import ConfigError, SlamtrialsError
+from slamtrials.io.layout import RunFolder
 from slamtrials.record import Trajectory
 from slamtrials.report import campaign_figures as cf
 from slamtrials.report import html as h
@@ -58,12 +59,23 @@ from slamtrials.report.compare import (
     compare_campaigns,
     world_pair_traps,
 )
-from slamtrials.io.layout import RunFolder
 from slamtrials.report.load import CampaignData, load_campaign
 from slamtrials.report.tables import METRICS, paper_table
 
-__all__ = ["build_report", "compare_report", "CompareReport", "parse_run", "REPORT_DIR", "REPORT_PAGE", "COMPARE_PAGE",
-           "COMPARE_CSV", "FIGURES_DIR", "DEFAULT_REPEATS", "trap_sentences", "draw_trap_pair"]
+__all__ = [
+    "build_report",
+    "compare_report",
+    "CompareReport",
+    "parse_run",
+    "REPORT_DIR",
+    "REPORT_PAGE",
+    "COMPARE_PAGE",
+    "COMPARE_CSV",
+    "FIGURES_DIR",
+    "DEFAULT_REPEATS",
+    "trap_sentences",
+    "draw_trap_pair",
+]
 
 log = logging.getLogger(__name__)
 
@@ -111,7 +123,11 @@ class _FigureWriter:
         else:
             from slamtrials.atomicfile import atomic_write
 
-            paths = [atomic_write(base.with_name(base.name + ".png"), lambda handle: fig.savefig(handle, format="png", dpi=100))]
+            paths = [
+                atomic_write(
+                    base.with_name(base.name + ".png"), lambda handle: fig.savefig(handle, format="png", dpi=100)
+                )
+            ]
         self.written.extend(paths)
         png, pdf = paths[0], (paths[1] if len(paths) > 1 else None)
         rel = lambda p: p.relative_to(self.out).as_posix()  # noqa: E731
@@ -157,8 +173,15 @@ def _versions() -> dict[str, str]:
 
     revision = source_revision()
     source = {"source": revision} if revision else {}
-    return {"slamtrials": __version__, **source, "python": platform.python_version(), "numpy": np.__version__,
-            "scipy": scipy.__version__, "pandas": pd.__version__, "matplotlib": matplotlib.__version__}
+    return {
+        "slamtrials": __version__,
+        **source,
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "pandas": pd.__version__,
+        "matplotlib": matplotlib.__version__,
+    }
 
 
 def _read_record(data: CampaignData, world: str, run: int):
@@ -176,8 +199,10 @@ def _notes(data: CampaignData, done: pd.DataFrame) -> list[str]:
     for _, w in data.worlds.iterrows():
         note = f" ({w['note']})" if isinstance(w["note"], str) and w["note"] else ""
         if w["status"] == "capped":
-            notes.append(f"{w['world']}: stopped at the cap of {w['runs_done']} runs; the run-count rule asked for "
-                         f"{w['runs_needed']}, so its margins of error are not reached.")
+            notes.append(
+                f"{w['world']}: stopped at the cap of {w['runs_done']} runs; the run-count rule asked for "
+                f"{w['runs_needed']}, so its margins of error are not reached."
+            )
         elif w["status"] == "failed":
             notes.append(f"{w['world']}: failed{note}; resume the campaign to retry.")
         elif w["status"] == "short":
@@ -202,10 +227,17 @@ def _overview(data: CampaignData, done: pd.DataFrame) -> str:
         ("campaign folder", str(data.folder)),
         ("kind", data.kind + (f" of {config.get('replay_of')}" if config.get("replay_of") else "")),
         ("SLAM algorithm", f"{slam.get('algorithm')} (preset {slam.get('preset')}, params {slam.get('params') or {}})"),
-        ("worlds", f"{len(data.worlds)}: " + ", ".join(f"{w} {s}" for w, s in zip(data.worlds["world"], data.worlds["status"]))),
+        (
+            "worlds",
+            f"{len(data.worlds)}: "
+            + ", ".join(f"{w} {s}" for w, s in zip(data.worlds["world"], data.worlds["status"])),
+        ),
         ("runs", ", ".join(f"{int(counts.get(s, 0))} {s}" for s in ("done", "running", "pending", "failed"))),
-        ("run-count rule", f"first {runs.get('initial')} runs, cap {runs.get('max_runs')}, margins \u00b1{runs.get('margin_t')} m "
-                           f"and \u00b1{runs.get('margin_r')} rad at {_pct(runs.get('confidence'))} confidence ({runs.get('distribution')} quantile)"),
+        (
+            "run-count rule",
+            f"first {runs.get('initial')} runs, cap {runs.get('max_runs')}, margins \u00b1{runs.get('margin_t')} m "
+            f"and \u00b1{runs.get('margin_r')} rad at {_pct(runs.get('confidence'))} confidence ({runs.get('distribution')} quantile)",
+        ),
         ("root seed", str(config.get("seed"))),
         ("created", str(data.meta.get("created"))),
     ]
@@ -220,8 +252,16 @@ def _pct(value: Any) -> str:
 
 
 def _table_one(data: CampaignData, done: pd.DataFrame) -> str:
-    header = ["world", "status", "runs", *(["mean", "std", "\u00b1 CI"] * 2), "outliers", "min \u2013 max " + SYMBOLS["eps_t"] + " (m)",
-              "runs ended by", "note"]
+    header = [
+        "world",
+        "status",
+        "runs",
+        *(["mean", "std", "\u00b1 CI"] * 2),
+        "outliers",
+        "min \u2013 max " + SYMBOLS["eps_t"] + " (m)",
+        "runs ended by",
+        "note",
+    ]
     groups = [("", 3), (f"{SYMBOLS['eps_t']} (m)", 3), (f"{SYMBOLS['eps_r']} (rad)", 3), ("", 4)]
     rows, classes = [], []
     reasons = done.groupby("world")["termination"].agg(lambda s: Counter(s.fillna("unknown"))) if len(done) else {}
@@ -230,29 +270,54 @@ def _table_one(data: CampaignData, done: pd.DataFrame) -> str:
         runs = f"{w['runs_done']}" + (f" / {needed}" if pd.notna(needed) and int(needed) > w["runs_done"] else "")
         cells = [w["world"], w["status"], h.Cell(runs, numeric=True)]
         for metric, digits in (("eps_t", 3), ("eps_r", 4)):
-            cells += [_num(w[f"{metric}_mean"], digits), _num(w[f"{metric}_std"], digits), _num(w[f"{metric}_half_width"], digits)]
-        cells.append(h.Cell(f"{w['eps_t_outliers']} / {w['eps_r_outliers']}" if w["runs_done"] else "-", numeric=True,
-                            title=f"{SYMBOLS['eps_t']} / {SYMBOLS['eps_r']} outliers beyond 1.5 IQR"))
-        cells.append(h.Cell(f"{h.fmt_number(w['eps_t_min'])} \u2013 {h.fmt_number(w['eps_t_max'])}" if w["runs_done"] else "-", numeric=True))
+            cells += [
+                _num(w[f"{metric}_mean"], digits),
+                _num(w[f"{metric}_std"], digits),
+                _num(w[f"{metric}_half_width"], digits),
+            ]
+        cells.append(
+            h.Cell(
+                f"{w['eps_t_outliers']} / {w['eps_r_outliers']}" if w["runs_done"] else "-",
+                numeric=True,
+                title=f"{SYMBOLS['eps_t']} / {SYMBOLS['eps_r']} outliers beyond 1.5 IQR",
+            )
+        )
+        cells.append(
+            h.Cell(
+                f"{h.fmt_number(w['eps_t_min'])} \u2013 {h.fmt_number(w['eps_t_max'])}" if w["runs_done"] else "-",
+                numeric=True,
+            )
+        )
         counter = reasons.get(w["world"], {}) if len(done) else {}
         cells.append(", ".join(f"{k} {v}" for k, v in sorted(counter.items())))
         cells.append(w["note"] if isinstance(w["note"], str) else "")
         rows.append(cells)
         classes.append({"failed": "bad", "capped": "warn", "short": "warn", "done": None}.get(w["status"], "warn"))
     confidence = data.confidence
-    caption = (f"The paper's Table I: per world, the mean and sample standard deviation (divisor n \u2212 1) of the runs' "
-               f"translational error {SYMBOLS['eps_t']} (m) and rotational error {SYMBOLS['eps_r']} (rad), and the half width "
-               f"of the {_pct(confidence)} confidence interval of the mean. Runs: done (/ needed by the run-count rule when more).")
+    caption = (
+        f"The paper's Table I: per world, the mean and sample standard deviation (divisor n \u2212 1) of the runs' "
+        f"translational error {SYMBOLS['eps_t']} (m) and rotational error {SYMBOLS['eps_r']} (rad), and the half width "
+        f"of the {_pct(confidence)} confidence interval of the mean. Runs: done (/ needed by the run-count rule when more)."
+    )
     parts = [h.table(header, rows, id="summary-table", caption=caption, row_classes=classes, groups=groups)]
     if len(done):
         summary = data.worlds[data.worlds["runs_done"] > 0]
         for metric, unit in (("eps_t", "m"), ("eps_r", "rad")):
             printed = paper_table(summary, metric, population=True)
-            rows = [[label, *[_num(v, 3 if metric == "eps_t" else 4) for v in printed.loc[label]]] for label in printed.index]
-            parts.append('<div style="overflow-x:auto">' + h.table(
-                ["", *printed.columns], rows, id=f"paper-table-{metric}",
-                caption=f"As printed in the paper: {SYMBOLS[metric]} ({unit}) per world, std dev with divisor n (Definition III.3).")
-                + "</div>")
+            rows = [
+                [label, *[_num(v, 3 if metric == "eps_t" else 4) for v in printed.loc[label]]]
+                for label in printed.index
+            ]
+            parts.append(
+                '<div style="overflow-x:auto">'
+                + h.table(
+                    ["", *printed.columns],
+                    rows,
+                    id=f"paper-table-{metric}",
+                    caption=f"As printed in the paper: {SYMBOLS[metric]} ({unit}) per world, std dev with divisor n (Definition III.3).",
+                )
+                + "</div>"
+            )
     return h.section("Table I: localization error per world", *parts, id="table-1")
 
 
@@ -265,8 +330,15 @@ def _fig1(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame) -> str:
     axes = fig.subplots(1, 2)
     for ax, metric in zip(axes, METRICS):
         cf.draw_sorted_errors(ax, done, worlds, metric)
-    parts.append(figs.save(fig, "fig1_all", "Every world's run errors sorted from largest to smallest (the paper's Fig. 1 "
-                                            "as printed): left translational, right rotational.", id="fig-1-all"))
+    parts.append(
+        figs.save(
+            fig,
+            "fig1_all",
+            "Every world's run errors sorted from largest to smallest (the paper's Fig. 1 "
+            "as printed): left translational, right rotational.",
+            id="fig-1-all",
+        )
+    )
     gallery = []
     for i, world in enumerate(worlds):
         n = int((done["world"] == world).sum())
@@ -274,12 +346,21 @@ def _fig1(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame) -> str:
         axes = fig.subplots(1, 2)
         for ax, metric in zip(axes, METRICS):
             cf.draw_world_errors(ax, done, world, metric, confidence=data.confidence)
-        gallery.append(figs.save(fig, f"fig1_{i:03d}_{world}",
-                                 f"{world}: its {n} runs' errors, largest first, labelled by run index; the mean and its "
-                                 f"{_pct(data.confidence)} confidence band."))
+        gallery.append(
+            figs.save(
+                fig,
+                f"fig1_{i:03d}_{world}",
+                f"{world}: its {n} runs' errors, largest first, labelled by run index; the mean and its "
+                f"{_pct(data.confidence)} confidence band.",
+            )
+        )
     parts.append('<div class="gallery">' + "\n".join(gallery) + "</div>")
-    return h.section("Fig. 1: run errors per world, largest first", *parts, id="fig-1",
-                     intro="The variability of one algorithm in one building: why a single run is not a measurement.")
+    return h.section(
+        "Fig. 1: run errors per world, largest first",
+        *parts,
+        id="fig-1",
+        intro="The variability of one algorithm in one building: why a single run is not a measurement.",
+    )
 
 
 def _fig5(figs: _FigureWriter, done: pd.DataFrame) -> str:
@@ -291,14 +372,26 @@ def _fig5(figs: _FigureWriter, done: pd.DataFrame) -> str:
     for ax, metric in zip(axes, METRICS):
         cf.draw_all_runs(ax, done, metric)
     count_t, count_r = int(done["outlier_t"].sum()), int(done["outlier_r"].sum())
-    caption = (f"The paper's Fig. 5: every run of every world (points), a box per world (quartiles, whiskers at 1.5 IQR), "
-               f"the world means (orange), and outliers beyond Tukey's fences as red crosses: {count_t} in "
-               f"{SYMBOLS['eps_t']} (top), {count_r} in {SYMBOLS['eps_r']} (bottom).")
-    return h.section("Fig. 5: all runs of all worlds, outliers marked", figs.save(fig, "fig5_all_runs", caption), id="fig-5")
+    caption = (
+        f"The paper's Fig. 5: every run of every world (points), a box per world (quartiles, whiskers at 1.5 IQR), "
+        f"the world means (orange), and outliers beyond Tukey's fences as red crosses: {count_t} in "
+        f"{SYMBOLS['eps_t']} (top), {count_r} in {SYMBOLS['eps_r']} (bottom)."
+    )
+    return h.section(
+        "Fig. 5: all runs of all worlds, outliers marked", figs.save(fig, "fig5_all_runs", caption), id="fig-5"
+    )
 
 
-def draw_trap_pair(ax, low: np.ndarray, high: np.ndarray, labels: tuple[str, str], i_low: int, i_high: int,
-                   metric: str = "eps_t", colors: tuple[str, str] = ("tab:blue", "tab:orange")) -> None:
+def draw_trap_pair(
+    ax,
+    low: np.ndarray,
+    high: np.ndarray,
+    labels: tuple[str, str],
+    i_low: int,
+    i_high: int,
+    metric: str = "eps_t",
+    colors: tuple[str, str] = ("tab:blue", "tab:orange"),
+) -> None:
     """Two samples side by side (``low``: lower mean) with their means and the most misleading pair ringed.
 
     The pair ``(low[i_low], high[i_high])`` is the single-run comparison that contradicts the means the
@@ -322,36 +415,76 @@ def _fig6(figs: _FigureWriter, done: pd.DataFrame) -> str:
     if done["world"].nunique() < 2:
         return h.section(title, "<p>Needs finished runs in at least two worlds.</p>", id="fig-6")
     traps = world_pair_traps(done, "eps_t")
-    reversed_ = traps[traps["reversed_by"] > 0].sort_values(["means_differ", "reversed_by"], ascending=False, kind="stable")
-    intro = ("The paper's Fig. 6: for two worlds, one run of each can rank them opposite to their mean errors. "
-             "Pairs of worlds where this happens (translational error): first those whose means differ significantly "
-             "(Welch, 5 %), then by how much the single runs reverse them.")
+    reversed_ = traps[traps["reversed_by"] > 0].sort_values(
+        ["means_differ", "reversed_by"], ascending=False, kind="stable"
+    )
+    intro = (
+        "The paper's Fig. 6: for two worlds, one run of each can rank them opposite to their mean errors. "
+        "Pairs of worlds where this happens (translational error): first those whose means differ significantly "
+        "(Welch, 5 %), then by how much the single runs reverse them."
+    )
     if reversed_.empty:
-        return h.section(title, "<p>No pair of worlds has a single-run comparison that contradicts the means.</p>",
-                         id="fig-6", intro=intro)
+        return h.section(
+            title,
+            "<p>No pair of worlds has a single-run comparison that contradicts the means.</p>",
+            id="fig-6",
+            intro=intro,
+        )
     rows = []
     for _, r in reversed_.head(15).iterrows():
-        rows.append([r["world_low"], _num(r["mean_low"]), r["world_high"], _num(r["mean_high"]), _num(r["p"], 4),
-                     "yes" if r["means_differ"] else "no", f"#{r['run_low']}: {r['value_low']:.3f} m",
-                     f"#{r['run_high']}: {r['value_high']:.3f} m", h.Cell(f"{r['reversed_fraction']:.0%}", numeric=True)])
-    header = ["lower-mean world", "mean (m)", "higher-mean world", "mean (m)", "Welch p", "means differ (5 %)",
-              "misleading run of the first", "misleading run of the second", "run pairs reversed"]
+        rows.append(
+            [
+                r["world_low"],
+                _num(r["mean_low"]),
+                r["world_high"],
+                _num(r["mean_high"]),
+                _num(r["p"], 4),
+                "yes" if r["means_differ"] else "no",
+                f"#{r['run_low']}: {r['value_low']:.3f} m",
+                f"#{r['run_high']}: {r['value_high']:.3f} m",
+                h.Cell(f"{r['reversed_fraction']:.0%}", numeric=True),
+            ]
+        )
+    header = [
+        "lower-mean world",
+        "mean (m)",
+        "higher-mean world",
+        "mean (m)",
+        "Welch p",
+        "means differ (5 %)",
+        "misleading run of the first",
+        "misleading run of the second",
+        "run pairs reversed",
+    ]
     top = reversed_.iloc[0]
-    sentence = (f"{top['world_low']} has the lower mean error ({top['mean_low']:.3f} m against {top['mean_high']:.3f} m), "
-                f"but its run #{top['run_low']} ({top['value_low']:.3f} m) is worse than run #{top['run_high']} of "
-                f"{top['world_high']} ({top['value_high']:.3f} m): comparing these two single runs gives the opposite verdict; "
-                f"{top['reversed_fraction']:.0%} of all pairs of single runs do. The difference of the means is "
-                f"{'significant' if top['means_differ'] else 'not significant'} (Welch p = {top['p']:.3g}).")
+    sentence = (
+        f"{top['world_low']} has the lower mean error ({top['mean_low']:.3f} m against {top['mean_high']:.3f} m), "
+        f"but its run #{top['run_low']} ({top['value_low']:.3f} m) is worse than run #{top['run_high']} of "
+        f"{top['world_high']} ({top['value_high']:.3f} m): comparing these two single runs gives the opposite verdict; "
+        f"{top['reversed_fraction']:.0%} of all pairs of single runs do. The difference of the means is "
+        f"{'significant' if top['means_differ'] else 'not significant'} (Welch p = {top['p']:.3g})."
+    )
     low = done.loc[done["world"] == top["world_low"], ["run", "eps_t"]]
     high = done.loc[done["world"] == top["world_high"], ["run", "eps_t"]]
     fig = figs.new(5.0, 3.6)
     ax = fig.subplots()
-    draw_trap_pair(ax, low["eps_t"].to_numpy(), high["eps_t"].to_numpy(), (top["world_low"], top["world_high"]),
-                   int(np.flatnonzero(low["run"].to_numpy() == top["run_low"])[0]),
-                   int(np.flatnonzero(high["run"].to_numpy() == top["run_high"])[0]))
-    picture = figs.save(fig, "fig6_trap", f"The runs of {top['world_low']} and {top['world_high']} with their means; "
-                                          "ringed and joined: the single-run pair that contradicts the means the most.")
-    return h.section(title, f"<p>{h.esc(sentence)}</p>", picture, h.table(header, rows, id="trap-table"), id="fig-6", intro=intro)
+    draw_trap_pair(
+        ax,
+        low["eps_t"].to_numpy(),
+        high["eps_t"].to_numpy(),
+        (top["world_low"], top["world_high"]),
+        int(np.flatnonzero(low["run"].to_numpy() == top["run_low"])[0]),
+        int(np.flatnonzero(high["run"].to_numpy() == top["run_high"])[0]),
+    )
+    picture = figs.save(
+        fig,
+        "fig6_trap",
+        f"The runs of {top['world_low']} and {top['world_high']} with their means; "
+        "ringed and joined: the single-run pair that contradicts the means the most.",
+    )
+    return h.section(
+        title, f"<p>{h.esc(sentence)}</p>", picture, h.table(header, rows, id="trap-table"), id="fig-6", intro=intro
+    )
 
 
 def _choose_sampling_run(data: CampaignData, done: pd.DataFrame, sampling_run) -> tuple[str, int] | None:
@@ -370,8 +503,9 @@ def _choose_sampling_run(data: CampaignData, done: pd.DataFrame, sampling_run) -
     return None
 
 
-def _fig3(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame, chosen: tuple[str, int] | None, repeats: int,
-          seed: int) -> str:
+def _fig3(
+    figs: _FigureWriter, data: CampaignData, done: pd.DataFrame, chosen: tuple[str, int] | None, repeats: int, seed: int
+) -> str:
     title = "Fig. 3: the relation-sampling check"
     if chosen is None:
         return h.section(title, "<p>No finished run to check.</p>", id="fig-3")
@@ -385,9 +519,19 @@ def _fig3(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame, chosen: t
         estimate = Trajectory(t=record.t, poses=np.asarray(record.estimate, dtype=np.float64))
         odometry = Trajectory(t=record.t, poses=record.odometry)
         sequence = np.random.SeedSequence(int(seed))
-        means = {component: cf.repeated_sampling_means(truth, estimate, repeats, sequence, component=component,
-                                                       rule=metric.rule, tolerance=metric.tolerance, odometry=odometry)
-                 for component in ("translational", "rotational")}
+        means = {
+            component: cf.repeated_sampling_means(
+                truth,
+                estimate,
+                repeats,
+                sequence,
+                component=component,
+                rule=metric.rule,
+                tolerance=metric.tolerance,
+                odometry=odometry,
+            )
+            for component in ("translational", "rotational")
+        }
     except SlamtrialsError as exc:
         log.warning("relation-sampling check of %s/%d: %s", world, index, exc)
         return h.section(title, h.notes([f"Run {world}/{index} could not be checked: {exc}"]), id="fig-3")
@@ -401,15 +545,24 @@ def _fig3(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame, chosen: t
             cf.draw_sampling_check(ax, values, xlabel=f"mean {component} error of one sampling ({unit})")
         ax.axvline(float(row[metric_name]), color="black", ls=":", lw=1.2, gid="campaign_value")
         ax.set_title(f"{world} run #{index}: {SYMBOLS[metric_name]} over {repeats} samplings", fontsize=9)
-    caption = (f"The paper's Fig. 3 for run #{index} of {world}: the distribution of the run's mean error over {repeats} "
-               f"independent samplings of relations (each by the campaign's rule: pilot {metric.pilot}, "
-               f"{_pct(metric.confidence)} confidence, margins \u00b1{metric.margin_t:g} m and "
-               f"\u00b1{metric.margin_r:g} rad), with a fitted normal; dotted: the value the campaign recorded "
-               f"({row['eps_t']:.4f} m, {row['eps_r']:.4f} rad). Sampling seed {seed}.")
-    spread = [f"{SYMBOLS[m]}: mean {v.mean():.4g}, sd {v.std(ddof=1):.2g} over samplings (margin \u00b1{getattr(metric, 'margin_' + m[-1]):g})"
-              for m, v in zip(METRICS, means.values())]
-    return h.section(title, figs.save(fig, "fig3_sampling", caption), "<p>" + h.esc("; ".join(spread)) + "</p>", id="fig-3",
-                     intro="Is the sampled mean of one run approximately normal with a spread within the margin of error?")
+    caption = (
+        f"The paper's Fig. 3 for run #{index} of {world}: the distribution of the run's mean error over {repeats} "
+        f"independent samplings of relations (each by the campaign's rule: pilot {metric.pilot}, "
+        f"{_pct(metric.confidence)} confidence, margins \u00b1{metric.margin_t:g} m and "
+        f"\u00b1{metric.margin_r:g} rad), with a fitted normal; dotted: the value the campaign recorded "
+        f"({row['eps_t']:.4f} m, {row['eps_r']:.4f} rad). Sampling seed {seed}."
+    )
+    spread = [
+        f"{SYMBOLS[m]}: mean {v.mean():.4g}, sd {v.std(ddof=1):.2g} over samplings (margin \u00b1{getattr(metric, 'margin_' + m[-1]):g})"
+        for m, v in zip(METRICS, means.values())
+    ]
+    return h.section(
+        title,
+        figs.save(fig, "fig3_sampling", caption),
+        "<p>" + h.esc("; ".join(spread)) + "</p>",
+        id="fig-3",
+        intro="Is the sampled mean of one run approximately normal with a spread within the margin of error?",
+    )
 
 
 def _zoom_to_known(ax, occupancy, margin: float = 0.5) -> None:
@@ -435,8 +588,11 @@ def _draw_run_panels(axes, record, label: str, row: pd.Series) -> None:
         map_ax.text(0.5, 0.5, "no map recorded", ha="center", va="center", transform=map_ax.transAxes)
         map_ax.set_title(title, fontsize=9)
     if record.estimate is not None:
-        cf.draw_trajectories(path_ax, Trajectory(t=record.t, poses=record.truth),
-                             Trajectory(t=record.t, poses=np.asarray(record.estimate, dtype=np.float64)))
+        cf.draw_trajectories(
+            path_ax,
+            Trajectory(t=record.t, poses=record.truth),
+            Trajectory(t=record.t, poses=np.asarray(record.estimate, dtype=np.float64)),
+        )
         path_ax.set_title(f"{label}: estimated vs true trajectory", fontsize=9)
     else:
         path_ax.text(0.5, 0.5, "no estimate recorded", ha="center", va="center", transform=path_ax.transAxes)
@@ -462,13 +618,25 @@ def _fig4(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame) -> str:
             problems.append(f"{world}: a run folder could not be read ({exc})")
             log.warning("gallery of %s: %s", world, exc)
             continue
-        described = " and ".join(f"the {label} run #{int(row['run'])} ({row['eps_t']:.3f} m, {row['eps_r']:.3f} rad)" for label, row in picks)
-        gallery.append(figs.save(fig, f"fig4_{i:03d}_{world}",
-                                 f"{world}: the final SLAM maps (top) and the estimated versus true trajectories (bottom; "
-                                 f"the estimate placed through its first pose) of {described}, by translational error."))
-    return h.section(title, h.notes(problems), '<div class="gallery">' + "\n".join(gallery) + "</div>", id="fig-4",
-                     intro="The metric should tell a good map from a bad one (the paper's Fig. 4): the map and the "
-                           "trajectories of the run with the smallest and the largest translational error of each world.")
+        described = " and ".join(
+            f"the {label} run #{int(row['run'])} ({row['eps_t']:.3f} m, {row['eps_r']:.3f} rad)" for label, row in picks
+        )
+        gallery.append(
+            figs.save(
+                fig,
+                f"fig4_{i:03d}_{world}",
+                f"{world}: the final SLAM maps (top) and the estimated versus true trajectories (bottom; "
+                f"the estimate placed through its first pose) of {described}, by translational error.",
+            )
+        )
+    return h.section(
+        title,
+        h.notes(problems),
+        '<div class="gallery">' + "\n".join(gallery) + "</div>",
+        id="fig-4",
+        intro="The metric should tell a good map from a bad one (the paper's Fig. 4): the map and the "
+        "trajectories of the run with the smallest and the largest translational error of each world.",
+    )
 
 
 def _termination(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame) -> str:
@@ -481,19 +649,34 @@ def _termination(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame) ->
     cf.draw_termination(axes[0], done)
     if len(mapped):
         cf.draw_explored(axes[1], mapped)
-    picture = figs.save(fig, "termination", "Left: why the runs ended, per world (run counts). Right: the fraction of each "
-                                            "world's free space the robot's footprint can reach that the final map knows (free or occupied), per run, and its mean.")
+    picture = figs.save(
+        fig,
+        "termination",
+        "Left: why the runs ended, per world (run counts). Right: the fraction of each "
+        "world's free space the robot's footprint can reach that the final map knows (free or occupied), per run, and its mean.",
+    )
     rows = []
     for world in data.worlds["world"]:
         mine = done[done["world"] == world]
         if mine.empty:
             continue
         reasons = Counter(mine["termination"].fillna("unknown"))
-        rows.append([world, len(mine), ", ".join(f"{k} {v}" for k, v in sorted(reasons.items())),
-                     _num(mine["mapped"].mean(), 3), _num(mine["mapped"].min(), 3), _num(mine["duration_s"].mean(), 1),
-                     _num(mine["wall_s"].mean(), 1)])
-    table = h.table(["world", "runs", "ended by", "explored (mean)", "explored (min)", "simulated s (mean)", "wall s (mean)"],
-                    rows, id="termination-table")
+        rows.append(
+            [
+                world,
+                len(mine),
+                ", ".join(f"{k} {v}" for k, v in sorted(reasons.items())),
+                _num(mine["mapped"].mean(), 3),
+                _num(mine["mapped"].min(), 3),
+                _num(mine["duration_s"].mean(), 1),
+                _num(mine["wall_s"].mean(), 1),
+            ]
+        )
+    table = h.table(
+        ["world", "runs", "ended by", "explored (mean)", "explored (min)", "simulated s (mean)", "wall s (mean)"],
+        rows,
+        id="termination-table",
+    )
     return h.section(title, picture, table, id="termination")
 
 
@@ -502,15 +685,47 @@ def _runs_table(data: CampaignData) -> str:
     rows, classes = [], []
     for _, r in runs.iterrows():
         flag = ", ".join(n for n, c in (("\u03b5t", r["outlier_t"]), ("\u03b5r", r["outlier_r"])) if c)
-        rows.append([r["world"], h.Cell(str(r["run"]), numeric=True), h.Cell(str(r["seed"]), numeric=True), r["status"],
-                     _num(r["eps_t"], 4), _num(r["eps_r"], 4), flag, r["termination"] if isinstance(r["termination"], str) else "",
-                     _num(r["mapped"], 3), _num(r["duration_s"], 1), _num(r["wall_s"], 1),
-                     r["error"] if isinstance(r["error"], str) else ""])
+        rows.append(
+            [
+                r["world"],
+                h.Cell(str(r["run"]), numeric=True),
+                h.Cell(str(r["seed"]), numeric=True),
+                r["status"],
+                _num(r["eps_t"], 4),
+                _num(r["eps_r"], 4),
+                flag,
+                r["termination"] if isinstance(r["termination"], str) else "",
+                _num(r["mapped"], 3),
+                _num(r["duration_s"], 1),
+                _num(r["wall_s"], 1),
+                r["error"] if isinstance(r["error"], str) else "",
+            ]
+        )
         classes.append("bad" if r["status"] == "failed" else ("warn" if flag else None))
-    table = h.table(["world", "run", "seed", "status", "\u03b5t (m)", "\u03b5r (rad)", "outlier in", "ended by", "explored",
-                     "sim s", "wall s", "error"], rows, id="runs-table", row_classes=classes)
-    return h.section("Every run", f"<details><summary>{len(runs)} runs with their seeds, errors and outlier marks</summary>"
-                                  f"{table}</details>", id="runs")
+    table = h.table(
+        [
+            "world",
+            "run",
+            "seed",
+            "status",
+            "\u03b5t (m)",
+            "\u03b5r (rad)",
+            "outlier in",
+            "ended by",
+            "explored",
+            "sim s",
+            "wall s",
+            "error",
+        ],
+        rows,
+        id="runs-table",
+        row_classes=classes,
+    )
+    return h.section(
+        "Every run",
+        f"<details><summary>{len(runs)} runs with their seeds, errors and outlier marks</summary>{table}</details>",
+        id="runs",
+    )
 
 
 def _provenance(data: CampaignData) -> str:
@@ -527,16 +742,28 @@ def _provenance(data: CampaignData) -> str:
         versions = doc.get("versions")
         if isinstance(versions, dict):
             seen[json.dumps(versions, sort_keys=True)] += 1
-    run_versions = [[", ".join(f"{k} {v}" for k, v in json.loads(key).items()), count] for key, count in seen.most_common()]
+    run_versions = [
+        [", ".join(f"{k} {v}" for k, v in json.loads(key).items()), count] for key, count in seen.most_common()
+    ]
     meta = [(k, v) for k, v in sorted(data.meta.items())]
     return h.section(
         "Provenance",
         "<h3>Campaign catalog</h3>",
-        h.definition_list([*meta, ("root seed", data.config.get("seed")),
-                           ("run seeds", "each (world, run index) has its own stream from numpy.random.SeedSequence of "
-                                         "the root seed (listed per run in the runs table)")]),
+        h.definition_list(
+            [
+                *meta,
+                ("root seed", data.config.get("seed")),
+                (
+                    "run seeds",
+                    "each (world, run index) has its own stream from numpy.random.SeedSequence of "
+                    "the root seed (listed per run in the runs table)",
+                ),
+            ]
+        ),
         "<h3>Versions of the runs (from run.json)</h3>",
-        h.table(["versions", "runs"], run_versions, id="versions-table") if run_versions else "<p>No run folder read.</p>",
+        h.table(["versions", "runs"], run_versions, id="versions-table")
+        if run_versions
+        else "<p>No run folder read.</p>",
         "<h3>This report</h3>",
         h.definition_list(sorted(_versions().items())),
         "<h3>Configuration</h3>",
@@ -548,8 +775,15 @@ def _provenance(data: CampaignData) -> str:
 # ---------------------------------------------------------------------------------------------- public
 
 
-def build_report(campaign_path: str | Path, out_dir: str | Path | None = None, *, sampling_run: str | tuple[str, int] | None = None,
-                 repeats: int = DEFAULT_REPEATS, seed: int = 0, pdf: bool = True) -> Path:
+def build_report(
+    campaign_path: str | Path,
+    out_dir: str | Path | None = None,
+    *,
+    sampling_run: str | tuple[str, int] | None = None,
+    repeats: int = DEFAULT_REPEATS,
+    seed: int = 0,
+    pdf: bool = True,
+) -> Path:
     """Write the HTML report of a campaign (see the module docstring) and return the path of ``index.html``.
 
     Parameters
@@ -590,8 +824,10 @@ def build_report(campaign_path: str | Path, out_dir: str | Path | None = None, *
     figs = _FigureWriter(out, "report_", pdf)
     title = f"{data.kind.capitalize()} report: {data.folder.name}"
     slam = data.config.get("slam", {})
-    subtitle = (f"SLAM algorithm {slam.get('algorithm')}; {len(data.worlds)} worlds, {len(done)} finished runs; "
-                f"errors of the Kuemmerle et al. metric on sampled relations (Amigoni, Castelli, Luperto, IROS 2018).")
+    subtitle = (
+        f"SLAM algorithm {slam.get('algorithm')}; {len(data.worlds)} worlds, {len(done)} finished runs; "
+        f"errors of the Kuemmerle et al. metric on sampled relations (Amigoni, Castelli, Luperto, IROS 2018)."
+    )
     body = [
         _overview(data, done),
         _table_one(data, done),
@@ -604,8 +840,18 @@ def build_report(campaign_path: str | Path, out_dir: str | Path | None = None, *
         _runs_table(data),
         _provenance(data),
     ]
-    nav = [("overview", "Overview"), ("table-1", "Table I"), ("fig-1", "Fig. 1"), ("fig-5", "Fig. 5"), ("fig-6", "Fig. 6"),
-           ("fig-3", "Fig. 3"), ("fig-4", "Fig. 4"), ("termination", "Termination"), ("runs", "Runs"), ("provenance", "Provenance")]
+    nav = [
+        ("overview", "Overview"),
+        ("table-1", "Table I"),
+        ("fig-1", "Fig. 1"),
+        ("fig-5", "Fig. 5"),
+        ("fig-6", "Fig. 6"),
+        ("fig-3", "Fig. 3"),
+        ("fig-4", "Fig. 4"),
+        ("termination", "Termination"),
+        ("runs", "Runs"),
+        ("provenance", "Provenance"),
+    ]
     page = atomic_write_text(out / REPORT_PAGE, h.page(title, body, subtitle=subtitle, nav=nav))
     figs.clean()
     return page
@@ -651,13 +897,17 @@ def _compare_notes(a: CampaignData, b: CampaignData, comparison: Comparison) -> 
         notes.append(f"Worlds only in {name_b}, not compared: {', '.join(comparison.only_b)}.")
     for data, other, name in ((b, a, name_b), (a, b, name_a)):
         if data.kind == "replay" and Path(str(data.config.get("replay_of"))) == other.folder:
-            notes.append(f"{name} is a replay of the other campaign: its runs use the same recorded data, so they are paired; "
-                         "Welch's test ignores the pairing (it is conservative). " + REPLAY_NOTE + ".")
+            notes.append(
+                f"{name} is a replay of the other campaign: its runs use the same recorded data, so they are paired; "
+                "Welch's test ignores the pairing (it is conservative). " + REPLAY_NOTE + "."
+            )
     for data, name in ((a, name_a), (b, name_b)):
         unfinished = data.worlds[~data.worlds["status"].isin(["done", "capped", "short"])]
         if len(unfinished):
-            notes.append(f"{name} is not finished ({', '.join(f'{w} {s}' for w, s in zip(unfinished['world'], unfinished['status']))}): "
-                         "the comparison uses the runs done so far.")
+            notes.append(
+                f"{name} is not finished ({', '.join(f'{w} {s}' for w, s in zip(unfinished['world'], unfinished['status']))}): "
+                "the comparison uses the runs done so far."
+            )
     return notes
 
 
@@ -673,10 +923,12 @@ def trap_sentences(comparison: Comparison, metric: str = "eps_t") -> list[str]:
         if diff == 0 or not np.sign(r["trap_difference"]) == -np.sign(diff):
             continue
         better, worse = (name_b, name_a) if diff < 0 else (name_a, name_b)
-        out.append(f"{r['world']}: {better} has the lower mean {SYMBOLS[metric]} (by {abs(diff):.3g} {unit}; verdict: {r['verdict']}), "
-                   f"but its run alone against one run of {worse} ({name_a} #{r['trap_run_a']}: {r['trap_value_a']:.3f} {unit}, "
-                   f"{name_b} #{r['trap_run_b']}: {r['trap_value_b']:.3f} {unit}) gives the opposite verdict; "
-                   f"{r['trap_fraction']:.0%} of all single-run pairs do.")
+        out.append(
+            f"{r['world']}: {better} has the lower mean {SYMBOLS[metric]} (by {abs(diff):.3g} {unit}; verdict: {r['verdict']}), "
+            f"but its run alone against one run of {worse} ({name_a} #{r['trap_run_a']}: {r['trap_value_a']:.3f} {unit}, "
+            f"{name_b} #{r['trap_run_b']}: {r['trap_value_b']:.3f} {unit}) gives the opposite verdict; "
+            f"{r['trap_fraction']:.0%} of all single-run pairs do."
+        )
     return out
 
 
@@ -686,22 +938,60 @@ def _comparison_table(comparison: Comparison, metric: str) -> str:
     digits = 3 if metric == "eps_t" else 4
     for _, r in comparison.for_metric(metric).iterrows():
         ci = f"[{h.fmt_number(r['ci_low'], digits)}, {h.fmt_number(r['ci_high'], digits)}]"
-        rows.append([r["world"], h.Cell(str(r["n_a"]), numeric=True), h.Cell(str(r["n_b"]), numeric=True), _num(r["mean_a"], digits),
-                     _num(r["mean_b"], digits), _num(r["difference"], digits), h.Cell(ci, numeric=True), _num(r["p"], 4),
-                     _num(r["p_adjusted"], 4), r["verdict"], h.Cell(h.fmt_number(r["trap_fraction"] * 100, 0) + " %"
-                                                                   if math.isfinite(r["trap_fraction"]) else "-", numeric=True)])
+        rows.append(
+            [
+                r["world"],
+                h.Cell(str(r["n_a"]), numeric=True),
+                h.Cell(str(r["n_b"]), numeric=True),
+                _num(r["mean_a"], digits),
+                _num(r["mean_b"], digits),
+                _num(r["difference"], digits),
+                h.Cell(ci, numeric=True),
+                _num(r["p"], 4),
+                _num(r["p_adjusted"], 4),
+                r["verdict"],
+                h.Cell(
+                    h.fmt_number(r["trap_fraction"] * 100, 0) + " %" if math.isfinite(r["trap_fraction"]) else "-",
+                    numeric=True,
+                ),
+            ]
+        )
         classes.append("good" if r["verdict"] == B_BETTER else ("bad" if r["verdict"] == A_BETTER else None))
     name_a, name_b = comparison.labels
-    header = ["world", f"n {name_a}", f"n {name_b}", f"mean {name_a}", f"mean {name_b}", f"{name_b} \u2212 {name_a}",
-              f"{1 - comparison.alpha:.0%} CI (Welch)", "p", f"p ({comparison.correction})", "verdict", "single-run pairs reversed"]
-    return h.table(header, rows, id=f"comparison-table-{metric}", row_classes=classes,
-                   caption=f"{SYMBOLS[metric]} ({unit}), lower is better: per world the difference of mean errors with its "
-                           f"Welch confidence interval, the Welch p-value and the p-value corrected for {len(rows)} comparisons "
-                           f"({comparison.correction}); verdict at \u03b1 = {comparison.alpha:g}.")
+    header = [
+        "world",
+        f"n {name_a}",
+        f"n {name_b}",
+        f"mean {name_a}",
+        f"mean {name_b}",
+        f"{name_b} \u2212 {name_a}",
+        f"{1 - comparison.alpha:.0%} CI (Welch)",
+        "p",
+        f"p ({comparison.correction})",
+        "verdict",
+        "single-run pairs reversed",
+    ]
+    return h.table(
+        header,
+        rows,
+        id=f"comparison-table-{metric}",
+        row_classes=classes,
+        caption=f"{SYMBOLS[metric]} ({unit}), lower is better: per world the difference of mean errors with its "
+        f"Welch confidence interval, the Welch p-value and the p-value corrected for {len(rows)} comparisons "
+        f"({comparison.correction}); verdict at \u03b1 = {comparison.alpha:g}.",
+    )
 
 
-def compare_report(campaign_a: str | Path, campaign_b: str | Path, out_dir: str | Path, *, alpha: float = 0.05,
-                   correction: Correction = "holm", labels: tuple[str, str] | None = None, pdf: bool = True) -> CompareReport:
+def compare_report(
+    campaign_a: str | Path,
+    campaign_b: str | Path,
+    out_dir: str | Path,
+    *,
+    alpha: float = 0.05,
+    correction: Correction = "holm",
+    labels: tuple[str, str] | None = None,
+    pdf: bool = True,
+) -> CompareReport:
     """Compare campaign B with campaign A on their common worlds and write ``compare.html`` into ``out_dir``.
 
     Parameters
@@ -748,12 +1038,21 @@ def compare_report(campaign_a: str | Path, campaign_b: str | Path, out_dir: str 
         rows = comparison.for_metric(metric)
         fig = figs.new(8.5, max(2.8, 0.42 * len(rows) + 1.8))
         cf.draw_comparison(fig.subplots(), comparison, metric)
-        forest.append(figs.save(fig, f"forest_{metric}",
-                                f"{name_b} \u2212 {name_a} in mean {SYMBOLS[metric]} per world with {1 - alpha:.0%} Welch intervals, "
-                                f"coloured by verdict ({correction} correction); diamonds: the most misleading single-run pair "
-                                "where it contradicts the means; right margin: share of run pairs that reverse the means."))
+        forest.append(
+            figs.save(
+                fig,
+                f"forest_{metric}",
+                f"{name_b} \u2212 {name_a} in mean {SYMBOLS[metric]} per world with {1 - alpha:.0%} Welch intervals, "
+                f"coloured by verdict ({correction} correction); diamonds: the most misleading single-run pair "
+                "where it contradicts the means; right margin: share of run pairs that reverse the means.",
+            )
+        )
     trap_rows = comparison.for_metric("eps_t")
-    trap_rows = trap_rows[np.isfinite(trap_rows["trap_fraction"])].sort_values("trap_fraction", ascending=False, kind="stable").head(12)
+    trap_rows = (
+        trap_rows[np.isfinite(trap_rows["trap_fraction"])]
+        .sort_values("trap_fraction", ascending=False, kind="stable")
+        .head(12)
+    )
     trap_picture = ""
     if len(trap_rows):
         ncols = min(4, len(trap_rows))
@@ -772,35 +1071,79 @@ def compare_report(campaign_a: str | Path, campaign_b: str | Path, out_dir: str 
             else:
                 draw_trap_pair(ax, va, vb, (name_a, name_b), ia, ib, colors=(color_a, color_b))
             ax.set_title(f"{r['world']}: {r['verdict']}\n{r['trap_fraction']:.0%} of run pairs reversed", fontsize=8)
-        for ax in axes[len(trap_rows):]:
+        for ax in axes[len(trap_rows) :]:
             ax.set_visible(False)
-        trap_picture = figs.save(fig, "trap", "The paper's Fig. 6 trap between the two campaigns: per world (most reversed "
-                                              "first), the runs of each and their means (A blue, B orange, the lower mean on the "
-                                              "left); ringed and joined: the single-run pair that contradicts the means the most.")
+        trap_picture = figs.save(
+            fig,
+            "trap",
+            "The paper's Fig. 6 trap between the two campaigns: per world (most reversed "
+            "first), the runs of each and their means (A blue, B orange, the lower mean on the "
+            "left); ringed and joined: the single-run pair that contradicts the means the most.",
+        )
     csv_text = io.StringIO()
     comparison.table.to_csv(csv_text, index=False, lineterminator="\n")
     table_csv = atomic_write_text(out / COMPARE_CSV, csv_text.getvalue())
 
-    describe = lambda d: (f"{d.folder} ({d.kind}, {d.config.get('slam', {}).get('algorithm')}, "  # noqa: E731
-                          f"{int((d.runs['status'] == 'done').sum())} finished runs)")
+    def describe(d: CampaignData) -> str:
+        return (
+            f"{d.folder} ({d.kind}, {d.config.get('slam', {}).get('algorithm')}, "
+            f"{int((d.runs['status'] == 'done').sum())} finished runs)"
+        )
+
     verdicts = [f"{SYMBOLS[m]}: {comparison.overall[m].statement}" for m in METRICS if m in comparison.overall]
     traps = trap_sentences(comparison)
     body = [
-        h.section("Campaigns", h.definition_list([(f"A = {name_a}", describe(data_a)), (f"B = {name_b}", describe(data_b)),
-                                                  ("compared worlds", ", ".join(comparison.for_metric(METRICS[0])["world"])),
-                                                  ("test", f"Welch's t-test per world, {correction} correction across worlds, "
-                                                           f"\u03b1 = {alpha:g}; overall: sign test over worlds")]),
-                  h.notes(notes, id="notes"), id="campaigns"),
-        h.section("Overall verdict", '<ul id="overall">' + "".join(f"<li>{h.esc(v)}</li>" for v in verdicts) + "</ul>", id="verdict"),
-        h.section("Per world", *(_comparison_table(comparison, m) for m in METRICS), f'<p><a href="{COMPARE_CSV}">comparison.csv</a></p>',
-                  *forest, id="per-world"),
-        h.section("Fig. 6: where single runs would give the opposite verdict",
-                  "<ul>" + "".join(f"<li>{h.esc(s)}</li>" for s in traps) + "</ul>" if traps else
-                  "<p>No world has a single-run pair that contradicts its means.</p>", trap_picture, id="trap"),
+        h.section(
+            "Campaigns",
+            h.definition_list(
+                [
+                    (f"A = {name_a}", describe(data_a)),
+                    (f"B = {name_b}", describe(data_b)),
+                    ("compared worlds", ", ".join(comparison.for_metric(METRICS[0])["world"])),
+                    (
+                        "test",
+                        f"Welch's t-test per world, {correction} correction across worlds, "
+                        f"\u03b1 = {alpha:g}; overall: sign test over worlds",
+                    ),
+                ]
+            ),
+            h.notes(notes, id="notes"),
+            id="campaigns",
+        ),
+        h.section(
+            "Overall verdict",
+            '<ul id="overall">' + "".join(f"<li>{h.esc(v)}</li>" for v in verdicts) + "</ul>",
+            id="verdict",
+        ),
+        h.section(
+            "Per world",
+            *(_comparison_table(comparison, m) for m in METRICS),
+            f'<p><a href="{COMPARE_CSV}">comparison.csv</a></p>',
+            *forest,
+            id="per-world",
+        ),
+        h.section(
+            "Fig. 6: where single runs would give the opposite verdict",
+            "<ul>" + "".join(f"<li>{h.esc(s)}</li>" for s in traps) + "</ul>"
+            if traps
+            else "<p>No world has a single-run pair that contradicts its means.</p>",
+            trap_picture,
+            id="trap",
+        ),
     ]
-    page = atomic_write_text(out / COMPARE_PAGE, h.page(f"Comparison: {name_b} vs {name_a}", body,
-                                                         subtitle="Lower errors are better; differences are B \u2212 A.",
-                                                         nav=[("campaigns", "Campaigns"), ("verdict", "Verdict"),
-                                                              ("per-world", "Per world"), ("trap", "Fig. 6 trap")]))
+    page = atomic_write_text(
+        out / COMPARE_PAGE,
+        h.page(
+            f"Comparison: {name_b} vs {name_a}",
+            body,
+            subtitle="Lower errors are better; differences are B \u2212 A.",
+            nav=[
+                ("campaigns", "Campaigns"),
+                ("verdict", "Verdict"),
+                ("per-world", "Per world"),
+                ("trap", "Fig. 6 trap"),
+            ],
+        ),
+    )
     figs.clean()
     return CompareReport(comparison, page, table_csv, tuple(figs.written), tuple(notes), (data_a.folder, data_b.folder))

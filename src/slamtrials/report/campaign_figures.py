@@ -40,9 +40,21 @@ from slamtrials.report.tables import (
     world_outliers,
 )
 
-__all__ = ["save_figure", "draw_world_errors", "draw_sorted_errors", "draw_all_runs", "repeated_sampling_means",
-           "draw_sampling_check", "map_picture", "draw_map", "draw_trajectories", "draw_termination", "draw_explored",
-           "draw_comparison", "METRIC_LABELS"]
+__all__ = [
+    "save_figure",
+    "draw_world_errors",
+    "draw_sorted_errors",
+    "draw_all_runs",
+    "repeated_sampling_means",
+    "draw_sampling_check",
+    "map_picture",
+    "draw_map",
+    "draw_trajectories",
+    "draw_termination",
+    "draw_explored",
+    "draw_comparison",
+    "METRIC_LABELS",
+]
 
 #: Axis labels of the metrics, with units.
 METRIC_LABELS = {"eps_t": "translational error \u03b5t (m)", "eps_r": "rotational error \u03b5r (rad)"}
@@ -94,8 +106,15 @@ def draw_world_errors(ax, runs: pd.DataFrame, world: str, metric: str = "eps_t",
     unit = UNITS[metric]
     ax.axhline(st.mean, color="tab:red", lw=1.5, label=f"mean {st.mean:.3g} {unit}", gid="mean")
     if st.n >= 2:
-        ax.axhspan(st.ci_low, st.ci_high, color="tab:red", alpha=0.15, lw=0, gid="ci",
-                   label=f"{confidence:.0%} CI of the mean \u00b1{st.half_width:.2g} {unit}")
+        ax.axhspan(
+            st.ci_low,
+            st.ci_high,
+            color="tab:red",
+            alpha=0.15,
+            lw=0,
+            gid="ci",
+            label=f"{confidence:.0%} CI of the mean \u00b1{st.half_width:.2g} {unit}",
+        )
     if len(x) <= 40:
         ax.set_xticks(x, labels=[str(r) for r in run_index[order]], fontsize=7)
     ax.set_xlabel("run (largest error first)")
@@ -116,7 +135,15 @@ def draw_sorted_errors(ax, runs: pd.DataFrame, worlds: list[str] | None = None, 
     names = sorted(runs["world"].astype(str).unique()) if worlds is None else list(worlds)
     for world in names:
         values, _ = _world_values(runs, world, metric)
-        ax.plot(np.arange(1, len(values) + 1), np.sort(values, kind="stable")[::-1], "o-", ms=3, lw=1.2, label=world, gid=f"world:{world}")
+        ax.plot(
+            np.arange(1, len(values) + 1),
+            np.sort(values, kind="stable")[::-1],
+            "o-",
+            ms=3,
+            lw=1.2,
+            label=world,
+            gid=f"world:{world}",
+        )
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("run (largest error first)")
     ax.set_ylabel(METRIC_LABELS[metric])
@@ -154,25 +181,59 @@ def draw_all_runs(ax, runs: pd.DataFrame, metric: str = "eps_t", *, order: str =
         here = np.flatnonzero(names == w)
         x[here] = position[w] + _spread(len(here))
     groups = [values[names == w] for w in worlds]
-    ax.boxplot(groups, positions=np.arange(1, len(worlds) + 1), widths=0.6, whis=OUTLIER_IQR, showfliers=False,
-               manage_ticks=False, medianprops={"color": "tab:blue"})
+    ax.boxplot(
+        groups,
+        positions=np.arange(1, len(worlds) + 1),
+        widths=0.6,
+        whis=OUTLIER_IQR,
+        showfliers=False,
+        manage_ticks=False,
+        medianprops={"color": "tab:blue"},
+    )
     ax.plot(x[~outlier], values[~outlier], "o", ms=2.5, color="0.35", alpha=0.7, label="runs", gid="runs")
-    ax.plot(x[outlier], values[outlier], "x", ms=6, mew=1.5, color="tab:red", label=f"outliers ({int(outlier.sum())})",
-            gid="outliers")
-    ax.plot(np.arange(1, len(worlds) + 1), [g.mean() for g in groups], "_", ms=14, mew=2, color="tab:orange",
-            label="mean", gid="means")
-    ax.set_xticks(np.arange(1, len(worlds) + 1), labels=worlds, rotation=90 if len(worlds) > 8 else 0,
-                  fontsize=7 if len(worlds) > 20 else 8)
+    ax.plot(
+        x[outlier],
+        values[outlier],
+        "x",
+        ms=6,
+        mew=1.5,
+        color="tab:red",
+        label=f"outliers ({int(outlier.sum())})",
+        gid="outliers",
+    )
+    ax.plot(
+        np.arange(1, len(worlds) + 1),
+        [g.mean() for g in groups],
+        "_",
+        ms=14,
+        mew=2,
+        color="tab:orange",
+        label="mean",
+        gid="means",
+    )
+    ax.set_xticks(
+        np.arange(1, len(worlds) + 1),
+        labels=worlds,
+        rotation=90 if len(worlds) > 8 else 0,
+        fontsize=7 if len(worlds) > 20 else 8,
+    )
     ax.set_xlim(0.3, len(worlds) + 0.7)
     ax.set_xlabel("world")
     ax.set_ylabel(METRIC_LABELS[metric])
     ax.legend(fontsize=7, loc="upper right")
 
 
-def repeated_sampling_means(truth: Trajectory, estimate: Trajectory, repeats: int,
-                            rng: np.random.Generator | np.random.SeedSequence | int, *,
-                            component: str = "translational", rule: SamplingRule = SamplingRule(),
-                            tolerance: float = DEFAULT_TOLERANCE, odometry: Trajectory | None = None) -> NDArray[np.float64]:
+def repeated_sampling_means(
+    truth: Trajectory,
+    estimate: Trajectory,
+    repeats: int,
+    rng: np.random.Generator | np.random.SeedSequence | int,
+    *,
+    component: str = "translational",
+    rule: SamplingRule = SamplingRule(),
+    tolerance: float = DEFAULT_TOLERANCE,
+    odometry: Trajectory | None = None,
+) -> NDArray[np.float64]:
     """Mean errors ``[repeats]`` of ``repeats`` independent relation samplings of one run (the paper's Fig. 3).
 
     Each repeat calls :func:`slamtrials.metric.sampling.sample_relations` with its own generator, spawned
@@ -209,8 +270,14 @@ def repeated_sampling_means(truth: Trajectory, estimate: Trajectory, repeats: in
     return means
 
 
-def draw_sampling_check(ax, sampled_means: ArrayLike, normal_fit: bool = True, *, bins: int | str = "auto",
-                        xlabel: str = "mean translational error of one sampling (m)") -> tuple[float, float] | None:
+def draw_sampling_check(
+    ax,
+    sampled_means: ArrayLike,
+    normal_fit: bool = True,
+    *,
+    bins: int | str = "auto",
+    xlabel: str = "mean translational error of one sampling (m)",
+) -> tuple[float, float] | None:
     """Histogram (density) of the mean error over repeated samplings with a fitted normal (the paper's Fig. 3).
 
     The normal has the sample mean and the sample standard deviation (divisor ``n - 1``) of the values; it
@@ -357,8 +424,12 @@ def draw_explored(ax, runs: pd.DataFrame) -> pd.Series:
         x[here] = i + _spread(len(here))
     ax.plot(x, mapped, "o", ms=3, color="tab:blue", alpha=0.6, label="runs", gid="runs")
     ax.plot(np.arange(len(means)), means.to_numpy(), "_", ms=14, mew=2, color="tab:orange", label="mean", gid="means")
-    ax.set_xticks(np.arange(len(means)), labels=list(means.index), rotation=90 if len(means) > 8 else 0,
-                  fontsize=7 if len(means) > 20 else 8)
+    ax.set_xticks(
+        np.arange(len(means)),
+        labels=list(means.index),
+        rotation=90 if len(means) > 8 else 0,
+        fontsize=7 if len(means) > 20 else 8,
+    )
     ax.set_ylim(0.0, 1.05)
     ax.set_xlabel("world")
     ax.set_ylabel("explored fraction")
@@ -388,12 +459,31 @@ def draw_comparison(ax, comparison: Comparison, metric: str = "eps_t") -> None:
         sel = verdicts == verdict
         if sel.any():
             label = {B_BETTER: f"{name_b} better", A_BETTER: f"{name_a} better"}.get(verdict, verdict)
-            ax.errorbar(diff[sel], y[sel], xerr=xerr[:, sel], fmt="o", color=color, ms=5, capsize=3,
-                        lw=2 if verdict in (A_BETTER, B_BETTER) else 1, label=label, gid=f"verdict:{verdict}")
+            ax.errorbar(
+                diff[sel],
+                y[sel],
+                xerr=xerr[:, sel],
+                fmt="o",
+                color=color,
+                ms=5,
+                capsize=3,
+                lw=2 if verdict in (A_BETTER, B_BETTER) else 1,
+                label=label,
+                gid=f"verdict:{verdict}",
+            )
     trap = rows["trap_difference"].to_numpy(dtype=float)
     reversed_ = (np.sign(trap) == -np.sign(diff)) & (diff != 0)
-    ax.plot(trap[reversed_], y[reversed_], "D", ms=6, mfc="none", mec="black", mew=1.2,
-            label="most misleading single-run pair", gid="trap")
+    ax.plot(
+        trap[reversed_],
+        y[reversed_],
+        "D",
+        ms=6,
+        mfc="none",
+        mec="black",
+        mew=1.2,
+        label="most misleading single-run pair",
+        gid="trap",
+    )
     for yi, fraction in zip(y, rows["trap_fraction"].to_numpy(dtype=float)):
         if math.isfinite(fraction):
             ax.annotate(f"{fraction:.0%}", xy=(1.01, yi), xycoords=("axes fraction", "data"), va="center", fontsize=7)
@@ -403,7 +493,11 @@ def draw_comparison(ax, comparison: Comparison, metric: str = "eps_t") -> None:
     ax.set_xlabel(f"{name_b} \u2212 {name_a}: difference of mean {METRIC_LABELS[metric]}")
     overall = comparison.overall.get(metric)
     conf = 1.0 - comparison.alpha
-    ax.set_title(f"{name_b} vs {name_a}" + (f": {overall.verdict}" if overall else "")
-                 + f"\n({conf:.0%} Welch intervals, {comparison.correction} correction; right: share of run pairs"
-                 " that reverse the means)", fontsize=8)
+    ax.set_title(
+        f"{name_b} vs {name_a}"
+        + (f": {overall.verdict}" if overall else "")
+        + f"\n({conf:.0%} Welch intervals, {comparison.correction} correction; right: share of run pairs"
+        " that reverse the means)",
+        fontsize=8,
+    )
     ax.legend(fontsize=7, loc="best")

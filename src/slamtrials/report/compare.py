@@ -43,8 +43,24 @@ from scipy import stats
 
 from slamtrials.report.tables import METRICS, check_metric
 
-__all__ = ["Correction", "VERDICTS", "A_BETTER", "B_BETTER", "NO_DIFFERENCE", "TOO_FEW", "WelchResult", "welch", "adjust_pvalues", "Reversal", "reversal",
-           "OverallVerdict", "Comparison", "compare_campaigns", "world_pair_traps", "sign_test"]
+__all__ = [
+    "Correction",
+    "VERDICTS",
+    "A_BETTER",
+    "B_BETTER",
+    "NO_DIFFERENCE",
+    "TOO_FEW",
+    "WelchResult",
+    "welch",
+    "adjust_pvalues",
+    "Reversal",
+    "reversal",
+    "OverallVerdict",
+    "Comparison",
+    "compare_campaigns",
+    "world_pair_traps",
+    "sign_test",
+]
 
 Correction = Literal["holm", "bh", "none"]
 A_BETTER, B_BETTER, NO_DIFFERENCE, TOO_FEW = "A better", "B better", "no significant difference", "too few runs"
@@ -269,19 +285,43 @@ class Comparison:
         return self.table[self.table["metric"] == metric].reset_index(drop=True)
 
 
-def _world_row(world: str, metric: str, a: NDArray, runs_a: NDArray, b: NDArray, runs_b: NDArray, confidence: float) -> dict:
+def _world_row(
+    world: str, metric: str, a: NDArray, runs_a: NDArray, b: NDArray, runs_b: NDArray, confidence: float
+) -> dict:
     w = welch(a, b, confidence=confidence)
-    row = {"world": world, "metric": metric, "n_a": w.n_a, "n_b": w.n_b, "mean_a": w.mean_a, "mean_b": w.mean_b,
-           "std_a": w.std_a, "std_b": w.std_b, "difference": w.difference, "se": w.se, "dof": w.dof, "t": w.t, "p": w.p,
-           "ci_low": w.ci_low, "ci_high": w.ci_high}
+    row = {
+        "world": world,
+        "metric": metric,
+        "n_a": w.n_a,
+        "n_b": w.n_b,
+        "mean_a": w.mean_a,
+        "mean_b": w.mean_b,
+        "std_a": w.std_a,
+        "std_b": w.std_b,
+        "difference": w.difference,
+        "se": w.se,
+        "dof": w.dof,
+        "t": w.t,
+        "p": w.p,
+        "ci_low": w.ci_low,
+        "ci_high": w.ci_high,
+    }
     if w.difference > 0:  # A has the lower mean: a B run below an A run contradicts it
         r = reversal(a, b)
         ia, ib = r.i_low, r.i_high
     else:
         r = reversal(b, a)
         ib, ia = r.i_low, r.i_high
-    row.update({"trap_fraction": r.fraction, "trap_run_a": int(runs_a[ia]), "trap_run_b": int(runs_b[ib]),
-                "trap_value_a": float(a[ia]), "trap_value_b": float(b[ib]), "trap_difference": float(b[ib] - a[ia])})
+    row.update(
+        {
+            "trap_fraction": r.fraction,
+            "trap_run_a": int(runs_a[ia]),
+            "trap_run_b": int(runs_b[ib]),
+            "trap_value_a": float(a[ia]),
+            "trap_value_b": float(b[ib]),
+            "trap_difference": float(b[ib] - a[ia]),
+        }
+    )
     return row
 
 
@@ -307,16 +347,37 @@ def _overall(metric: str, rows: pd.DataFrame, alpha: float, labels: tuple[str, s
     else:
         verdict = "no consistent difference"
         head = f"no consistent difference in {metric}"
-    statement = (f"{head}: {name_b} has the lower mean in {lower} and the higher in {higher} of {len(rows)} worlds "
-                 f"(sign test p = {p:.3g}); significant at {alpha:g} after correction: {name_a} better in "
-                 f"{int(counts.get(A_BETTER, 0))}, {name_b} better in {int(counts.get(B_BETTER, 0))}.")
-    return OverallVerdict(metric, len(rows), int(counts.get(A_BETTER, 0)), int(counts.get(B_BETTER, 0)),
-                          int(counts.get(NO_DIFFERENCE, 0)), int(counts.get(TOO_FEW, 0)), lower, higher, ties, p,
-                          median, verdict, statement)
+    statement = (
+        f"{head}: {name_b} has the lower mean in {lower} and the higher in {higher} of {len(rows)} worlds "
+        f"(sign test p = {p:.3g}); significant at {alpha:g} after correction: {name_a} better in "
+        f"{int(counts.get(A_BETTER, 0))}, {name_b} better in {int(counts.get(B_BETTER, 0))}."
+    )
+    return OverallVerdict(
+        metric,
+        len(rows),
+        int(counts.get(A_BETTER, 0)),
+        int(counts.get(B_BETTER, 0)),
+        int(counts.get(NO_DIFFERENCE, 0)),
+        int(counts.get(TOO_FEW, 0)),
+        lower,
+        higher,
+        ties,
+        p,
+        median,
+        verdict,
+        statement,
+    )
 
 
-def compare_campaigns(a: pd.DataFrame, b: pd.DataFrame, *, metrics: tuple[str, ...] = METRICS, alpha: float = 0.05,
-                      correction: Correction = "holm", labels: tuple[str, str] = ("A", "B")) -> Comparison:
+def compare_campaigns(
+    a: pd.DataFrame,
+    b: pd.DataFrame,
+    *,
+    metrics: tuple[str, ...] = METRICS,
+    alpha: float = 0.05,
+    correction: Correction = "holm",
+    labels: tuple[str, str] = ("A", "B"),
+) -> Comparison:
     """Compare campaign B with campaign A world by world (see the module docstring for the method).
 
     Parameters
@@ -357,7 +418,11 @@ def compare_campaigns(a: pd.DataFrame, b: pd.DataFrame, *, metrics: tuple[str, .
         rows = []
         for world in common:
             ia, ib = worlds_a == world, worlds_b == world
-            rows.append(_world_row(world, metric, values_a[metric][ia], runs_a[ia], values_b[metric][ib], runs_b[ib], 1.0 - alpha))
+            rows.append(
+                _world_row(
+                    world, metric, values_a[metric][ia], runs_a[ia], values_b[metric][ib], runs_b[ib], 1.0 - alpha
+                )
+            )
         table = pd.DataFrame(rows)
         table.insert(table.columns.get_loc("p") + 1, "p_adjusted", adjust_pvalues(table["p"].to_numpy(), correction))
         table.insert(table.columns.get_loc("ci_high") + 1, "verdict", [_verdict(r, alpha) for _, r in table.iterrows()])
@@ -410,11 +475,35 @@ def world_pair_traps(runs: pd.DataFrame, metric: str = "eps_t", *, alpha: float 
         (vl, rl), (vh, rh) = groups[low], groups[high]
         rev = reversal(vl, vh)
         p = welch(vl, vh).p
-        rows.append({"world_low": low, "world_high": high, "mean_low": float(vl.mean()), "mean_high": float(vh.mean()),
-                     "p": p, "means_differ": bool(p <= alpha), "reversed_fraction": rev.fraction,
-                     "run_low": int(rl[rev.i_low]), "run_high": int(rh[rev.i_high]), "value_low": float(vl[rev.i_low]),
-                     "value_high": float(vh[rev.i_high]), "reversed_by": rev.reversed_by})
-    columns = ["world_low", "world_high", "mean_low", "mean_high", "p", "means_differ", "reversed_fraction", "run_low",
-               "run_high", "value_low", "value_high", "reversed_by"]
+        rows.append(
+            {
+                "world_low": low,
+                "world_high": high,
+                "mean_low": float(vl.mean()),
+                "mean_high": float(vh.mean()),
+                "p": p,
+                "means_differ": bool(p <= alpha),
+                "reversed_fraction": rev.fraction,
+                "run_low": int(rl[rev.i_low]),
+                "run_high": int(rh[rev.i_high]),
+                "value_low": float(vl[rev.i_low]),
+                "value_high": float(vh[rev.i_high]),
+                "reversed_by": rev.reversed_by,
+            }
+        )
+    columns = [
+        "world_low",
+        "world_high",
+        "mean_low",
+        "mean_high",
+        "p",
+        "means_differ",
+        "reversed_fraction",
+        "run_low",
+        "run_high",
+        "value_low",
+        "value_high",
+        "reversed_by",
+    ]
     table = pd.DataFrame(rows, columns=columns)
     return table.sort_values("reversed_by", ascending=False, kind="stable").reset_index(drop=True)

@@ -28,8 +28,12 @@ def draw_repeated_errors(ax, eps_t: ArrayLike, threshold: float, *, factor: floa
     above = values > threshold
     ax.plot(rank[~above], values[~above], "o", color="tab:blue", label="runs")
     if above.any():
-        ax.plot(rank[above], values[above], "o", color="tab:red", label=f"diverged ({int(above.sum())} of {len(values)})")
-    ax.axhline(threshold, color="tab:red", linestyle="--", linewidth=1, label=f"{factor:g} x median = {threshold:.3g} m")
+        ax.plot(
+            rank[above], values[above], "o", color="tab:red", label=f"diverged ({int(above.sum())} of {len(values)})"
+        )
+    ax.axhline(
+        threshold, color="tab:red", linestyle="--", linewidth=1, label=f"{factor:g} x median = {threshold:.3g} m"
+    )
     if len(values) and values.min() > 0:
         ax.set_yscale("log")
     ax.set_xlabel("run, sorted by error")

@@ -58,8 +58,9 @@ def world_picture(world: World, max_pixels: int = 2000) -> tuple[NDArray[np.floa
     return rgb, factor
 
 
-def draw_world(ax, world: World, *, start: bool = True, scale_bar: bool = True, title: str | None = None,
-               max_pixels: int = 2000) -> None:
+def draw_world(
+    ax, world: World, *, start: bool = True, scale_bar: bool = True, title: str | None = None, max_pixels: int = 2000
+) -> None:
     """Draw a world on ``ax`` in world coordinates (metres): walls black, free white, outside grey,
     the start pose as an arrow, a scale bar in metres, and a title with the name and the free area.
 
@@ -96,8 +97,13 @@ def draw_world(ax, world: World, *, start: bool = True, scale_bar: bool = True, 
         x, y, heading = (float(v) for v in world.start)
         length = max(0.8, 0.04 * span)
         ax.plot([x], [y], "o", color="tab:green", ms=5, zorder=3)
-        ax.annotate("", xy=(x + length * math.cos(heading), y + length * math.sin(heading)), xytext=(x, y),
-                    arrowprops={"arrowstyle": "-|>", "color": "tab:green", "lw": 2}, zorder=3)
+        ax.annotate(
+            "",
+            xy=(x + length * math.cos(heading), y + length * math.sin(heading)),
+            xytext=(x, y),
+            arrowprops={"arrowstyle": "-|>", "color": "tab:green", "lw": 2},
+            zorder=3,
+        )
     if scale_bar:
         _scale_bar(ax, nice_length(width))
     if title is None:
@@ -110,8 +116,18 @@ def _scale_bar(ax, length: float) -> None:
     from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar
 
     label = f"{length:g} m"
-    bar = AnchoredSizeBar(ax.transData, length, label, loc="lower right", pad=0.4, borderpad=0.6, sep=3,
-                          frameon=True, size_vertical=0, color="tab:blue")
+    bar = AnchoredSizeBar(
+        ax.transData,
+        length,
+        label,
+        loc="lower right",
+        pad=0.4,
+        borderpad=0.6,
+        sep=3,
+        frameon=True,
+        size_vertical=0,
+        color="tab:blue",
+    )
     bar.patch.set_alpha(0.85)
     ax.add_artist(bar)
 

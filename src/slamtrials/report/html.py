@@ -15,7 +15,20 @@ from dataclasses import dataclass
 from pathlib import PurePosixPath
 from typing import Any
 
-__all__ = ["esc", "attr", "Cell", "fmt_number", "table", "figure", "section", "notes", "pre", "definition_list", "page", "STYLE"]
+__all__ = [
+    "esc",
+    "attr",
+    "Cell",
+    "fmt_number",
+    "table",
+    "figure",
+    "section",
+    "notes",
+    "pre",
+    "definition_list",
+    "page",
+    "STYLE",
+]
 
 STYLE = """
 body { font-family: system-ui, -apple-system, "Segoe UI", Roboto, sans-serif; margin: 0 auto; max-width: 1250px;
@@ -91,8 +104,15 @@ def _cell(value: Any, tag: str = "td") -> str:
     return f"<{tag}{cls}{title}>{content}</{tag}>"
 
 
-def table(header: Sequence[Any], rows: Iterable[Sequence[Any]], *, id: str | None = None, caption: str | None = None,
-          row_classes: Sequence[str | None] | None = None, groups: Sequence[tuple[str, int]] = ()) -> str:
+def table(
+    header: Sequence[Any],
+    rows: Iterable[Sequence[Any]],
+    *,
+    id: str | None = None,
+    caption: str | None = None,
+    row_classes: Sequence[str | None] | None = None,
+    groups: Sequence[tuple[str, int]] = (),
+) -> str:
     """A ``<table>``: ``header`` cells, then ``rows`` of cells (plain values are escaped; floats get 3 decimals).
 
     ``groups`` is an optional header row above ``header`` of ``(label, columns spanned)``; ``row_classes``
@@ -114,13 +134,21 @@ def table(header: Sequence[Any], rows: Iterable[Sequence[Any]], *, id: str | Non
     return "\n".join(out)
 
 
-def figure(png: str | PurePosixPath, caption: str, *, alt: str | None = None, pdf: str | PurePosixPath | None = None,
-           id: str | None = None) -> str:
+def figure(
+    png: str | PurePosixPath,
+    caption: str,
+    *,
+    alt: str | None = None,
+    pdf: str | PurePosixPath | None = None,
+    id: str | None = None,
+) -> str:
     """A ``<figure>`` with the image at relative path ``png``, its caption and a link to ``pdf``."""
     link = f' <a href="{attr(pdf)}">PDF</a>' if pdf else ""
     ident = f' id="{attr(id)}"' if id else ""
-    return (f'<figure{ident}><img src="{attr(png)}" alt="{attr(alt or caption)}" loading="eager">'
-            f"<figcaption>{esc(caption)}{link}</figcaption></figure>")
+    return (
+        f'<figure{ident}><img src="{attr(png)}" alt="{attr(alt or caption)}" loading="eager">'
+        f"<figcaption>{esc(caption)}{link}</figcaption></figure>"
+    )
 
 
 def section(title: str, *parts: str, id: str | None = None, intro: str | None = None) -> str:
@@ -153,18 +181,20 @@ def definition_list(items: Iterable[tuple[str, Any]]) -> str:
 def page(title: str, body: Sequence[str], *, subtitle: str | None = None, nav: Sequence[tuple[str, str]] = ()) -> str:
     """A whole HTML5 page: inline style, the ``<h1>`` title, a subtitle, a table of contents, the trusted ``body`` parts."""
     links = "".join(f'<a href="#{attr(anchor)}">{esc(label)}</a>' for anchor, label in nav)
-    return "\n".join([
-        "<!DOCTYPE html>",
-        '<html lang="en"><head><meta charset="utf-8">',
-        '<meta name="viewport" content="width=device-width, initial-scale=1">',
-        '<meta name="generator" content="slamtrials">',
-        f"<title>{esc(title)}</title>",
-        f"<style>{STYLE}</style>",
-        "</head><body>",
-        f"<h1>{esc(title)}</h1>",
-        f'<p class="lead">{esc(subtitle)}</p>' if subtitle else "",
-        f"<nav>{links}</nav>" if links else "",
-        *body,
-        "</body></html>",
-        "",
-    ])
+    return "\n".join(
+        [
+            "<!DOCTYPE html>",
+            '<html lang="en"><head><meta charset="utf-8">',
+            '<meta name="viewport" content="width=device-width, initial-scale=1">',
+            '<meta name="generator" content="slamtrials">',
+            f"<title>{esc(title)}</title>",
+            f"<style>{STYLE}</style>",
+            "</head><body>",
+            f"<h1>{esc(title)}</h1>",
+            f'<p class="lead">{esc(subtitle)}</p>' if subtitle else "",
+            f"<nav>{links}</nav>" if links else "",
+            *body,
+            "</body></html>",
+            "",
+        ]
+    )

@@ -64,24 +64,68 @@ from slamtrials.report.tables import METRICS, outlier_mask, world_summary
 __all__ = ["CampaignData", "load_campaign", "export_table", "RUN_COLUMNS", "WORLD_COLUMNS", "TABLES", "FORMATS"]
 
 #: Columns of ``runs`` always present, in order (``details`` entries follow).
-RUN_COLUMNS = ("world", "run", "seed", "status", "attempts", "eps_t", "eps_r", "relations", "termination", "mapped",
-               "duration_s", "wall_s", "worker", "error", "folder", "submitted", "finished", "outlier_t", "outlier_r")
-_STORE_WORLD_COLUMNS = ("world", "ref", "position", "reachable_area", "status", "runs_target", "runs_needed", "needed_t",
-                        "needed_r", "std_t", "std_r", "capped", "note", "updated")
+RUN_COLUMNS = (
+    "world",
+    "run",
+    "seed",
+    "status",
+    "attempts",
+    "eps_t",
+    "eps_r",
+    "relations",
+    "termination",
+    "mapped",
+    "duration_s",
+    "wall_s",
+    "worker",
+    "error",
+    "folder",
+    "submitted",
+    "finished",
+    "outlier_t",
+    "outlier_r",
+)
+_STORE_WORLD_COLUMNS = (
+    "world",
+    "ref",
+    "position",
+    "reachable_area",
+    "status",
+    "runs_target",
+    "runs_needed",
+    "needed_t",
+    "needed_r",
+    "std_t",
+    "std_r",
+    "capped",
+    "note",
+    "updated",
+)
 _STATS = ("mean", "std", "std_population", "ci_low", "ci_high", "half_width", "min", "max", "outliers")
 #: Columns of ``worlds``, in order.
-WORLD_COLUMNS = (*_STORE_WORLD_COLUMNS, "runs_done", "runs_failed", "runs_running", "runs_pending",
-                 *(f"{m}_{s}" for m in METRICS for s in _STATS), "confidence")
+WORLD_COLUMNS = (
+    *_STORE_WORLD_COLUMNS,
+    "runs_done",
+    "runs_failed",
+    "runs_running",
+    "runs_pending",
+    *(f"{m}_{s}" for m in METRICS for s in _STATS),
+    "confidence",
+)
 #: The tables :func:`export_table` writes.
 TABLES = ("runs", "worlds")
 #: The file formats :func:`export_table` writes.
 FORMATS = ("csv", "parquet")
 
-_RUN_SQL = ("SELECT r.world, r.idx, r.seed, r.status, r.attempts, r.eps_t, r.eps_r, r.relations, r.termination, "
-            "r.mapped_fraction, r.sim_duration, r.wall_time, r.worker, r.error, r.folder, r.submitted, r.finished, r.details "
-            "FROM runs r JOIN worlds w ON w.name = r.world ORDER BY w.position, r.idx")
-_WORLD_SQL = ("SELECT name, ref, position, reachable_area, status, runs_target, runs_needed, needed_t, needed_r, std_t, "
-              "std_r, capped, note, updated FROM worlds ORDER BY position")
+_RUN_SQL = (
+    "SELECT r.world, r.idx, r.seed, r.status, r.attempts, r.eps_t, r.eps_r, r.relations, r.termination, "
+    "r.mapped_fraction, r.sim_duration, r.wall_time, r.worker, r.error, r.folder, r.submitted, r.finished, r.details "
+    "FROM runs r JOIN worlds w ON w.name = r.world ORDER BY w.position, r.idx"
+)
+_WORLD_SQL = (
+    "SELECT name, ref, position, reachable_area, status, runs_target, runs_needed, needed_t, needed_r, std_t, "
+    "std_r, capped, note, updated FROM worlds ORDER BY position"
+)
 
 
 @dataclass(frozen=True)
@@ -237,8 +281,14 @@ def _worlds_frame(rows: list[tuple], runs: pd.DataFrame, config: dict[str, Any])
     if distribution != "normal" and len(done):
         for i, world in enumerate(table["world"]):
             for metric in METRICS:
-                st = environment_stats(done.loc[done["world"] == world, metric], confidence=confidence, distribution=distribution)
-                table.loc[i, [f"{metric}_ci_low", f"{metric}_ci_high", f"{metric}_half_width"]] = [st.ci_low, st.ci_high, st.half_width]
+                st = environment_stats(
+                    done.loc[done["world"] == world, metric], confidence=confidence, distribution=distribution
+                )
+                table.loc[i, [f"{metric}_ci_low", f"{metric}_ci_high", f"{metric}_half_width"]] = [
+                    st.ci_low,
+                    st.ci_high,
+                    st.half_width,
+                ]
     table = table.drop(columns=["runs", "confidence"], errors="ignore")
     worlds = worlds.merge(table, on="world", how="left")
     for metric in METRICS:
@@ -287,8 +337,13 @@ def load_campaign(path: str | Path) -> CampaignData:
     return CampaignData(folder, runs, worlds, config if isinstance(config, dict) else {}, meta)
 
 
-def export_table(path: str | Path, fmt: Literal["csv", "parquet"] = "csv", out: str | Path | None = None, *,
-                 table: Literal["runs", "worlds"] = "runs") -> Path:
+def export_table(
+    path: str | Path,
+    fmt: Literal["csv", "parquet"] = "csv",
+    out: str | Path | None = None,
+    *,
+    table: Literal["runs", "worlds"] = "runs",
+) -> Path:
     """Write a table of the campaign in ``path`` as CSV or Parquet (pyarrow), atomically.
 
     Parameters

@@ -19,8 +19,16 @@ from numpy.typing import ArrayLike, NDArray
 
 from slamtrials.metric.stats import environment_stats
 
-__all__ = ["METRICS", "OUTLIER_IQR", "require_columns", "check_metric", "outlier_mask", "world_outliers",
-           "world_summary", "paper_table"]
+__all__ = [
+    "METRICS",
+    "OUTLIER_IQR",
+    "require_columns",
+    "check_metric",
+    "outlier_mask",
+    "world_outliers",
+    "world_summary",
+    "paper_table",
+]
 
 #: The per-run error columns: translational (m) and rotational (rad).
 METRICS = ("eps_t", "eps_r")
@@ -73,7 +81,11 @@ def outlier_mask(values: ArrayLike, factor: float = OUTLIER_IQR) -> NDArray[np.b
 def world_outliers(runs: pd.DataFrame, metric: str = "eps_t") -> pd.Series:
     """Boolean Series (aligned with ``runs.index``): the run is an outlier of ``metric`` within its world."""
     values = pd.Series(check_metric(runs, metric), index=runs.index)
-    return values.groupby(runs["world"].astype(str), sort=False).transform(lambda v: outlier_mask(v.to_numpy())).astype(bool)
+    return (
+        values.groupby(runs["world"].astype(str), sort=False)
+        .transform(lambda v: outlier_mask(v.to_numpy()))
+        .astype(bool)
+    )
 
 
 def world_summary(runs: pd.DataFrame, confidence: float = 0.99) -> pd.DataFrame:
@@ -110,21 +122,26 @@ def world_summary(runs: pd.DataFrame, confidence: float = 0.99) -> pd.DataFrame:
         for metric in METRICS:
             v = values[metric][here]
             stats = environment_stats(v, confidence=confidence)
-            row.update({
-                f"{metric}_mean": stats.mean,
-                f"{metric}_std": stats.std_sample,
-                f"{metric}_std_population": stats.std_population,
-                f"{metric}_ci_low": stats.ci_low,
-                f"{metric}_ci_high": stats.ci_high,
-                f"{metric}_half_width": stats.half_width,
-                f"{metric}_min": float(v.min()),
-                f"{metric}_max": float(v.max()),
-                f"{metric}_outliers": int(outlier_mask(v).sum()),
-            })
+            row.update(
+                {
+                    f"{metric}_mean": stats.mean,
+                    f"{metric}_std": stats.std_sample,
+                    f"{metric}_std_population": stats.std_population,
+                    f"{metric}_ci_low": stats.ci_low,
+                    f"{metric}_ci_high": stats.ci_high,
+                    f"{metric}_half_width": stats.half_width,
+                    f"{metric}_min": float(v.min()),
+                    f"{metric}_max": float(v.max()),
+                    f"{metric}_outliers": int(outlier_mask(v).sum()),
+                }
+            )
         row["confidence"] = float(confidence)
         rows.append(row)
-    columns = ["world", "runs"] + [f"{m}_{s}" for m in METRICS for s in
-                                   ("mean", "std", "std_population", "ci_low", "ci_high", "half_width", "min", "max", "outliers")]
+    columns = ["world", "runs"] + [
+        f"{m}_{s}"
+        for m in METRICS
+        for s in ("mean", "std", "std_population", "ci_low", "ci_high", "half_width", "min", "max", "outliers")
+    ]
     return pd.DataFrame(rows, columns=columns + ["confidence"])
 
 

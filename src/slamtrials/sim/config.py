@@ -59,11 +59,17 @@ class RobotConfig(BaseModel):
 
     radius: float = Field(0.15, gt=0.0, le=5.0, description="footprint disc radius (m)")
     max_linear_speed: float = Field(0.7, gt=0.0, le=10.0, description="largest forward speed (m/s)")
-    max_angular_speed: float = Field(math.radians(70.0), gt=0.0, le=4.0 * math.pi, description="largest turn rate (rad/s)")
+    max_angular_speed: float = Field(
+        math.radians(70.0), gt=0.0, le=4.0 * math.pi, description="largest turn rate (rad/s)"
+    )
     max_linear_accel: float = Field(0.5, gt=0.0, le=100.0, description="largest linear acceleration (m/s^2)")
-    max_angular_accel: float = Field(math.radians(100.0), gt=0.0, le=100.0, description="largest angular acceleration (rad/s^2)")
+    max_angular_accel: float = Field(
+        math.radians(100.0), gt=0.0, le=100.0, description="largest angular acceleration (rad/s^2)"
+    )
     allow_reverse: bool = Field(True, description="obey negative linear speeds")
-    max_reverse_speed: float | None = Field(None, gt=0.0, le=10.0, description="largest backward speed (m/s); None = max_linear_speed")
+    max_reverse_speed: float | None = Field(
+        None, gt=0.0, le=10.0, description="largest backward speed (m/s); None = max_linear_speed"
+    )
 
     @property
     def reverse_speed_limit(self) -> float:
@@ -103,7 +109,9 @@ class LaserConfig(BaseModel):
     model_config = _MODEL_CONFIG
 
     fov: float = Field(math.radians(270.0), gt=0.0, le=2.0 * math.pi, description="field of view (rad)")
-    angular_resolution: float = Field(math.radians(0.5), gt=0.0, le=2.0 * math.pi, description="angle between beams (rad)")
+    angular_resolution: float = Field(
+        math.radians(0.5), gt=0.0, le=2.0 * math.pi, description="angle between beams (rad)"
+    )
     max_range: float = Field(30.0, gt=0.0, le=1000.0, description="largest range (m)")
     min_range: float = Field(0.0, ge=0.0, le=1000.0, description="smallest range (m)")
     mount: tuple[float, float, float] = Field((0.0, 0.0, 0.0), description="laser pose (x, y, theta) in the base frame")
@@ -116,7 +124,7 @@ class LaserConfig(BaseModel):
         return value
 
     @model_validator(mode="after")
-    def _consistent(self) -> "LaserConfig":
+    def _consistent(self) -> LaserConfig:
         if self.angular_resolution > self.fov:
             raise ValueError(
                 f"angular_resolution ({self.angular_resolution:g} rad) must not exceed fov ({self.fov:g} rad)"
@@ -149,9 +157,13 @@ class LaserConfig(BaseModel):
 
     def geometry(self) -> LaserGeometry:
         """The laser's geometry as it is recorded with every run."""
-        return LaserGeometry(angle_min=self.angle_min, angle_increment=self.angle_increment,
-                             range_min=self.min_range, range_max=self.max_range,
-                             mount=(float(self.mount[0]), float(self.mount[1]), float(self.mount[2])))
+        return LaserGeometry(
+            angle_min=self.angle_min,
+            angle_increment=self.angle_increment,
+            range_min=self.min_range,
+            range_max=self.max_range,
+            mount=(float(self.mount[0]), float(self.mount[1]), float(self.mount[2])),
+        )
 
 
 class OdometryConfig(BaseModel):
@@ -226,7 +238,7 @@ class SimConfig(BaseModel):
     odometry: OdometryConfig = Field(default_factory=OdometryConfig)
 
     @classmethod
-    def paper(cls) -> "SimConfig":
+    def paper(cls) -> SimConfig:
         """The settings of the paper (270 deg / 0.5 deg / 30 m laser, 10 Hz, +-0.5 % and +-1 deg/rad bias).
 
         These are the defaults.
@@ -234,7 +246,7 @@ class SimConfig(BaseModel):
         return cls()
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> "SimConfig":
+    def from_dict(cls, data: dict[str, Any]) -> SimConfig:
         """Validate a plain dict (e.g. loaded from YAML); raise :class:`ConfigError` with a one-line message."""
         try:
             return cls.model_validate(data)

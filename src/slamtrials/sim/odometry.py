@@ -29,8 +29,8 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from slamtrials.sim.config import OdometryConfig
 from slamtrials.geometry import compose1
+from slamtrials.sim.config import OdometryConfig
 from slamtrials.sim.robot import sinc
 
 __all__ = ["draw_bias", "measured_increment", "Odometry"]
@@ -51,8 +51,9 @@ def draw_bias(config: OdometryConfig, rng: np.random.Generator) -> dict[str, flo
     return {"linear": lin, "angular": ang}
 
 
-def measured_increment(delta: ArrayLike, bias_linear: float, bias_angular: float, noise_linear: float = 0.0,
-                       noise_angular: float = 0.0) -> NDArray[np.float64]:
+def measured_increment(
+    delta: ArrayLike, bias_linear: float, bias_angular: float, noise_linear: float = 0.0, noise_angular: float = 0.0
+) -> NDArray[np.float64]:
     """The odometry increment measured for the true step ``delta``.
 
     Parameters

@@ -34,9 +34,9 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
+from slamtrials.geometry import Pose1Like, compose1
 from slamtrials.record import LaserGeometry
 from slamtrials.sim.config import LaserConfig
-from slamtrials.geometry import Pose1Like, compose1
 from slamtrials.worlds.world import World, world_to_map
 
 __all__ = ["RaycastMap", "LaserModel", "cast_scan", "cast_scan_dda", "SAFETY_CELLS"]
@@ -135,19 +135,36 @@ def _cast_scan(dist, ox, oy, theta, angles, max_t, resolution, max_range, accele
             out[b] = min(t * resolution, max_range) + 0.0  # + 0.0 turns a -0.0 into 0.0
 
 
-def _run(dist: NDArray[np.float32], origin_uv: Pose1Like, theta: float, angles: NDArray[np.float64], max_range: float,
-         resolution: float, accelerate: bool, out: NDArray[np.float32] | None) -> NDArray[np.float32]:
+def _run(
+    dist: NDArray[np.float32],
+    origin_uv: Pose1Like,
+    theta: float,
+    angles: NDArray[np.float64],
+    max_range: float,
+    resolution: float,
+    accelerate: bool,
+    out: NDArray[np.float32] | None,
+) -> NDArray[np.float32]:
     angles = np.ascontiguousarray(angles, dtype=np.float64)
     if out is None:
         out = np.empty(angles.shape[0], dtype=np.float32)
     ox, oy = float(origin_uv[0]), float(origin_uv[1])
     max_range = float(max_range)
-    _cast_scan(dist, ox, oy, float(theta), angles, max_range / resolution, float(resolution), max_range, accelerate, out)
+    _cast_scan(
+        dist, ox, oy, float(theta), angles, max_range / resolution, float(resolution), max_range, accelerate, out
+    )
     return out
 
 
-def cast_scan(dist: NDArray[np.float32], origin_uv: Pose1Like, theta: float, angles: NDArray[np.float64],
-              max_range: float, resolution: float = 1.0, out: NDArray[np.float32] | None = None) -> NDArray[np.float32]:
+def cast_scan(
+    dist: NDArray[np.float32],
+    origin_uv: Pose1Like,
+    theta: float,
+    angles: NDArray[np.float64],
+    max_range: float,
+    resolution: float = 1.0,
+    out: NDArray[np.float32] | None = None,
+) -> NDArray[np.float32]:
     """Ranges of all beams of one scan, with distance-field acceleration.
 
     Parameters
@@ -177,8 +194,15 @@ def cast_scan(dist: NDArray[np.float32], origin_uv: Pose1Like, theta: float, ang
     return _run(dist, origin_uv, theta, angles, max_range, resolution, True, out)
 
 
-def cast_scan_dda(dist: NDArray[np.float32], origin_uv: Pose1Like, theta: float, angles: NDArray[np.float64],
-                  max_range: float, resolution: float = 1.0, out: NDArray[np.float32] | None = None) -> NDArray[np.float32]:
+def cast_scan_dda(
+    dist: NDArray[np.float32],
+    origin_uv: Pose1Like,
+    theta: float,
+    angles: NDArray[np.float64],
+    max_range: float,
+    resolution: float = 1.0,
+    out: NDArray[np.float32] | None = None,
+) -> NDArray[np.float32]:
     """Same as :func:`cast_scan` with the plain cell-by-cell traversal (the reference; slower)."""
     return _run(dist, origin_uv, theta, angles, max_range, resolution, False, out)
 
@@ -201,7 +225,7 @@ class RaycastMap:
         Metres per cell.
     """
 
-    _cache: "weakref.WeakKeyDictionary[World, RaycastMap]" = weakref.WeakKeyDictionary()
+    _cache: weakref.WeakKeyDictionary[World, RaycastMap] = weakref.WeakKeyDictionary()
 
     def __init__(self, world: World):
         cells = np.asarray(world.clearance, dtype=np.float64) / world.resolution
@@ -213,7 +237,7 @@ class RaycastMap:
         # No reference back to the world: the per-world cache holds the world weakly.
 
     @classmethod
-    def for_world(cls, world: World) -> "RaycastMap":
+    def for_world(cls, world: World) -> RaycastMap:
         """The (cached) map of ``world``; built on first use and kept while the world lives."""
         rmap = cls._cache.get(world)
         if rmap is None:

@@ -44,7 +44,6 @@ from slamtrials.worlds.world import World, world_to_map
 __all__ = ["sinc", "cosc", "arc_increment", "arc_sagitta", "limit_velocity", "CollisionChecker", "Robot"]
 
 
-
 def sinc(x: float) -> float:
     """``sin(x) / x`` (1 at 0), accurate for tiny and subnormal ``x`` (Taylor series below 1e-3)."""
     if abs(x) < 1e-3:
@@ -91,8 +90,9 @@ def arc_sagitta(length: float, phi: float) -> float:
     return abs(length) * 2.0 * math.sin(0.5 * half) ** 2 / abs(phi)  # |L| (1 - cos(phi/2)) / |phi|
 
 
-def limit_velocity(velocity: tuple[float, float], command: tuple[float, float], config: RobotConfig,
-                   dt: float) -> tuple[float, float]:
+def limit_velocity(
+    velocity: tuple[float, float], command: tuple[float, float], config: RobotConfig, dt: float
+) -> tuple[float, float]:
     """The velocity ``(v, w)`` the robot reaches after one step towards ``command``.
 
     Parameters
@@ -244,8 +244,9 @@ class CollisionChecker:
         pts[1] = np.asarray(end, dtype=np.float64)[:2]
         (a, b) = world_to_map(self.world, pts).tolist()
         res = self.world.resolution
-        return bool(_capsule_free(self._occupied, self._clearance, res, a[0], a[1], b[0], b[1],
-                                  (self.radius + inflate) / res))
+        return bool(
+            _capsule_free(self._occupied, self._clearance, res, a[0], a[1], b[0], b[1], (self.radius + inflate) / res)
+        )
 
     def disc_free(self, xy: ArrayLike) -> bool:
         """True when the footprint disc centred at ``xy`` (world, m) overlaps no occupied cell."""

@@ -18,11 +18,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from slamtrials.errors import SimulationError
+from slamtrials.geometry import Pose1Like, ominus1
 from slamtrials.record import Frame, LaserGeometry
 from slamtrials.sim.config import SimConfig
 from slamtrials.sim.odometry import Odometry, draw_bias
 from slamtrials.sim.raycast import LaserModel
-from slamtrials.geometry import Pose1Like, ominus1
 from slamtrials.sim.robot import Robot
 from slamtrials.worlds.world import World
 
@@ -64,8 +64,14 @@ class Simulator:
     >>> frames = [sim.observe()] + [sim.step((0.5, 0.1)) for _ in range(100)]   # doctest: +SKIP
     """
 
-    def __init__(self, world: World, config: SimConfig | None,
-                 rng: np.random.Generator | int | np.random.SeedSequence, *, start: ArrayLike | None = None):
+    def __init__(
+        self,
+        world: World,
+        config: SimConfig | None,
+        rng: np.random.Generator | int | np.random.SeedSequence,
+        *,
+        start: ArrayLike | None = None,
+    ):
         self.world = world
         self.config = SimConfig.paper() if config is None else config
         self.rng = as_generator(rng)

@@ -53,8 +53,15 @@ def waypoint_command(pose: ArrayLike, target: ArrayLike, robot: RobotConfig) -> 
     return v, w
 
 
-def simulate_waypoints(world: World, waypoints: ArrayLike, config: SimConfig | None = None, *,
-                       seed: int | np.random.Generator, max_time: float = 3600.0, tolerance: float = 0.2) -> RunRecord:
+def simulate_waypoints(
+    world: World,
+    waypoints: ArrayLike,
+    config: SimConfig | None = None,
+    *,
+    seed: int | np.random.Generator,
+    max_time: float = 3600.0,
+    tolerance: float = 0.2,
+) -> RunRecord:
     """Drive through ``waypoints`` in order and record every frame.
 
     Parameters

@@ -22,8 +22,8 @@ from slamtrials.slam.base import (
     register_algorithm,
     resolve_config,
 )
-from slamtrials.slam.gridmap import GridMap
 from slamtrials.slam.gmapping import GMapping, GMappingConfig
+from slamtrials.slam.gridmap import GridMap
 from slamtrials.slam.karto import Karto, KartoConfig
 from slamtrials.slam.odometry import OdometryConfig, OdometrySlam
 

@@ -46,6 +46,8 @@ __all__ = [
 
 #: Entry-point group under which other packages publish SLAM algorithm classes.
 ENTRY_POINT_GROUP = "slamtrials.slam"
+
+
 @runtime_checkable
 class SlamAlgorithm(Protocol):
     """What every SLAM algorithm offers (structural: no base class needed).
@@ -111,7 +113,9 @@ def register_algorithm(cls: _Class) -> _Class:
     """
     missing = [member for member in _CONTRACT if member not in dir(cls)]
     if missing:
-        raise ConfigError(f"SLAM algorithm class {cls.__qualname__} lacks {', '.join(missing)} (see slamtrials.slam.SlamAlgorithm)")
+        raise ConfigError(
+            f"SLAM algorithm class {cls.__qualname__} lacks {', '.join(missing)} (see slamtrials.slam.SlamAlgorithm)"
+        )
     name, config, presets = cls.name, cls.Config, cls.PRESETS
     if not isinstance(name, str) or not name:
         raise ConfigError(f"SLAM algorithm class {cls.__qualname__}: name must be a non-empty string, got {name!r}")
@@ -172,7 +176,9 @@ def _allowed(model: type[BaseModel], parameter: str) -> str:
     return f"; allowed: {' and '.join(words)}" if words else ""
 
 
-def resolve_config(cls: type[SlamAlgorithm], *, preset: str | None = None, overrides: dict[str, Any] | None = None) -> BaseModel:
+def resolve_config(
+    cls: type[SlamAlgorithm], *, preset: str | None = None, overrides: dict[str, Any] | None = None
+) -> BaseModel:
     """Validate ``cls.Config`` from the defaults, then preset ``preset``, then ``overrides``.
 
     Raises
@@ -191,7 +197,9 @@ def resolve_config(cls: type[SlamAlgorithm], *, preset: str | None = None, overr
     fields = cls.Config.model_fields
     unknown = sorted(set(values) - set(fields))
     if unknown:
-        raise ConfigError(f"SLAM algorithm {cls.name!r} has no parameter {', '.join(unknown)}; parameters: {', '.join(fields)}")
+        raise ConfigError(
+            f"SLAM algorithm {cls.name!r} has no parameter {', '.join(unknown)}; parameters: {', '.join(fields)}"
+        )
     try:
         return cls.Config.model_validate(values)
     except ValidationError as exc:
@@ -204,8 +212,9 @@ def resolve_config(cls: type[SlamAlgorithm], *, preset: str | None = None, overr
         raise ConfigError(f"SLAM algorithm {cls.name!r}: " + "; ".join(problems)) from None
 
 
-def make_algorithm(name: str, laser: LaserGeometry, *, preset: str | None = None,
-                   overrides: dict[str, Any] | None = None) -> SlamAlgorithm:
+def make_algorithm(
+    name: str, laser: LaserGeometry, *, preset: str | None = None, overrides: dict[str, Any] | None = None
+) -> SlamAlgorithm:
     """Build algorithm ``name`` for a laser of geometry ``laser`` with a validated configuration.
 
     Parameters

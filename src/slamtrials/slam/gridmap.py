@@ -122,9 +122,15 @@ def _classify(hits, visits, occ_thresh, flip):  # pragma: no cover - compiled
     return grid
 
 
-def scan_endpoints(laser_poses: ArrayLike, ranges: ArrayLike, angles: ArrayLike, *, range_min: float,
-                   range_max: float, max_urange: float) -> tuple[NDArray[np.float64], NDArray[np.float64],
-                                                                 NDArray[np.bool_], NDArray[np.bool_]]:
+def scan_endpoints(
+    laser_poses: ArrayLike,
+    ranges: ArrayLike,
+    angles: ArrayLike,
+    *,
+    range_min: float,
+    range_max: float,
+    max_urange: float,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_], NDArray[np.bool_]]:
     """Where the traced segment of every beam of ``M`` scans ends, and what it marks (module docstring).
 
     Parameters
@@ -158,16 +164,28 @@ def scan_endpoints(laser_poses: ArrayLike, ranges: ArrayLike, angles: ArrayLike,
     return pose[:, 0:1] + length * stablemath.cos(heading), pose[:, 1:2] + length * stablemath.sin(heading), usable, hit
 
 
-def beam_endpoints(laser_pose: ArrayLike, ranges: ArrayLike, angles: ArrayLike, *, range_min: float,
-                   range_max: float, max_urange: float) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+def beam_endpoints(
+    laser_pose: ArrayLike,
+    ranges: ArrayLike,
+    angles: ArrayLike,
+    *,
+    range_min: float,
+    range_max: float,
+    max_urange: float,
+) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """:func:`scan_endpoints` of one scan, only the beams that carry information.
 
     Returns float64 ``[K, 2]`` map-frame end points (m) of the ``K`` usable beams and bool ``[K]`` whether
     each is a return (marks a hit), not a cut.
     """
-    x, y, usable, hit = scan_endpoints(np.asarray(laser_pose, dtype=np.float64).reshape(1, 3),
-                                       np.asarray(ranges, dtype=np.float64).reshape(1, -1), angles,
-                                       range_min=range_min, range_max=range_max, max_urange=max_urange)
+    x, y, usable, hit = scan_endpoints(
+        np.asarray(laser_pose, dtype=np.float64).reshape(1, 3),
+        np.asarray(ranges, dtype=np.float64).reshape(1, -1),
+        angles,
+        range_min=range_min,
+        range_max=range_max,
+        max_urange=max_urange,
+    )
     return np.column_stack([x[usable], y[usable]]), hit[usable]
 
 
@@ -238,30 +256,55 @@ class GridMap:
         hits, visits = np.zeros((height, width), np.int32), np.zeros((height, width), np.int32)
         r, c = self.row0 - row0, self.col0 - col0
         old_height, old_width = self.visits.shape
-        hits[r:r + old_height, c:c + old_width] = self.hits
-        visits[r:r + old_height, c:c + old_width] = self.visits
+        hits[r : r + old_height, c : c + old_width] = self.hits
+        visits[r : r + old_height, c : c + old_width] = self.visits
         self.hits, self.visits, self.col0, self.row0 = hits, visits, col0, row0
 
-    def integrate(self, laser_pose: ArrayLike, ranges: ArrayLike, angles: ArrayLike, *, range_min: float,
-                  range_max: float, max_urange: float, weight: int = 1) -> None:
+    def integrate(
+        self,
+        laser_pose: ArrayLike,
+        ranges: ArrayLike,
+        angles: ArrayLike,
+        *,
+        range_min: float,
+        range_max: float,
+        max_urange: float,
+        weight: int = 1,
+    ) -> None:
         """Trace one scan from ``laser_pose`` (map frame, ``[3]``) into the counts (see the module).
 
         ``weight`` -1 removes a scan integrated before from the same pose (counts are exact integers).
         """
-        self.integrate_many(np.asarray(laser_pose, dtype=np.float64).reshape(1, 3),
-                            np.asarray(ranges, dtype=np.float64).reshape(1, -1), angles, np.array([int(weight)]),
-                            range_min=range_min, range_max=range_max, max_urange=max_urange)
+        self.integrate_many(
+            np.asarray(laser_pose, dtype=np.float64).reshape(1, 3),
+            np.asarray(ranges, dtype=np.float64).reshape(1, -1),
+            angles,
+            np.array([int(weight)]),
+            range_min=range_min,
+            range_max=range_max,
+            max_urange=max_urange,
+        )
 
-    def integrate_many(self, laser_poses: ArrayLike, ranges: ArrayLike, angles: ArrayLike, weights: ArrayLike, *,
-                       range_min: float, range_max: float, max_urange: float) -> None:
+    def integrate_many(
+        self,
+        laser_poses: ArrayLike,
+        ranges: ArrayLike,
+        angles: ArrayLike,
+        weights: ArrayLike,
+        *,
+        range_min: float,
+        range_max: float,
+        max_urange: float,
+    ) -> None:
         """Trace ``M`` scans, scan ``m`` from ``laser_poses[m]`` (map frame, ``[M, 3]``) with ranges
         ``ranges[m]`` (``[M, B]``, m) counted ``weights[m]`` times (int ``[M]``; -1 removes it): the same
         counts and window as :meth:`integrate` called for each scan in turn, in one compiled call."""
         poses = np.asarray(laser_poses, dtype=np.float64).reshape(-1, 3)
         if poses.shape[0] == 0:
             return
-        x, y, usable, hit = scan_endpoints(poses, ranges, angles, range_min=range_min, range_max=range_max,
-                                           max_urange=max_urange)
+        x, y, usable, hit = scan_endpoints(
+            poses, ranges, angles, range_min=range_min, range_max=range_max, max_urange=max_urange
+        )
         scale = 1.0 / self.resolution
         eu, ev = x * scale, y * scale
         ou, ov = poses[:, 0] * scale, poses[:, 1] * scale
@@ -271,11 +314,23 @@ class GridMap:
         rows = np.hstack([origin_r, np.where(usable, np.floor(ev), origin_r)])
         boxes = np.column_stack([cols.min(axis=1), cols.max(axis=1), rows.min(axis=1), rows.max(axis=1)])
         self._grow_for(boxes.astype(np.int64).tolist())
-        _integrate_scans(self.hits, self.visits, self.col0, self.row0, ou, ov, eu, ev, usable, hit,
-                         np.asarray(weights, dtype=np.int64).reshape(-1))
+        _integrate_scans(
+            self.hits,
+            self.visits,
+            self.col0,
+            self.row0,
+            ou,
+            ov,
+            eu,
+            ev,
+            usable,
+            hit,
+            np.asarray(weights, dtype=np.int64).reshape(-1),
+        )
 
-    def integrate_frame(self, base_pose: ArrayLike, ranges: ArrayLike, laser: LaserGeometry, *,
-                        max_urange: float | None = None) -> None:
+    def integrate_frame(
+        self, base_pose: ArrayLike, ranges: ArrayLike, laser: LaserGeometry, *, max_urange: float | None = None
+    ) -> None:
         """Trace a scan taken with the robot base at ``base_pose`` (map frame) by a laser of geometry ``laser``.
 
         ``max_urange`` defaults to the laser's ``range_max``.
@@ -283,8 +338,14 @@ class GridMap:
         r = np.asarray(ranges)
         laser_pose = compose1(np.asarray(base_pose, dtype=np.float64), np.asarray(laser.mount, dtype=np.float64))
         range_max = laser.range_max
-        self.integrate(laser_pose, r, laser.beam_angles(r.shape[0]), range_min=laser.range_min,
-                       range_max=range_max, max_urange=range_max if max_urange is None else min(float(max_urange), range_max))
+        self.integrate(
+            laser_pose,
+            r,
+            laser.beam_angles(r.shape[0]),
+            range_min=laser.range_min,
+            range_max=range_max,
+            max_urange=range_max if max_urange is None else min(float(max_urange), range_max),
+        )
 
     def occupancy(self, occ_thresh: float = 0.25) -> OccupancyGrid:
         """The trinary map (:func:`classify`), flipped to row 0 at the top, with the window's origin."""

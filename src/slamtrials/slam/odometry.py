@@ -51,7 +51,9 @@ class OdometryConfig(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
     resolution: float = Field(0.05, gt=0.0, le=10.0, description="map cell size (m)")
-    max_urange: float | None = Field(None, gt=0.0, le=1000.0, description="usable range (m); None: the laser's range_max")
+    max_urange: float | None = Field(
+        None, gt=0.0, le=1000.0, description="usable range (m); None: the laser's range_max"
+    )
     occ_thresh: float = Field(0.25, ge=0.0, lt=1.0, description="occupied when hits/visits exceeds this")
     linear_update: float = Field(0.0, ge=0.0, le=1000.0, description="map after this much travel (m)")
     angular_update: float = Field(0.0, ge=0.0, le=2.0 * math.pi, description="map after this much turning (rad)")

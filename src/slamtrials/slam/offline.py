@@ -71,14 +71,22 @@ def estimate_per_frame(algorithm: str, trajectory: Trajectory, record: RunRecord
         The trajectory does not hold one pose per frame at the frames' times.
     """
     if len(trajectory) != len(record) or not np.array_equal(trajectory.t, record.t):
-        raise ConfigError(f"SLAM algorithm {algorithm!r} returned {len(trajectory)} poses for {len(record)} frames; "
-                          "trajectory() must hold one pose per processed frame")
+        raise ConfigError(
+            f"SLAM algorithm {algorithm!r} returned {len(trajectory)} poses for {len(record)} frames; "
+            "trajectory() must hold one pose per processed frame"
+        )
     return trajectory.poses
 
 
-def run_over_recording(record: RunRecord, algorithm: str, *, preset: str | None = None,
-                       overrides: dict[str, Any] | None = None, seed: int = 0,
-                       on_frame: Callable[[int, int], None] | None = None) -> SlamRun:
+def run_over_recording(
+    record: RunRecord,
+    algorithm: str,
+    *,
+    preset: str | None = None,
+    overrides: dict[str, Any] | None = None,
+    seed: int = 0,
+    on_frame: Callable[[int, int], None] | None = None,
+) -> SlamRun:
     """Process every frame of ``record`` with algorithm ``algorithm``.
 
     Parameters
@@ -109,12 +117,25 @@ def run_over_recording(record: RunRecord, algorithm: str, *, preset: str | None 
     total = len(record)
     timing = np.empty(total, dtype=np.float64)
     for k in range(total):
-        frame = Frame(t=float(record.t[k]), ranges=record.scans[k], odometry=record.odometry[k], truth=record.truth[k],
-                      stalled=bool(record.stalled[k]))
+        frame = Frame(
+            t=float(record.t[k]),
+            ranges=record.scans[k],
+            odometry=record.odometry[k],
+            truth=record.truth[k],
+            stalled=bool(record.stalled[k]),
+        )
         started = time.perf_counter()
         slam.process(frame)
         timing[k] = time.perf_counter() - started
         if on_frame is not None:
             on_frame(k, total)
-    return SlamRun(algorithm=algorithm, preset=preset, config=config, seed=seed, trajectory=slam.trajectory(),
-                   occupancy=slam.occupancy(), timing=timing, updates=int(slam.updates))
+    return SlamRun(
+        algorithm=algorithm,
+        preset=preset,
+        config=config,
+        seed=seed,
+        trajectory=slam.trajectory(),
+        occupancy=slam.occupancy(),
+        timing=timing,
+        updates=int(slam.updates),
+    )

@@ -11,5 +11,13 @@ from slamtrials.trial.coverage import mapped_fraction, observed_fraction
 from slamtrials.trial.run import TrialProgress, run_trial
 from slamtrials.trial.summary import TRIAL_FORMAT, TrialSummary
 
-__all__ = ["run_trial", "TrialConfig", "SlamSettings", "TrialProgress", "TrialSummary", "TRIAL_FORMAT", "mapped_fraction",
-           "observed_fraction"]
+__all__ = [
+    "run_trial",
+    "TrialConfig",
+    "SlamSettings",
+    "TrialProgress",
+    "TrialSummary",
+    "TRIAL_FORMAT",
+    "mapped_fraction",
+    "observed_fraction",
+]

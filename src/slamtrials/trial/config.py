@@ -21,6 +21,7 @@ __all__ = ["SlamSettings", "TrialConfig"]
 
 _MODEL_CONFIG = ConfigDict(extra="forbid", frozen=True)
 
+
 class SlamSettings(BaseModel):
     """Which SLAM algorithm runs online, and with which parameters.
 
@@ -69,17 +70,27 @@ class TrialConfig(BaseModel):
     slam: SlamSettings = Field(default_factory=SlamSettings)
     explore: ExploreConfig = Field(default_factory=ExploreConfig)
     termination: TerminationConfig = Field(default_factory=TerminationConfig)
-    coverage_stride: int = Field(5, ge=1, le=1000, description="frames between scans traced for the observed area, and between poses aligning the mapped area")
+    coverage_stride: int = Field(
+        5,
+        ge=1,
+        le=1000,
+        description="frames between scans traced for the observed area, and between poses aligning the mapped area",
+    )
 
     def robot_limits(self) -> RobotLimits:
         """The explorer's robot: footprint and limits from ``sim.robot``, control period ``sim.dt``."""
         robot = self.sim.robot
-        return RobotLimits(radius=robot.radius, max_linear_speed=robot.max_linear_speed,
-                           max_angular_speed=robot.max_angular_speed, max_linear_accel=robot.max_linear_accel,
-                           max_angular_accel=robot.max_angular_accel, control_period=self.sim.dt)
+        return RobotLimits(
+            radius=robot.radius,
+            max_linear_speed=robot.max_linear_speed,
+            max_angular_speed=robot.max_angular_speed,
+            max_linear_accel=robot.max_linear_accel,
+            max_angular_accel=robot.max_angular_accel,
+            control_period=self.sim.dt,
+        )
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> "TrialConfig":
+    def from_dict(cls, data: dict[str, Any]) -> TrialConfig:
         """Validate a plain dict (e.g. from YAML), including the SLAM parameters; one-line ConfigError."""
         try:
             config = cls.model_validate(data)

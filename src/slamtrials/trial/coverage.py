@@ -48,8 +48,13 @@ def _lookup(grid: OccupancyGrid, xy: NDArray[np.float64]) -> NDArray[np.int8]:
     return values
 
 
-def mapped_fraction(world: World, grid: OccupancyGrid, estimate0: NDArray[np.float64], truth0: NDArray[np.float64],
-                    reachable: NDArray[np.bool_] | None = None) -> float:
+def mapped_fraction(
+    world: World,
+    grid: OccupancyGrid,
+    estimate0: NDArray[np.float64],
+    truth0: NDArray[np.float64],
+    reachable: NDArray[np.bool_] | None = None,
+) -> float:
     """Fraction of the ``reachable`` world cells (bool ``[H, W]``, see :func:`reachable_cell_centres`)
     that the SLAM map ``grid`` knows.
 
@@ -63,8 +68,14 @@ def mapped_fraction(world: World, grid: OccupancyGrid, estimate0: NDArray[np.flo
     return float(np.mean(_lookup(grid, transform_points(map_from_world, centres)) != UNKNOWN))
 
 
-def local_mapped_fraction(world: World, grid: OccupancyGrid, estimate: NDArray[np.float64], truth: NDArray[np.float64],
-                          reachable: NDArray[np.bool_] | None = None, stride: int = 5) -> float:
+def local_mapped_fraction(
+    world: World,
+    grid: OccupancyGrid,
+    estimate: NDArray[np.float64],
+    truth: NDArray[np.float64],
+    reachable: NDArray[np.bool_] | None = None,
+    stride: int = 5,
+) -> float:
     """Fraction of the ``reachable`` world cells that the SLAM map ``grid`` knows, each cell carried into
     the map frame through the trajectory pose nearest to it.
 
@@ -73,8 +84,8 @@ def local_mapped_fraction(world: World, grid: OccupancyGrid, estimate: NDArray[n
     pose ``k``, the map-frame point is ``estimate[k] (+) (truth[k] (-) cell)``.
     """
     centres = reachable_cell_centres(world, reachable)
-    truth = np.asarray(truth, dtype=np.float64)[::max(int(stride), 1)]
-    estimate = np.asarray(estimate, dtype=np.float64)[::max(int(stride), 1)]
+    truth = np.asarray(truth, dtype=np.float64)[:: max(int(stride), 1)]
+    estimate = np.asarray(estimate, dtype=np.float64)[:: max(int(stride), 1)]
     if centres.shape[0] == 0 or grid.grid.size == 0 or truth.shape[0] == 0:
         return 0.0
     _, nearest = cKDTree(truth[:, :2]).query(centres)
@@ -83,8 +94,14 @@ def local_mapped_fraction(world: World, grid: OccupancyGrid, estimate: NDArray[n
     return float(np.mean(_lookup(grid, points) != UNKNOWN))
 
 
-def observed_fraction(world: World, truth: NDArray[np.float64], scans: NDArray[np.float32], laser: LaserGeometry,
-                      stride: int, reachable: NDArray[np.bool_] | None = None) -> float:
+def observed_fraction(
+    world: World,
+    truth: NDArray[np.float64],
+    scans: NDArray[np.float32],
+    laser: LaserGeometry,
+    stride: int,
+    reachable: NDArray[np.bool_] | None = None,
+) -> float:
     """Fraction of the ``reachable`` world cells the laser saw (scans traced at their true poses)."""
     centres = reachable_cell_centres(world, reachable)
     if centres.shape[0] == 0:
@@ -97,4 +114,4 @@ def observed_fraction(world: World, truth: NDArray[np.float64], scans: NDArray[n
 
 def known_free_area(grid: OccupancyGrid) -> float:
     """Free area (m^2) of a SLAM map."""
-    return float(np.count_nonzero(grid.grid == 0)) * grid.resolution ** 2
+    return float(np.count_nonzero(grid.grid == 0)) * grid.resolution**2

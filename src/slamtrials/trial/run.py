@@ -80,9 +80,14 @@ def _turning(truth: np.ndarray) -> float:
     return float(np.sum(np.abs(np.remainder(np.diff(truth[:, 2]) + np.pi, 2.0 * np.pi) - np.pi)))
 
 
-def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
-              on_progress: Callable[[TrialProgress], None] | None = None,
-              progress_period: float = 10.0) -> RunRecord:
+def run_trial(
+    world: World,
+    config: TrialConfig | None = None,
+    seed: int = 0,
+    *,
+    on_progress: Callable[[TrialProgress], None] | None = None,
+    progress_period: float = 10.0,
+) -> RunRecord:
     """Explore ``world`` once with online SLAM and return the run.
 
     Parameters
@@ -158,8 +163,10 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
     record = RunRecord.from_frames(frames, laser)
     trajectory = slam.trajectory()
     if len(trajectory) != len(record) or not np.array_equal(trajectory.t, record.t):
-        raise ConfigError(f"SLAM algorithm {config.slam.algorithm!r} returned {len(trajectory)} poses for "
-                          f"{len(record)} frames; trajectory() must hold one pose per processed frame")
+        raise ConfigError(
+            f"SLAM algorithm {config.slam.algorithm!r} returned {len(trajectory)} poses for "
+            f"{len(record)} frames; trajectory() must hold one pose per processed frame"
+        )
     record.estimate = trajectory.poses
     final_map: OccupancyGrid = slam.occupancy()
     record.map = final_map
@@ -168,10 +175,13 @@ def run_trial(world: World, config: TrialConfig | None = None, seed: int = 0, *,
     stats = explorer.stats
     summary = TrialSummary(
         termination_reason=reason,
-        mapped_fraction=local_mapped_fraction(world, final_map, record.estimate, record.truth, reachable,
-                                              config.coverage_stride),
+        mapped_fraction=local_mapped_fraction(
+            world, final_map, record.estimate, record.truth, reachable, config.coverage_stride
+        ),
         mapped_fraction_global=mapped_fraction(world, final_map, record.estimate[0], record.truth[0], reachable),
-        observed_fraction=observed_fraction(world, record.truth, record.scans, laser, config.coverage_stride, reachable),
+        observed_fraction=observed_fraction(
+            world, record.truth, record.scans, laser, config.coverage_stride, reachable
+        ),
         reachable_area_m2=reachable_area,
         mapped_fraction_connected=mapped_fraction(world, final_map, record.estimate[0], record.truth[0]),
         connected_free_area_m2=world.area_of(world.reachable_free()),

@@ -80,7 +80,7 @@ class TrialSummary:
         return doc
 
     @classmethod
-    def from_dict(cls, doc: dict[str, Any]) -> "TrialSummary":
+    def from_dict(cls, doc: dict[str, Any]) -> TrialSummary:
         """Read the JSON form; a field missing (a run.json of an older version) reads as NaN, 0 or empty."""
         values: dict[str, Any] = {}
         for item in fields(cls):
@@ -98,7 +98,7 @@ class TrialSummary:
         return cls(**values)
 
     @classmethod
-    def of(cls, record: RunRecord) -> "TrialSummary | None":
+    def of(cls, record: RunRecord) -> TrialSummary | None:
         """The summary a trial stored in ``record.metadata["trial"]``, or None for a record of no trial."""
         doc = record.metadata.get("trial")
         return cls.from_dict(doc) if isinstance(doc, dict) else None

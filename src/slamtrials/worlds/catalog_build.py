@@ -71,7 +71,9 @@ def describe(world: World) -> str:
     """One line about a generated world: kind, shape, rooms and doors."""
     meta = world.metadata
     kind = meta["kind"]
-    return f"{kind} ({KINDS[kind].description}); {meta['shape']} shape, {meta['rooms']} rooms, {len(meta['doors'])} doors"
+    return (
+        f"{kind} ({KINDS[kind].description}); {meta['shape']} shape, {meta['rooms']} rooms, {len(meta['doors'])} doors"
+    )
 
 
 def build_catalog(out_dir: str | Path, entries: tuple[CatalogEntry, ...] = CATALOG) -> list[dict]:
@@ -87,18 +89,20 @@ def build_catalog(out_dir: str | Path, entries: tuple[CatalogEntry, ...] = CATAL
         for suffix in (".yaml", ".png"):  # readable by everyone once installed
             (out_dir / f"{entry.name}{suffix}").chmod(0o644)
         width, height = world.size_m
-        records.append({
-            "name": entry.name,
-            "kind": entry.kind,
-            "shape": world.metadata["shape"],
-            "area_m2": float(entry.area),
-            "free_area_m2": round(world.free_area, 1),
-            "seed": entry.seed,
-            "width_m": round(width, 2),
-            "height_m": round(height, 2),
-            "rooms": world.metadata["rooms"],
-            "description": describe(world),
-        })
+        records.append(
+            {
+                "name": entry.name,
+                "kind": entry.kind,
+                "shape": world.metadata["shape"],
+                "area_m2": float(entry.area),
+                "free_area_m2": round(world.free_area, 1),
+                "seed": entry.seed,
+                "width_m": round(width, 2),
+                "height_m": round(height, 2),
+                "rooms": world.metadata["rooms"],
+                "description": describe(world),
+            }
+        )
     doc = {
         "generator_version": GENERATOR_VERSION,
         "resolution": RESOLUTION,

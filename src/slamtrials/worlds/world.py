@@ -56,15 +56,23 @@ class World:
     def __post_init__(self) -> None:
         occupied = np.asarray(self.occupied)
         if occupied.ndim != 2 or occupied.shape[0] < 2 or occupied.shape[1] < 2:
-            raise WorldError(f"world {self.name!r}: occupancy grid must be 2-D and at least 2x2, got shape {occupied.shape}")
+            raise WorldError(
+                f"world {self.name!r}: occupancy grid must be 2-D and at least 2x2, got shape {occupied.shape}"
+            )
         resolution = float(self.resolution)
         if not np.isfinite(resolution) or resolution <= 0:
-            raise WorldError(f"world {self.name!r}: resolution must be a positive number of metres per pixel, got {self.resolution!r}")
-        origin = np.array(self.origin, dtype=np.float64).reshape(-1)  # copies: the flags below must not touch the caller's arrays
+            raise WorldError(
+                f"world {self.name!r}: resolution must be a positive number of metres per pixel, got {self.resolution!r}"
+            )
+        origin = np.array(self.origin, dtype=np.float64).reshape(
+            -1
+        )  # copies: the flags below must not touch the caller's arrays
         if origin.shape == (2,):
             origin = np.append(origin, 0.0)
         if origin.shape != (3,) or not np.all(np.isfinite(origin)):
-            raise WorldError(f"world {self.name!r}: origin must be three finite numbers (x, y, theta), got {self.origin!r}")
+            raise WorldError(
+                f"world {self.name!r}: origin must be three finite numbers (x, y, theta), got {self.origin!r}"
+            )
         occupied = np.array(occupied, dtype=bool, order="C")
         occupied.setflags(write=False)
         origin.setflags(write=False)
@@ -75,7 +83,9 @@ class World:
             raise WorldError(f"world {self.name!r}: the floor plan has no free space")
         start = choose_start_pose(self) if self.start is None else np.array(self.start, dtype=np.float64).reshape(-1)
         if start.shape != (3,) or not np.all(np.isfinite(start)):
-            raise WorldError(f"world {self.name!r}: start pose must be three finite numbers (x, y, theta), got {self.start!r}")
+            raise WorldError(
+                f"world {self.name!r}: start pose must be three finite numbers (x, y, theta), got {self.start!r}"
+            )
         row, col = world_to_cell(self, start[:2])
         if not (0 <= row < self.height and 0 <= col < self.width) or occupied[row, col]:
             raise WorldError(f"world {self.name!r}: start pose ({start[0]:.2f}, {start[1]:.2f}) is not in free space")
@@ -160,7 +170,7 @@ class World:
         if not fits[row, col]:
             reach = int(np.ceil(radius / self.resolution))
             r0, c0 = max(row - reach, 0), max(col - reach, 0)
-            window = fits[r0:row + reach + 1, c0:col + reach + 1]
+            window = fits[r0 : row + reach + 1, c0 : col + reach + 1]
             candidates = np.argwhere(window)
             if candidates.size == 0:
                 return np.zeros_like(self.occupied)
@@ -180,9 +190,11 @@ class World:
         out[r0:r1, c0:c1] = (cells <= radius / self.resolution + 1e-9) & ~self.occupied[r0:r1, c0:c1]
         return out
 
-    def with_start(self, start: ArrayLike) -> "World":
+    def with_start(self, start: ArrayLike) -> World:
         """A copy of this world with another start pose."""
-        return World(self.occupied, self.resolution, self.origin, self.name, np.asarray(start, float), dict(self.metadata))
+        return World(
+            self.occupied, self.resolution, self.origin, self.name, np.asarray(start, float), dict(self.metadata)
+        )
 
     def __repr__(self) -> str:
         w, h = self.size_m

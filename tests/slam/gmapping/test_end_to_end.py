@@ -34,8 +34,10 @@ from slamtrials.worlds.world import world_to_cell
 def world_and_record():
     world = load_world("office_small_01")
     waypoints = tour_waypoints(world, num_goals=3)
-    config = SimConfig(odometry=OdometryConfig(bias_linear=0.03, bias_angular=0.05),
-                       laser=LaserConfig(mount=(0.1, 0.0, 0.0), range_noise_std=0.01))
+    config = SimConfig(
+        odometry=OdometryConfig(bias_linear=0.03, bias_angular=0.05),
+        laser=LaserConfig(mount=(0.1, 0.0, 0.0), range_noise_std=0.01),
+    )
     record = simulate_waypoints(world, waypoints, config, seed=3, max_time=150)
     assert record.metadata["outcome"] == "completed"
     return world, record
@@ -88,8 +90,13 @@ def test_final_map_lies_on_the_walls(world_and_record, gmapping_run):
     rows, cols = np.nonzero(grid.grid == 100)
     assert len(rows) > 500
     h = grid.grid.shape[0]
-    xy_map = np.column_stack([grid.origin[0] + (cols + 0.5) * grid.resolution,
-                              grid.origin[1] + (h - rows - 0.5) * grid.resolution, np.zeros(len(rows))])
+    xy_map = np.column_stack(
+        [
+            grid.origin[0] + (cols + 0.5) * grid.resolution,
+            grid.origin[1] + (h - rows - 0.5) * grid.resolution,
+            np.zeros(len(rows)),
+        ]
+    )
     # map frame -> world frame through the first pose: world = truth0 (+) (est0 (-) p)
     xy_world = compose(record.truth[0], ominus(trajectory.poses[0], xy_map))[:, :2]
     wr, wc = world_to_cell(world, xy_world)
@@ -100,8 +107,13 @@ def test_final_map_lies_on_the_walls(world_and_record, gmapping_run):
     assert on_wall.mean() >= 0.95  # observed 0.99
     # and free cells are mostly free space in the world
     frows, fcols = np.nonzero(grid.grid == 0)
-    fxy = np.column_stack([grid.origin[0] + (fcols + 0.5) * grid.resolution,
-                           grid.origin[1] + (h - frows - 0.5) * grid.resolution, np.zeros(len(frows))])
+    fxy = np.column_stack(
+        [
+            grid.origin[0] + (fcols + 0.5) * grid.resolution,
+            grid.origin[1] + (h - frows - 0.5) * grid.resolution,
+            np.zeros(len(frows)),
+        ]
+    )
     fr, fc = world_to_cell(world, compose(record.truth[0], ominus(trajectory.poses[0], fxy))[:, :2])
     ok = (fr >= 0) & (fr < world.height) & (fc >= 0) & (fc < world.width)
     assert np.mean(~world.occupied[fr[ok], fc[ok]]) > 0.97

@@ -19,8 +19,9 @@ def _many(a):
 
 
 def test_within_a_few_ulp_of_libm_over_the_series_range_and_equal_beyond():
-    a = np.concatenate([np.linspace(0.0, _EXP_SERIES_MAX, 200_001),
-                        np.random.default_rng(0).uniform(0.0, _EXP_SERIES_MAX, 100_000)])
+    a = np.concatenate(
+        [np.linspace(0.0, _EXP_SERIES_MAX, 200_001), np.random.default_rng(0).uniform(0.0, _EXP_SERIES_MAX, 100_000)]
+    )
     got = _many(a)
     want = np.exp(-a)
     assert np.max(np.abs(got - want) / want) < 8 * np.finfo(float).eps

@@ -22,8 +22,15 @@ from slamtrials.record import Frame, LaserGeometry
 from slamtrials.slam import make_algorithm
 
 BEAMS = 181
-LASER = LaserGeometry.from_dict({"angle_min": -math.pi / 2, "angle_increment": math.pi / (BEAMS - 1), "range_min": 0.02, "range_max": 10.0,
-         "mount": [0.0, 0.0, 0.0]})
+LASER = LaserGeometry.from_dict(
+    {
+        "angle_min": -math.pi / 2,
+        "angle_increment": math.pi / (BEAMS - 1),
+        "range_min": 0.02,
+        "range_max": 10.0,
+        "mount": [0.0, 0.0, 0.0],
+    }
+)
 HALF_X, HALF_Y = 4.0, 3.0
 
 
@@ -52,7 +59,9 @@ def run(odometry: np.ndarray, times: np.ndarray, *, laser: dict = LASER, seed: i
     return algorithm, processed
 
 
-def expected_updates(odometry: np.ndarray, times: np.ndarray, linear: float, angular: float, temporal: float) -> list[int]:
+def expected_updates(
+    odometry: np.ndarray, times: np.ndarray, linear: float, angular: float, temporal: float
+) -> list[int]:
     """The spec's rule, written out."""
     out = [0]
     moved = turned = 0.0
@@ -105,8 +114,9 @@ def test_first_reading_places_every_particle_on_the_first_odometry_pose_and_only
     start = np.array([0.5, -0.4, 0.3])
     algorithm = make_algorithm("gmapping", laser, overrides={"particles": 4})
     algorithm.reset(np.random.default_rng(0))
-    estimate = algorithm.process(Frame(t=0.0, ranges=box_scan(compose1(start, np.array(laser.mount)), laser),
-                                       odometry=start, truth=start))
+    estimate = algorithm.process(
+        Frame(t=0.0, ranges=box_scan(compose1(start, np.array(laser.mount)), laser), odometry=start, truth=start)
+    )
     np.testing.assert_allclose(estimate, start, atol=1e-12)
     np.testing.assert_allclose(algorithm.poses, np.tile(compose1(start, np.array(laser.mount)), (4, 1)), atol=1e-12)
     assert algorithm.updates == 1 and np.all(algorithm.log_weights == 0.0) and algorithm.resamplings == 0

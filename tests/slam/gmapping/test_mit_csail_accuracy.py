@@ -34,7 +34,9 @@ def test_gmapping_defaults_on_mit_csail_meet_the_published_accuracy(tmp_path):
     assert len(record) == 1988
     result = run_slam(record, "gmapping", seed=1, source=str(LOG))
     assert result.config["particles"] == 30
-    assert result.updates == 430  # the update rule depends on odometry only; the C++ original makes 430 (spec section 7)
+    assert (
+        result.updates == 430
+    )  # the update rule depends on odometry only; the C++ original makes 430 (spec section 7)
     written = write_slam_outputs(result, tmp_path)
     assert tmp_path / "trajectory.clf" in written
     evaluation = evaluate_files(tmp_path / "trajectory.clf", RELATIONS)

@@ -29,11 +29,13 @@ N = 200_000
 def spec_sigmas(dx: float, dy: float, dth: float) -> np.ndarray:
     """The spec's formulas, written out."""
     dx, dy, dth = abs(dx), abs(dy), abs(dth)
-    return np.array([
-        SRR * dx + STR * dth + 0.3 * SRR * dy,
-        SRR * dy + STR * dth + 0.3 * SRR * dx,
-        STT * dth + SRT * math.sqrt(dx * dx + dy * dy),
-    ])
+    return np.array(
+        [
+            SRR * dx + STR * dth + 0.3 * SRR * dy,
+            SRR * dy + STR * dth + 0.3 * SRR * dx,
+            STT * dth + SRT * math.sqrt(dx * dx + dy * dy),
+        ]
+    )
 
 
 def _start_poses(rng: np.random.Generator) -> np.ndarray:

@@ -16,13 +16,15 @@ import math
 import numpy as np
 import pytest
 
+from slamtrials.record import LaserGeometry
 from slamtrials.slam.gmapping.published import PublishedMap
 from slamtrials.slam.gridmap import GridMap
-from slamtrials.record import LaserGeometry
 
 RES = 0.05
 BEAMS = 181
-LASER = LaserGeometry.from_dict({"angle_min": -math.pi / 2, "angle_increment": math.pi / (BEAMS - 1), "range_min": 0.05, "range_max": 8.0})
+LASER = LaserGeometry.from_dict(
+    {"angle_min": -math.pi / 2, "angle_increment": math.pi / (BEAMS - 1), "range_min": 0.05, "range_max": 8.0}
+)
 MAX_URANGE = 5.0
 HALF_X, HALF_Y = 3.1, 2.2  # walls of the room (m)
 
@@ -47,8 +49,14 @@ def room_scan(pose: np.ndarray, rng: np.random.Generator) -> np.ndarray:
 def scratch(path: np.ndarray, scans: list[np.ndarray]) -> GridMap:
     grid = GridMap(RES)
     for pose, ranges in zip(path, scans):
-        grid.integrate(pose, ranges, LASER.beam_angles(ranges.shape[0]), range_min=LASER.range_min,
-                       range_max=LASER.range_max, max_urange=MAX_URANGE)
+        grid.integrate(
+            pose,
+            ranges,
+            LASER.beam_angles(ranges.shape[0]),
+            range_min=LASER.range_min,
+            range_max=LASER.range_max,
+            max_urange=MAX_URANGE,
+        )
     return grid
 
 
@@ -61,7 +69,7 @@ def aligned(a: GridMap, b: GridMap) -> tuple[np.ndarray, ...]:
     for g in (a, b):
         for counts in (g.hits, g.visits):
             big = np.zeros((r1 - r0, c1 - c0), dtype=np.int64)
-            big[g.row0 - r0:g.row0 - r0 + counts.shape[0], g.col0 - c0:g.col0 - c0 + counts.shape[1]] = counts
+            big[g.row0 - r0 : g.row0 - r0 + counts.shape[0], g.col0 - c0 : g.col0 - c0 + counts.shape[1]] = counts
             out.append(big)
     return tuple(out)
 
@@ -83,8 +91,8 @@ def assert_same_grid(published: PublishedMap, path: np.ndarray, scans: list[np.n
     cb, rb = round(theirs.origin[0] / RES), round(theirs.origin[1] / RES)
     c0, r0 = max(ca, cb), max(ra, rb)
     c1, r1 = min(ca + wa, cb + wb), min(ra + ha, rb + hb)
-    overlap_a = a[r0 - ra:r1 - ra, c0 - ca:c1 - ca]
-    overlap_b = b[r0 - rb:r1 - rb, c0 - cb:c1 - cb]
+    overlap_a = a[r0 - ra : r1 - ra, c0 - ca : c1 - ca]
+    overlap_b = b[r0 - rb : r1 - rb, c0 - cb : c1 - cb]
     np.testing.assert_array_equal(overlap_a, overlap_b)
     # outside the overlap both grids are unknown
     assert (a != -1).sum() == (overlap_a != -1).sum() and (b != -1).sum() == (overlap_b != -1).sum()

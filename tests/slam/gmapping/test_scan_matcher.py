@@ -23,8 +23,7 @@ import math
 import numpy as np
 import pytest
 
-from slamtrials.slam.gmapping.kernels import (TILE, likelihood_3x3, match_particles, score_3x3, score_pose,
-                                              score_scratch)
+from slamtrials.slam.gmapping.kernels import TILE, likelihood_3x3, match_particles, score_3x3, score_pose, score_scratch
 from slamtrials.slam.gmapping.tilemap import TileMaps
 
 RES = 0.05
@@ -86,8 +85,25 @@ def room_map():
 
 
 def _score(maps: TileMaps, pose, lx, ly, lfx, lfy, *, kernel=1, sigma=0.05, lsigma=0.075, free=False):
-    return score_pose(maps.directories[0], maps.mean.reshape(-1), maps.tile_col0, maps.tile_row0, maps.resolution,
-                      float(pose[0]), float(pose[1]), float(pose[2]), lx, ly, lfx, lfy, kernel, sigma, lsigma, free, True)
+    return score_pose(
+        maps.directories[0],
+        maps.mean.reshape(-1),
+        maps.tile_col0,
+        maps.tile_row0,
+        maps.resolution,
+        float(pose[0]),
+        float(pose[1]),
+        float(pose[2]),
+        lx,
+        ly,
+        lfx,
+        lfy,
+        kernel,
+        sigma,
+        lsigma,
+        free,
+        True,
+    )
 
 
 def test_hill_climbing_recovers_a_known_offset(room_map):
@@ -99,8 +115,25 @@ def test_hill_climbing_recovers_a_known_offset(room_map):
     start = TRUE_POSE + np.array([0.08, -0.05, 0.03])
     m = room_map
     matched, scores, likelihoods = match_particles(
-        m.directories, m.mean.reshape(-1), m.tile_col0, m.tile_row0, RES, start[None, :].copy(), lx, ly, lfx, lfy,
-        1, 0.05, 0.075, False, 0.05, 0.05, 5, 0.0)
+        m.directories,
+        m.mean.reshape(-1),
+        m.tile_col0,
+        m.tile_row0,
+        RES,
+        start[None, :].copy(),
+        lx,
+        ly,
+        lfx,
+        lfy,
+        1,
+        0.05,
+        0.075,
+        False,
+        0.05,
+        0.05,
+        5,
+        0.0,
+    )
     error = matched[0] - TRUE_POSE
     assert math.hypot(error[0], error[1]) < 0.01
     assert abs(error[2]) < 0.005
@@ -123,8 +156,25 @@ def test_minimum_score_keeps_the_motion_sample(room_map):
     start = TRUE_POSE + np.array([0.08, -0.05, 0.03])
     m = room_map
     matched, scores, likelihoods = match_particles(
-        m.directories, m.mean.reshape(-1), m.tile_col0, m.tile_row0, RES, start[None, :].copy(), lx, ly, lfx, lfy,
-        1, 0.05, 0.075, False, 0.05, 0.05, 5, 1.0e6)
+        m.directories,
+        m.mean.reshape(-1),
+        m.tile_col0,
+        m.tile_row0,
+        RES,
+        start[None, :].copy(),
+        lx,
+        ly,
+        lfx,
+        lfy,
+        1,
+        0.05,
+        0.075,
+        False,
+        0.05,
+        0.05,
+        5,
+        1.0e6,
+    )
     np.testing.assert_array_equal(matched[0], start)
     assert scores[0] > 300  # a good match was found, but below the (huge) minimum score
     assert likelihoods[0] == pytest.approx(_score(m, start, lx, ly, lfx, lfy)[1], rel=1e-12)
@@ -133,6 +183,7 @@ def test_minimum_score_keeps_the_motion_sample(room_map):
 def _reference_climb(maps: TileMaps, start, lx, ly, lfx, lfy, lstep=0.05, astep=0.05, iterations=5):
     """GMapping's ScanMatcher::optimize as the spec gives it, with no shortcut: every iteration scores
     all six moves."""
+
     def score(p):
         return _score(maps, p, lx, ly, lfx, lfy)[0]
 
@@ -166,8 +217,25 @@ def test_hill_climbing_equals_the_plain_climb_bit_for_bit(room_map):
     m = room_map
     directories = np.repeat(m.directories, len(starts), axis=0)
     matched, scores, likelihoods = match_particles(
-        directories, m.mean.reshape(-1), m.tile_col0, m.tile_row0, RES, starts.copy(), lx, ly, lfx, lfy,
-        1, 0.05, 0.075, False, 0.05, 0.05, 5, 0.0)
+        directories,
+        m.mean.reshape(-1),
+        m.tile_col0,
+        m.tile_row0,
+        RES,
+        starts.copy(),
+        lx,
+        ly,
+        lfx,
+        lfy,
+        1,
+        0.05,
+        0.075,
+        False,
+        0.05,
+        0.05,
+        5,
+        0.0,
+    )
     for k, start in enumerate(starts):
         pose, score = _reference_climb(m, start, lx, ly, lfx, lfy)
         assert scores[k] == score
@@ -261,8 +329,12 @@ def test_windows_beyond_the_directory_and_on_its_edge_equal_the_naive_reference(
     targets = []
     for t in np.linspace(0.05, 0.95, 25):
         for dx in (-0.02, -0.001, 0.001, 0.02, 3.0):
-            targets += [(col1 + dx, row0 + t * (row1 - row0)), (col0 - dx, row0 + t * (row1 - row0)),
-                        (col0 + t * (col1 - col0), row1 + dx), (col0 + t * (col1 - col0), row0 - dx)]
+            targets += [
+                (col1 + dx, row0 + t * (row1 - row0)),
+                (col0 - dx, row0 + t * (row1 - row0)),
+                (col0 + t * (col1 - col0), row1 + dx),
+                (col0 + t * (col1 - col0), row0 - dx),
+            ]
     targets = np.array(targets + [tuple(p) for p in points[:100] + 0.01])
     lx, ly = targets[:, 0].copy(), targets[:, 1].copy()
     lfx, lfy = free_points(lx, ly)
@@ -283,20 +355,42 @@ def test_the_staged_default_window_score_is_score_pose_bit_for_bit():
     points = np.vstack([points, points[:400] + rng.normal(0.0, 0.01, size=(400, 2))])
     maps = TileMaps(1, RES)
     maps.register(points[None, :, 0], points[None, :, 1])
-    targets = np.vstack([points[rng.choice(len(points), 300)] + rng.normal(0.0, 0.03, size=(300, 2)),
-                         rng.uniform(-6.0, 6.0, size=(200, 2))])  # many beyond the directory
+    targets = np.vstack(
+        [
+            points[rng.choice(len(points), 300)] + rng.normal(0.0, 0.03, size=(300, 2)),
+            rng.uniform(-6.0, 6.0, size=(200, 2)),
+        ]
+    )  # many beyond the directory
     lx, ly = targets[:, 0].copy(), targets[:, 1].copy()
     floats, ints = score_scratch(len(lx))
     directory, mean = maps.directories[0], maps.mean.reshape(-1)
     found = 0
     for _ in range(40):
         x, y, theta = rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), rng.uniform(-0.5, 0.5)
-        want, want_likelihood = score_pose(directory, mean, maps.tile_col0, maps.tile_row0, RES, x, y, theta, lx,
-                                           ly, lx, ly, 1, 0.05, 0.075, False, True)
+        want, want_likelihood = score_pose(
+            directory,
+            mean,
+            maps.tile_col0,
+            maps.tile_row0,
+            RES,
+            x,
+            y,
+            theta,
+            lx,
+            ly,
+            lx,
+            ly,
+            1,
+            0.05,
+            0.075,
+            False,
+            True,
+        )
         got = score_3x3(directory, mean, maps.tile_col0, maps.tile_row0, RES, x, y, theta, lx, ly, 0.05, floats, ints)
         assert got == want
-        got_likelihood = likelihood_3x3(directory, mean, maps.tile_col0, maps.tile_row0, RES, x, y, theta, lx, ly,
-                                        0.075, floats, ints)
+        got_likelihood = likelihood_3x3(
+            directory, mean, maps.tile_col0, maps.tile_row0, RES, x, y, theta, lx, ly, 0.075, floats, ints
+        )
         assert got_likelihood == want_likelihood and got_likelihood < 0.0
         found += want > 1.0
     assert found == 40  # beams found cells at every pose: the comparison is not between two zeros

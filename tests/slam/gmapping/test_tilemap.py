@@ -41,8 +41,11 @@ def dense(maps: TileMaps, p: int) -> dict[tuple[int, int], tuple[int, float, flo
         for i, j in zip(*np.nonzero(maps.count[tile])):
             gc = (maps.tile_col0 + int(tc)) * TILE + int(j)
             gr = (maps.tile_row0 + int(tr)) * TILE + int(i)
-            out[(gc, gr)] = (int(maps.count[tile, i, j]), gc * RES + float(maps.mean[tile, i, j, 0]),
-                             gr * RES + float(maps.mean[tile, i, j, 1]))
+            out[(gc, gr)] = (
+                int(maps.count[tile, i, j]),
+                gc * RES + float(maps.mean[tile, i, j, 0]),
+                gr * RES + float(maps.mean[tile, i, j, 1]),
+            )
     return out
 
 
@@ -116,7 +119,7 @@ def test_dense_clustered_scans_with_a_one_tile_pool():
     n = 6
     maps = TileMaps(n, RES, initial_tiles=1)
     reference: list[list[tuple[float, float]]] = [[] for _ in range(n)]
-    for step in range(6):
+    for _ in range(6):
         base = rng.uniform(-4, 4, size=(1, 150, 2))
         points = base + rng.normal(0, 0.02, size=(n, 150, 2))  # nearby but different per particle
         _register(maps, reference, points)
@@ -187,10 +190,10 @@ def test_the_empty_tile_is_never_handed_out_or_written():
     resamplings (which release unheld tiles) must never give it out or write into it."""
     rng = np.random.default_rng(5)
     maps = TileMaps(3, RES, initial_tiles=4)
-    for step in range(6):
+    for _ in range(6):
         pts = rng.uniform(-4.0, 4.0, size=(3, 40, 2))
         maps.register(pts[:, :, 0], pts[:, :, 1])
         maps.resample(rng.integers(0, 3, size=3))
         assert not (maps.directories == EMPTY_TILE).any()
         assert (maps.count[EMPTY_TILE] == 0).all() and (maps.mean[EMPTY_TILE] == EMPTY).all()
-        assert EMPTY_TILE not in maps.free_stack[:int(maps.state[0])]
+        assert EMPTY_TILE not in maps.free_stack[: int(maps.state[0])]

@@ -57,8 +57,12 @@ def test_random_windows_equal_the_scalar_loop_exactly():
 
 
 @settings(max_examples=300, deadline=None)
-@given(st.lists(st.floats(0.0, float(np.float32(0.05)), width=32) | st.just(float(EMPTY)), min_size=70, max_size=70),
-       st.floats(-0.2, 0.2), st.floats(-0.2, 0.2), st.sampled_from([0.01, 0.05, 0.1]))
+@given(
+    st.lists(st.floats(0.0, float(np.float32(0.05)), width=32) | st.just(float(EMPTY)), min_size=70, max_size=70),
+    st.floats(-0.2, 0.2),
+    st.floats(-0.2, 0.2),
+    st.sampled_from([0.01, 0.05, 0.1]),
+)
 def test_any_window_equals_the_scalar_loop(values, ox, oy, res):
     """Any cell contents (including ties and empty cells) and endpoint offsets: identical results."""
     mean = np.array(values, dtype=np.float32)

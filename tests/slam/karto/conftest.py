@@ -22,9 +22,20 @@ def square_loop_segments() -> np.ndarray:
     corridor around it), with notches on the walls (none on the centre line the robot drives) so that no
     stretch of corridor looks like another."""
     walls = _box(-7, -7, 7, 7) + _box(-5, -5, 5, 5)
-    features = [(-7.0, -3.0, -6.5, -2.4), (6.5, 1.0, 7.0, 1.8), (-2.0, 6.5, -1.2, 7.0), (2.5, -7.0, 3.3, -6.5),
-                (-5.4, 2.0, -5.0, 2.8), (5.0, -3.5, 5.4, -2.5), (0.5, 5.0, 1.1, 5.4), (-3.6, -5.4, -2.6, -5.0),
-                (-7.0, 4.5, -6.6, 4.8), (6.6, 5.0, 7.0, 5.6), (6.6, -6.0, 7.0, -5.4), (-5.6, -7.0, -5.0, -6.6)]
+    features = [
+        (-7.0, -3.0, -6.5, -2.4),
+        (6.5, 1.0, 7.0, 1.8),
+        (-2.0, 6.5, -1.2, 7.0),
+        (2.5, -7.0, 3.3, -6.5),
+        (-5.4, 2.0, -5.0, 2.8),
+        (5.0, -3.5, 5.4, -2.5),
+        (0.5, 5.0, 1.1, 5.4),
+        (-3.6, -5.4, -2.6, -5.0),
+        (-7.0, 4.5, -6.6, 4.8),
+        (6.6, 5.0, 7.0, 5.6),
+        (6.6, -6.0, 7.0, -5.4),
+        (-5.6, -7.0, -5.0, -6.6),
+    ]
     for box in features:
         walls += _box(*box)
     return np.array(walls, dtype=np.float64)
@@ -92,10 +103,16 @@ def square_loop() -> SimpleNamespace:
     truth = square_path(laps=1.25)
     odometry = drifting_odometry(truth, turn_scale=1.03, travel_scale=1.02)
     angles = LASER.beam_angles(361)
-    frames = [Frame(t=0.25 * k, ranges=raycast(truth[k], angles, segments, LASER.range_max), odometry=odometry[k],
-                    truth=truth[k]) for k in range(truth.shape[0])]
-    return SimpleNamespace(laser=LASER, segments=segments, truth=truth, odometry=odometry, frames=frames,
-                           angles=angles)
+    frames = [
+        Frame(
+            t=0.25 * k,
+            ranges=raycast(truth[k], angles, segments, LASER.range_max),
+            odometry=odometry[k],
+            truth=truth[k],
+        )
+        for k in range(truth.shape[0])
+    ]
+    return SimpleNamespace(laser=LASER, segments=segments, truth=truth, odometry=odometry, frames=frames, angles=angles)
 
 
 @pytest.fixture(scope="session")

@@ -88,8 +88,9 @@ def test_cli_bad_parameters_and_a_log_without_scans_exit_2_with_one_line(tmp_pat
     log = tmp_path / "odometry_only.clf"
     log.write_text("ODOM 0.0 0.0 0.0 0 0 0 1.0 host 1.0\nODOM 0.1 0.0 0.0 0 0 0 1.2 host 1.2\n")
     for extra in (["--set", "nope=1"], ["--set", "minimum_travel_distance=-1"], []):
-        result = runner.invoke(app, ["slam", "--algorithm", "karto", "--input", str(log), "--out", str(tmp_path / "o"),
-                                     *extra])
+        result = runner.invoke(
+            app, ["slam", "--algorithm", "karto", "--input", str(log), "--out", str(tmp_path / "o"), *extra]
+        )
         assert result.exit_code == 2, result.output
         assert len(result.output.strip().splitlines()) == 1 and "Traceback" not in result.output
     bad = runner.invoke(app, ["slam", "-a", "karto", "-i", str(log), "-o", str(tmp_path / "o"), "--set", "nope=1"])

@@ -33,7 +33,9 @@ def test_moving_nodes_gives_the_grid_of_a_rebuild(square_loop):
         for grid in (incremental.grid, fresh.grid):
             array = getattr(grid, counts)
             rows, cols = np.nonzero(array)
-            cells.append(sorted(zip((rows + grid.row0).tolist(), (cols + grid.col0).tolist(), array[rows, cols].tolist())))
+            cells.append(
+                sorted(zip((rows + grid.row0).tolist(), (cols + grid.col0).tolist(), array[rows, cols].tolist()))
+            )
         assert cells[0] == cells[1] and len(cells[0]) > 1000
     assert set(np.unique(a.grid)) <= {FREE, OCCUPIED, UNKNOWN} and (b.grid == OCCUPIED).any()
 

@@ -10,9 +10,16 @@ import pytest
 from slamtrials.slam.karto.correlation import find_valid_points, smear_kernel
 from slamtrials.slam.karto.scanmatch import MatcherSettings, ScanMatcher, points_in_map
 
-SETTINGS = MatcherSettings(coarse_search_angle_offset=0.349, coarse_angle_resolution=0.0349,
-                           fine_search_angle_offset=0.00349, distance_variance=0.25, angle_variance=1.0,
-                           minimum_distance_penalty=0.5, minimum_angle_penalty=0.9, use_response_expansion=True)
+SETTINGS = MatcherSettings(
+    coarse_search_angle_offset=0.349,
+    coarse_angle_resolution=0.0349,
+    fine_search_angle_offset=0.00349,
+    distance_variance=0.25,
+    angle_variance=1.0,
+    minimum_distance_penalty=0.5,
+    minimum_angle_penalty=0.9,
+    use_response_expansion=True,
+)
 
 
 def _local(ranges, angles, range_max):

@@ -91,12 +91,18 @@ class GMappingConfig(BaseModel):
     minimumScore: float = Field(0.0, ge=0.0, le=1.0e6, description="least score for taking the matched pose")
     resampleThreshold: float = Field(0.5, ge=0.0, le=1.0, description="resample when Neff < this x particles")
     delta: float = Field(0.05, ge=0.005, le=1.0, description="map resolution (m)")
-    maxUrange: float | None = Field(None, gt=0.0, le=1000.0, description="usable range (m); None: the laser's range_max")
-    maxRange: float | None = Field(None, gt=0.0, le=1000.0, description="beams beyond are ignored (m); None: the laser's range_max")
+    maxUrange: float | None = Field(
+        None, gt=0.0, le=1000.0, description="usable range (m); None: the laser's range_max"
+    )
+    maxRange: float | None = Field(
+        None, gt=0.0, le=1000.0, description="beams beyond are ignored (m); None: the laser's range_max"
+    )
     occ_thresh: float = Field(0.25, ge=0.0, lt=1.0, description="published map: occupied when hits/visits exceeds this")
     map_update_interval: float = Field(5.0, ge=0.0, le=1.0e6, description="seconds between published-map rebuilds")
     free_cell_test: bool = Field(False, description="do the likelihood's free-cell test (the original never rejects)")
-    initial_pose: tuple[float, float, float] | None = Field(None, description="pose of the first reading; None: first odometry pose")
+    initial_pose: tuple[float, float, float] | None = Field(
+        None, description="pose of the first reading; None: first odometry pose"
+    )
 
     @field_validator("initial_pose")
     @classmethod
@@ -106,7 +112,7 @@ class GMappingConfig(BaseModel):
         return value
 
     @model_validator(mode="after")
-    def _ranges_consistent(self) -> "GMappingConfig":
+    def _ranges_consistent(self) -> GMappingConfig:
         if self.maxUrange is not None and self.maxRange is not None and self.maxUrange > self.maxRange:
             raise ValueError(f"maxUrange ({self.maxUrange} m) must not exceed maxRange ({self.maxRange} m)")
         return self

@@ -112,8 +112,9 @@ class GMapping:
         self.log_weights = np.zeros(c.particles)
         self.weight_sums = np.zeros(c.particles)
         self.lineage = Lineage()
-        self.published = PublishedMap(c.delta, self.laser, max_urange=min(self.max_urange, self.range_max),
-                                      occ_thresh=c.occ_thresh)
+        self.published = PublishedMap(
+            c.delta, self.laser, max_urange=min(self.max_urange, self.range_max), occ_thresh=c.occ_thresh
+        )
         self._scans: list[NDArray[np.float32]] = []  # scans of processed readings, maxRange applied
         self._t: list[float] = []
         self._odometry: list[NDArray[np.float64]] = []  # base odometry of every reading
@@ -143,8 +144,13 @@ class GMapping:
         c = self.config
         angles = self._angles
         assert angles is not None
-        usable = ~np.isnan(ranges) & (ranges > self.range_min) & (ranges < self.range_max) \
-            & (ranges <= self.max_urange) & (ranges <= self.max_range)
+        usable = (
+            ~np.isnan(ranges)
+            & (ranges > self.range_min)
+            & (ranges < self.range_max)
+            & (ranges <= self.max_urange)
+            & (ranges <= self.max_range)
+        )
         matched = usable & (np.arange(ranges.shape[0]) % (c.lskip + 1) == c.lskip)
         r, a = ranges[usable], angles[usable]
         cos_a, sin_a = stablemath.cos(a), stablemath.sin(a)
@@ -170,14 +176,32 @@ class GMapping:
             return True
         return c.temporalUpdate >= 0 and t - self._last_update_t > c.temporalUpdate
 
-    def _update(self, lx: NDArray[np.float64], ly: NDArray[np.float64], lfx: NDArray[np.float64],
-                lfy: NDArray[np.float64]) -> None:
+    def _update(
+        self, lx: NDArray[np.float64], ly: NDArray[np.float64], lfx: NDArray[np.float64], lfy: NDArray[np.float64]
+    ) -> None:
         """Scan matching, weighing and (maybe) resampling of every particle (spec sections 3 and 4)."""
         c = self.config
         m = self.maps
         matched, _, likelihoods = match_particles(
-            m.directories, m.mean.reshape(-1), m.tile_col0, m.tile_row0, c.delta, self.poses, lx, ly, lfx, lfy,
-            c.kernelSize, c.sigma, c.lsigma, c.free_cell_test, c.lstep, c.astep, c.iterations, c.minimumScore)
+            m.directories,
+            m.mean.reshape(-1),
+            m.tile_col0,
+            m.tile_row0,
+            c.delta,
+            self.poses,
+            lx,
+            ly,
+            lfx,
+            lfy,
+            c.kernelSize,
+            c.sigma,
+            c.lsigma,
+            c.free_cell_test,
+            c.lstep,
+            c.astep,
+            c.iterations,
+            c.minimumScore,
+        )
         self.poses = matched
         self.log_weights += likelihoods
         self.weight_sums += likelihoods
@@ -208,8 +232,7 @@ class GMapping:
             start = laser_odometry if c.initial_pose is None else compose1(np.asarray(c.initial_pose), self.mount)
             self.poses[:] = start
         else:
-            self.poses = sample_motion(self.poses, previous, laser_odometry, c.srr, c.srt, c.str, c.stt,
-                                       self.rng)
+            self.poses = sample_motion(self.poses, previous, laser_odometry, c.srr, c.srt, c.str, c.stt, self.rng)
         due = self._due(t, laser_odometry)
         self._last_laser_odometry = laser_odometry
         if due:

@@ -22,8 +22,16 @@ from numba import njit
 
 from slamtrials.slam.gmapping.window import NOTHING_D2, window_min_3x3
 
-__all__ = ["TILE_SHIFT", "TILE", "score_pose", "score_3x3", "likelihood_3x3", "score_scratch", "match_particles",
-           "register_endpoints"]
+__all__ = [
+    "TILE_SHIFT",
+    "TILE",
+    "score_pose",
+    "score_3x3",
+    "likelihood_3x3",
+    "score_scratch",
+    "match_particles",
+    "register_endpoints",
+]
 
 # 32-cell tiles: a 3 x 3 window crosses a tile border for 12 % of beams (23 % with 16-cell tiles),
 # which takes the slower scalar path; the price is about twice the particle-map memory (bench/RESULTS.md)
@@ -100,8 +108,25 @@ def _exp_minus(a):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def score_pose(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, lfx, lfy, kernel, sigma, lsigma,
-               free_test, with_likelihood):  # pragma: no cover - compiled
+def score_pose(
+    directory,
+    mean,
+    tile_col0,
+    tile_row0,
+    res,
+    x,
+    y,
+    theta,
+    lx,
+    ly,
+    lfx,
+    lfy,
+    kernel,
+    sigma,
+    lsigma,
+    free_test,
+    with_likelihood,
+):  # pragma: no cover - compiled
     """Score (and log-likelihood) of a scan from laser pose (x, y, theta) in one particle's map.
 
     Parameters
@@ -189,8 +214,9 @@ def score_pose(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, 
                         continue
                     if free_test:
                         free_tile = _tile_or_empty(directory, rows, cols, fdrow + dr, fdcol + dc)
-                        f = np.uint64(free_tile * tile_stride + ((fdrow + dr) & _MASK) * row_stride
-                                      + ((fdcol + dc) & _MASK) * 2)
+                        f = np.uint64(
+                            free_tile * tile_stride + ((fdrow + dr) & _MASK) * row_stride + ((fdcol + dc) & _MASK) * 2
+                        )
                         if mean[f] < EMPTY:
                             continue
                     ux = ox - dc * res - mx
@@ -213,8 +239,9 @@ def score_scratch(beams):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _window_minima_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, floats, ints,
-                       row):  # pragma: no cover - compiled
+def _window_minima_3x3(
+    directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, floats, ints, row
+):  # pragma: no cover - compiled
     """Stages 1 and 2 of :func:`score_3x3`: each beam's smallest squared distance to a mean in its 3 x 3
     window goes to ``floats[row]`` (:data:`NOTHING_D2` if none; ``row`` >= 2); ``floats[0]`` is left
     free for reuse."""
@@ -259,13 +286,15 @@ def _window_minima_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, 
         best[b] = window_min_3x3(mean, first[b], row_stride, offset_x[b], offset_y[b], res)
     for i in range(crossings):
         b = crossing[i]
-        best[b] = _window_min_across_tiles(directory, mean, rows, cols, crossing_row[i], crossing_col[i],
-                                           offset_x[b], offset_y[b], res)
+        best[b] = _window_min_across_tiles(
+            directory, mean, rows, cols, crossing_row[i], crossing_col[i], offset_x[b], offset_y[b], res
+        )
 
 
 @njit(cache=True, nogil=True, fastmath={"nnan", "ninf", "nsz"})
-def score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats, ints,
-              row=2):  # pragma: no cover - compiled
+def score_3x3(
+    directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats, ints, row=2
+):  # pragma: no cover - compiled
     """The score of :func:`score_pose` for its default window (``kernel`` 1, no free-cell test), bit for
     bit, in stages that keep each loop short: the hill climbing's hot spot.
 
@@ -299,8 +328,9 @@ def score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, s
 
 
 @njit(cache=True, nogil=True, fastmath={"nnan", "ninf", "nsz"})
-def likelihood_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, lsigma, floats,
-                   ints):  # pragma: no cover - compiled
+def likelihood_3x3(
+    directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, lsigma, floats, ints
+):  # pragma: no cover - compiled
     """The log-likelihood of :func:`score_pose` for its default window (``kernel`` 1, no free-cell
     test), bit for bit: the window minima of :func:`score_3x3`, then the sum in beam order."""
     _window_minima_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, floats, ints, 2)
@@ -321,14 +351,50 @@ def _likelihood_of(best, lsigma):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _match_score(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, lfx, lfy, kernel, sigma, lsigma,
-                 free_test, floats, ints, row):  # pragma: no cover - compiled
+def _match_score(
+    directory,
+    mean,
+    tile_col0,
+    tile_row0,
+    res,
+    x,
+    y,
+    theta,
+    lx,
+    ly,
+    lfx,
+    lfy,
+    kernel,
+    sigma,
+    lsigma,
+    free_test,
+    floats,
+    ints,
+    row,
+):  # pragma: no cover - compiled
     """The scan-matching score at one pose: :func:`score_3x3` for the default window (window minima left
     in ``floats[row]``), else :func:`score_pose`."""
     if kernel == 1 and not free_test:
         return score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats, ints, row)
-    score, _ = score_pose(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, lfx, lfy, kernel, sigma,
-                          lsigma, free_test, False)
+    score, _ = score_pose(
+        directory,
+        mean,
+        tile_col0,
+        tile_row0,
+        res,
+        x,
+        y,
+        theta,
+        lx,
+        ly,
+        lfx,
+        lfy,
+        kernel,
+        sigma,
+        lsigma,
+        free_test,
+        False,
+    )
     return score
 
 
@@ -347,8 +413,28 @@ def _seen_before(seen, count, x, y, theta):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _hill_climb(directory, mean, tile_col0, tile_row0, res, pose, lx, ly, lfx, lfy, kernel, sigma, lsigma, free_test,
-                lstep, astep, iterations, floats, ints, seen):  # pragma: no cover - compiled
+def _hill_climb(
+    directory,
+    mean,
+    tile_col0,
+    tile_row0,
+    res,
+    pose,
+    lx,
+    ly,
+    lfx,
+    lfy,
+    kernel,
+    sigma,
+    lsigma,
+    free_test,
+    lstep,
+    astep,
+    iterations,
+    floats,
+    ints,
+    seen,
+):  # pragma: no cover - compiled
     """GMapping's hill climbing from ``pose`` (spec/gmapping.md, section 3); returns (x, y, theta, score,
     row): with the default window, ``floats[row]`` holds the window minima at the returned pose (for its
     likelihood). ``floats``, ``ints``: work arrays from :func:`score_scratch`; ``seen``: float64
@@ -369,8 +455,27 @@ def _hill_climb(directory, mean, tile_col0, tile_row0, res, pose, lx, ly, lfx, l
     n_seen = 1
     # rows of floats: the current pose's window minima, the best candidate's so far, the next candidate's
     at, kept, scratch = 2, 3, 4
-    current = _match_score(directory, mean, tile_col0, tile_row0, res, cx, cy, ct, lx, ly, lfx, lfy, kernel, sigma,
-                           lsigma, free_test, floats, ints, at)
+    current = _match_score(
+        directory,
+        mean,
+        tile_col0,
+        tile_row0,
+        res,
+        cx,
+        cy,
+        ct,
+        lx,
+        ly,
+        lfx,
+        lfy,
+        kernel,
+        sigma,
+        lsigma,
+        free_test,
+        floats,
+        ints,
+        at,
+    )
     ld = lstep
     ad = astep
     refinement = 0
@@ -406,8 +511,27 @@ def _hill_climb(directory, mean, tile_col0, tile_row0, res, pose, lx, ly, lfx, l
             if n_seen < seen.shape[0]:
                 seen[n_seen, 0], seen[n_seen, 1], seen[n_seen, 2] = px, py, pt
                 n_seen += 1
-            local = _match_score(directory, mean, tile_col0, tile_row0, res, px, py, pt, lx, ly, lfx, lfy, kernel,
-                                 sigma, lsigma, free_test, floats, ints, scratch)
+            local = _match_score(
+                directory,
+                mean,
+                tile_col0,
+                tile_row0,
+                res,
+                px,
+                py,
+                pt,
+                lx,
+                ly,
+                lfx,
+                lfy,
+                kernel,
+                sigma,
+                lsigma,
+                free_test,
+                floats,
+                ints,
+                scratch,
+            )
             if local > current:
                 current = local
                 bx, by, bt = px, py, pt
@@ -423,8 +547,26 @@ def _hill_climb(directory, mean, tile_col0, tile_row0, res, pose, lx, ly, lfx, l
 
 
 @njit(cache=True, nogil=True)
-def match_particles(directories, mean, tile_col0, tile_row0, res, poses, lx, ly, lfx, lfy, kernel, sigma, lsigma,
-                    free_test, lstep, astep, iterations, minimum_score):  # pragma: no cover - compiled
+def match_particles(
+    directories,
+    mean,
+    tile_col0,
+    tile_row0,
+    res,
+    poses,
+    lx,
+    ly,
+    lfx,
+    lfy,
+    kernel,
+    sigma,
+    lsigma,
+    free_test,
+    lstep,
+    astep,
+    iterations,
+    minimum_score,
+):  # pragma: no cover - compiled
     """Scan-match every particle and weigh it (spec/gmapping.md, section 3).
 
     Parameters
@@ -453,8 +595,28 @@ def match_particles(directories, mean, tile_col0, tile_row0, res, poses, lx, ly,
     seen = np.empty((_SEEN_CAPACITY, 3))
     for p in range(n):
         directory = directories[p]
-        x, y, t, best, row = _hill_climb(directory, mean, tile_col0, tile_row0, res, poses[p], lx, ly, lfx, lfy,
-                                         kernel, sigma, lsigma, free_test, lstep, astep, iterations, floats, ints, seen)
+        x, y, t, best, row = _hill_climb(
+            directory,
+            mean,
+            tile_col0,
+            tile_row0,
+            res,
+            poses[p],
+            lx,
+            ly,
+            lfx,
+            lfy,
+            kernel,
+            sigma,
+            lsigma,
+            free_test,
+            lstep,
+            astep,
+            iterations,
+            floats,
+            ints,
+            seen,
+        )
         scores[p] = best
         if best > minimum_score:
             matched[p, 0] = x
@@ -463,12 +625,41 @@ def match_particles(directories, mean, tile_col0, tile_row0, res, poses, lx, ly,
         if kernel == 1 and not free_test and best > minimum_score and matched[p, 2] == t:
             likelihoods[p] = _likelihood_of(floats[row], lsigma)  # the climb scored this very pose last
         elif kernel == 1 and not free_test:
-            likelihoods[p] = likelihood_3x3(directory, mean, tile_col0, tile_row0, res, matched[p, 0], matched[p, 1],
-                                            matched[p, 2], lx, ly, lsigma, floats, ints)
+            likelihoods[p] = likelihood_3x3(
+                directory,
+                mean,
+                tile_col0,
+                tile_row0,
+                res,
+                matched[p, 0],
+                matched[p, 1],
+                matched[p, 2],
+                lx,
+                ly,
+                lsigma,
+                floats,
+                ints,
+            )
         else:
-            _, likelihoods[p] = score_pose(directory, mean, tile_col0, tile_row0, res, matched[p, 0],
-                                           matched[p, 1], matched[p, 2], lx, ly, lfx, lfy, kernel, sigma, lsigma,
-                                           free_test, True)
+            _, likelihoods[p] = score_pose(
+                directory,
+                mean,
+                tile_col0,
+                tile_row0,
+                res,
+                matched[p, 0],
+                matched[p, 1],
+                matched[p, 2],
+                lx,
+                ly,
+                lfx,
+                lfy,
+                kernel,
+                sigma,
+                lsigma,
+                free_test,
+                True,
+            )
     return matched, scores, likelihoods
 
 
@@ -485,8 +676,9 @@ def _copy_tile(count, mean, source, target):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def register_endpoints(directories, count, mean, refs, free_stack, state, tile_col0, tile_row0, res, ex, ey,
-                       start):  # pragma: no cover - compiled
+def register_endpoints(
+    directories, count, mean, refs, free_stack, state, tile_col0, tile_row0, res, ex, ey, start
+):  # pragma: no cover - compiled
     """Add each particle's scan endpoints to its map, copying shared tiles before writing (copy-on-write).
 
     Parameters

@@ -13,21 +13,33 @@ from slamtrials.geometry import ominus1
 __all__ = ["motion_sigmas", "sample_motion"]
 
 
-def motion_sigmas(increment: NDArray[np.float64], srr: float, srt: float, str_: float, stt: float) -> NDArray[np.float64]:
+def motion_sigmas(
+    increment: NDArray[np.float64], srr: float, srt: float, str_: float, stt: float
+) -> NDArray[np.float64]:
     """Standard deviations (m, m, rad) of the noise added to an odometry increment ``(dx, dy, dth)``.
 
     ``increment`` is the motion in the previous odometry pose's frame, float64 ``[3]``.
     """
     dx, dy, dth = (abs(float(v)) for v in increment)
-    return np.array([
-        srr * dx + str_ * dth + 0.3 * srr * dy,
-        srr * dy + str_ * dth + 0.3 * srr * dx,
-        stt * dth + srt * math.hypot(dx, dy),
-    ])
+    return np.array(
+        [
+            srr * dx + str_ * dth + 0.3 * srr * dy,
+            srr * dy + str_ * dth + 0.3 * srr * dx,
+            stt * dth + srt * math.hypot(dx, dy),
+        ]
+    )
 
 
-def sample_motion(poses: NDArray[np.float64], odometry_old: NDArray[np.float64], odometry_new: NDArray[np.float64],
-                  srr: float, srt: float, str_: float, stt: float, rng: np.random.Generator) -> NDArray[np.float64]:
+def sample_motion(
+    poses: NDArray[np.float64],
+    odometry_old: NDArray[np.float64],
+    odometry_new: NDArray[np.float64],
+    srr: float,
+    srt: float,
+    str_: float,
+    stt: float,
+    rng: np.random.Generator,
+) -> NDArray[np.float64]:
     """Move every particle by its own noisy sample of the odometry increment.
 
     Parameters
@@ -48,8 +60,9 @@ def sample_motion(poses: NDArray[np.float64], odometry_old: NDArray[np.float64],
     """
     increment = ominus1(odometry_old, odometry_new)
     sigmas = motion_sigmas(increment, srr, srt, str_, stt)
-    return _moved(np.ascontiguousarray(poses, dtype=np.float64), increment, sigmas,
-                  rng.standard_normal((poses.shape[0], 3)))
+    return _moved(
+        np.ascontiguousarray(poses, dtype=np.float64), increment, sigmas, rng.standard_normal((poses.shape[0], 3))
+    )
 
 
 @njit(cache=True, nogil=True)

@@ -9,12 +9,11 @@ same grid a rebuild from scratch would give.
 
 from __future__ import annotations
 
-
 import numpy as np
 from numpy.typing import NDArray
 
-from slamtrials.slam.base import OccupancyGrid
 from slamtrials.record import LaserGeometry
+from slamtrials.slam.base import OccupancyGrid
 from slamtrials.slam.gridmap import GridMap
 
 __all__ = ["PublishedMap"]
@@ -52,10 +51,15 @@ class PublishedMap:
             end = start + 1
             while end < len(scans) and scans[end].shape == scans[start].shape:
                 end += 1
-            self.grid.integrate_many(np.array(poses[start:end]), np.stack(scans[start:end]),
-                                     self.laser.beam_angles(scans[start].shape[0]), np.array(weights[start:end]),
-                                     range_min=self.laser.range_min,
-                                     range_max=self.laser.range_max, max_urange=self.max_urange)
+            self.grid.integrate_many(
+                np.array(poses[start:end]),
+                np.stack(scans[start:end]),
+                self.laser.beam_angles(scans[start].shape[0]),
+                np.array(weights[start:end]),
+                range_min=self.laser.range_min,
+                range_max=self.laser.range_max,
+                max_urange=self.max_urange,
+            )
             start = end
 
     def rebuild(self, path: NDArray[np.float64], scans: list[NDArray[np.float32]]) -> int:
@@ -70,9 +74,11 @@ class PublishedMap:
         keep = int(differs[0]) if differs.size else common
         removed = range(len(old) - 1, keep - 1, -1)
         added = range(keep, len(path))
-        self._trace([old[u] for u in removed] + [path[u] for u in added],
-                    [self._scans[u] for u in removed] + [scans[u] for u in added],
-                    [-1] * len(removed) + [1] * len(added))
+        self._trace(
+            [old[u] for u in removed] + [path[u] for u in added],
+            [self._scans[u] for u in removed] + [scans[u] for u in added],
+            [-1] * len(removed) + [1] * len(added),
+        )
         self._path = np.array(path, dtype=np.float64)
         self._scans = scans
         self._occupancy = self.grid.occupancy(self.occ_thresh)
@@ -81,6 +87,7 @@ class PublishedMap:
     def occupancy(self) -> OccupancyGrid:
         """The grid as of the last :meth:`rebuild` (an empty 0 x 0 grid before the first)."""
         if self._occupancy is None:
-            return OccupancyGrid(grid=np.zeros((0, 0), dtype=np.int8), resolution=self.grid.resolution,
-                                 origin=np.zeros(3))
+            return OccupancyGrid(
+                grid=np.zeros((0, 0), dtype=np.int8), resolution=self.grid.resolution, origin=np.zeros(3)
+            )
         return self._occupancy

@@ -78,8 +78,9 @@ class TileMaps:
 
     def nbytes(self) -> int:
         """Bytes held by the pool and the directories."""
-        return int(self.count.nbytes + self.mean.nbytes + self.refs.nbytes
-                   + self.free_stack.nbytes + self.directories.nbytes)
+        return int(
+            self.count.nbytes + self.mean.nbytes + self.refs.nbytes + self.free_stack.nbytes + self.directories.nbytes
+        )
 
     def ensure(self, low: NDArray[np.float64], high: NDArray[np.float64]) -> None:
         """Grow every directory so it covers the box from ``low`` to ``high`` (map frame, (x, y), m)."""
@@ -87,8 +88,14 @@ class TileMaps:
         lo = np.floor(np.asarray(low) * scale).astype(np.int64)
         hi = np.floor(np.asarray(high) * scale).astype(np.int64)
         _, rows, cols = self.directories.shape
-        if rows and cols and lo[0] >= self.tile_col0 and lo[1] >= self.tile_row0 \
-                and hi[0] < self.tile_col0 + cols and hi[1] < self.tile_row0 + rows:
+        if (
+            rows
+            and cols
+            and lo[0] >= self.tile_col0
+            and lo[1] >= self.tile_row0
+            and hi[0] < self.tile_col0 + cols
+            and hi[1] < self.tile_row0 + rows
+        ):
             return
         if rows and cols:
             lo = np.minimum(lo, [self.tile_col0, self.tile_row0])
@@ -97,7 +104,7 @@ class TileMaps:
         shape = (self.particles, int(hi[1]) + _GROW_TILES + 1 - row0, int(hi[0]) + _GROW_TILES + 1 - col0)
         grown = np.full(shape, -1, dtype=np.int32)
         r, c = self.tile_row0 - row0, self.tile_col0 - col0
-        grown[:, r:r + rows, c:c + cols] = self.directories
+        grown[:, r : r + rows, c : c + cols] = self.directories
         self.directories, self.tile_col0, self.tile_row0 = grown, col0, row0
 
     def _grow_pool(self, needed: int) -> None:
@@ -126,8 +133,20 @@ class TileMaps:
         self.ensure(np.array([ex.min(), ey.min()]), np.array([ex.max(), ey.max()]))
         done = 0
         while done < self.particles:
-            done = register_endpoints(self.directories, self.count, self.mean, self.refs, self.free_stack,
-                                      self.state, self.tile_col0, self.tile_row0, self.resolution, ex, ey, done)
+            done = register_endpoints(
+                self.directories,
+                self.count,
+                self.mean,
+                self.refs,
+                self.free_stack,
+                self.state,
+                self.tile_col0,
+                self.tile_row0,
+                self.resolution,
+                ex,
+                ey,
+                done,
+            )
             if done < self.particles:
                 self._grow_pool(ex.shape[1])
 
@@ -140,7 +159,7 @@ class TileMaps:
         self.refs[:allocated] = np.bincount(held, minlength=allocated)[:allocated]
         released = np.flatnonzero(self.refs[:allocated] == 0).astype(np.int32)
         released = released[released != EMPTY_TILE]
-        self.free_stack[:released.size] = released
+        self.free_stack[: released.size] = released
         self.state[0] = released.size
 
     def cell_mean(self, particle: int, xy: NDArray[np.float64]) -> tuple[int, NDArray[np.float64]]:
@@ -157,4 +176,9 @@ class TileMaps:
         n = int(self.count[tile, i, j])
         if n == 0:
             return 0, np.full(2, np.nan)
-        return n, np.array([gc * self.resolution + float(self.mean[tile, i, j, 0]), gr * self.resolution + float(self.mean[tile, i, j, 1])])
+        return n, np.array(
+            [
+                gc * self.resolution + float(self.mean[tile, i, j, 0]),
+                gr * self.resolution + float(self.mean[tile, i, j, 1]),
+            ]
+        )

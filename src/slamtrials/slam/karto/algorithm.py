@@ -121,13 +121,22 @@ class Karto:
         # slam_karto's config/mapper_params.yaml, which are open_karto's own defaults; slam_karto has no
         # time throttle between nodes, and leaves Karto's default range threshold (12 m)
         "slam_karto": {
-            "minimum_time_interval": 0.0, "minimum_travel_distance": 0.2, "minimum_travel_heading": 0.174,
-            "scan_buffer_size": 70, "scan_buffer_maximum_scan_distance": 20.0,
-            "link_match_minimum_response_fine": 0.8, "link_scan_maximum_distance": 10.0,
-            "loop_search_maximum_distance": 4.0, "loop_match_maximum_variance_coarse": 0.4,
-            "loop_match_minimum_response_coarse": 0.8, "loop_match_minimum_response_fine": 0.8,
-            "correlation_search_space_dimension": 0.3, "correlation_search_space_smear_deviation": 0.03,
-            "distance_variance_penalty": 0.3, "angle_variance_penalty": 0.349, "use_response_expansion": False,
+            "minimum_time_interval": 0.0,
+            "minimum_travel_distance": 0.2,
+            "minimum_travel_heading": 0.174,
+            "scan_buffer_size": 70,
+            "scan_buffer_maximum_scan_distance": 20.0,
+            "link_match_minimum_response_fine": 0.8,
+            "link_scan_maximum_distance": 10.0,
+            "loop_search_maximum_distance": 4.0,
+            "loop_match_maximum_variance_coarse": 0.4,
+            "loop_match_minimum_response_coarse": 0.8,
+            "loop_match_minimum_response_fine": 0.8,
+            "correlation_search_space_dimension": 0.3,
+            "correlation_search_space_smear_deviation": 0.03,
+            "distance_variance_penalty": 0.3,
+            "angle_variance_penalty": 0.349,
+            "use_response_expansion": False,
             "max_laser_range": 12.0,
         },
     }
@@ -141,14 +150,29 @@ class Karto:
         self.range_threshold = min(float(config.max_laser_range), laser.range_max)
         c = config
         settings = MatcherSettings(
-            coarse_search_angle_offset=c.coarse_search_angle_offset, coarse_angle_resolution=c.coarse_angle_resolution,
-            fine_search_angle_offset=c.fine_search_angle_offset, distance_variance=c.distance_variance_penalty ** 2,
-            angle_variance=c.angle_variance_penalty ** 2, minimum_distance_penalty=c.minimum_distance_penalty,
-            minimum_angle_penalty=c.minimum_angle_penalty, use_response_expansion=c.use_response_expansion)
-        self.sequential = ScanMatcher(c.correlation_search_space_dimension, c.correlation_search_space_resolution,
-                                      c.correlation_search_space_smear_deviation, self.range_threshold, settings)
-        self.loop_matcher = ScanMatcher(c.loop_search_space_dimension, c.loop_search_space_resolution,
-                                        c.loop_search_space_smear_deviation, self.range_threshold, settings)
+            coarse_search_angle_offset=c.coarse_search_angle_offset,
+            coarse_angle_resolution=c.coarse_angle_resolution,
+            fine_search_angle_offset=c.fine_search_angle_offset,
+            distance_variance=c.distance_variance_penalty**2,
+            angle_variance=c.angle_variance_penalty**2,
+            minimum_distance_penalty=c.minimum_distance_penalty,
+            minimum_angle_penalty=c.minimum_angle_penalty,
+            use_response_expansion=c.use_response_expansion,
+        )
+        self.sequential = ScanMatcher(
+            c.correlation_search_space_dimension,
+            c.correlation_search_space_resolution,
+            c.correlation_search_space_smear_deviation,
+            self.range_threshold,
+            settings,
+        )
+        self.loop_matcher = ScanMatcher(
+            c.loop_search_space_dimension,
+            c.loop_search_space_resolution,
+            c.loop_search_space_smear_deviation,
+            self.range_threshold,
+            settings,
+        )
         self.reset(np.random.default_rng(0))
 
     # ------------------------------------------------------------------ state
@@ -162,8 +186,13 @@ class Karto:
         self.optimizations: list[tuple[int, int, float, int]] = []
         self.graph = PoseGraph()
         self.running: list[int] = []
-        self.map = NodeMap(c.resolution, self.laser, max_urange=self.range_threshold,
-                           min_pass_through=c.min_pass_through, occupancy_threshold=c.occupancy_threshold)
+        self.map = NodeMap(
+            c.resolution,
+            self.laser,
+            max_urange=self.range_threshold,
+            min_pass_through=c.min_pass_through,
+            occupancy_threshold=c.occupancy_threshold,
+        )
         self._last_map_t = -math.inf
         self._t: list[float] = []
         self._odometry: list[NDArray[np.float64]] = []
@@ -189,20 +218,35 @@ class Karto:
                 if node.barycenter is not None:
                     offsets[k] = node.barycenter
         c, s = stablemath.cos(laser[:, 2]), stablemath.sin(laser[:, 2])
-        return np.column_stack([laser[:, 0] + c * offsets[:, 0] - s * offsets[:, 1],
-                                laser[:, 1] + s * offsets[:, 0] + c * offsets[:, 1]])
+        return np.column_stack(
+            [laser[:, 0] + c * offsets[:, 0] - s * offsets[:, 1], laser[:, 1] + s * offsets[:, 0] + c * offsets[:, 1]]
+        )
 
     def _points(self, indexes: list[int]) -> list[tuple[NDArray[np.float64], NDArray[np.float64]]]:
         nodes = self.graph.nodes
         return [points_in_map(self._laser_pose(i), nodes[i].lx, nodes[i].ly) for i in indexes]
 
-    def _match(self, matcher: ScanMatcher, laser_pose: NDArray[np.float64], index: int, base: list[int], *,
-               penalize: bool, refine: bool = True) -> MatchResult:
+    def _match(
+        self,
+        matcher: ScanMatcher,
+        laser_pose: NDArray[np.float64],
+        index: int,
+        base: list[int],
+        *,
+        penalize: bool,
+        refine: bool = True,
+    ) -> MatchResult:
         node = self.graph.nodes[index]
         return matcher.match(laser_pose, node.lx, node.ly, self._points(base), penalize=penalize, refine=refine)
 
-    def _scan_node(self, frame_index: int, t: float, odometry: NDArray[np.float64], pose: NDArray[np.float64],
-                   ranges: NDArray[np.float64]) -> ScanNode:
+    def _scan_node(
+        self,
+        frame_index: int,
+        t: float,
+        odometry: NDArray[np.float64],
+        pose: NDArray[np.float64],
+        ranges: NDArray[np.float64],
+    ) -> ScanNode:
         if self._angles is None or self._angles.shape[0] != ranges.shape[0]:
             self._angles = self.laser.beam_angles(ranges.shape[0])
         has_point = np.isfinite(ranges) & (ranges > self.laser.range_min) & (ranges < self.laser.range_max)
@@ -211,8 +255,16 @@ class Karto:
         near = has_point & (ranges <= self.range_threshold)
         count = int(near.sum())  # fsum: correctly rounded, the same on every machine
         barycenter = np.array([math.fsum(lx[near]) / count, math.fsum(ly[near]) / count]) if count else None
-        return ScanNode(frame=frame_index, t=t, odometry=odometry, pose=pose, lx=lx, ly=ly, barycenter=barycenter,
-                        ranges=np.asarray(ranges, dtype=np.float32))
+        return ScanNode(
+            frame=frame_index,
+            t=t,
+            odometry=odometry,
+            pose=pose,
+            lx=lx,
+            ly=ly,
+            barycenter=barycenter,
+            ranges=np.asarray(ranges, dtype=np.float32),
+        )
 
     def _is_node(self, t: float, odometry: NDArray[np.float64]) -> bool:
         c = self.config
@@ -226,12 +278,13 @@ class Karto:
         if abs(wrap_angle1(now[2] - before[2])) >= c.minimum_travel_heading:
             return True
         dx, dy = now[0] - before[0], now[1] - before[1]
-        return dx * dx + dy * dy >= c.minimum_travel_distance ** 2 - _TOLERANCE
+        return dx * dx + dy * dy >= c.minimum_travel_distance**2 - _TOLERANCE
 
     # ------------------------------------------------------------------ graph building (Karto's MapperGraph)
 
-    def _link_chain(self, chain: list[int], index: int, laser_mean: NDArray[np.float64],
-                    covariance: NDArray[np.float64]) -> None:
+    def _link_chain(
+        self, chain: list[int], index: int, laser_mean: NDArray[np.float64], covariance: NDArray[np.float64]
+    ) -> None:
         """LinkChainToScan: link the chain's node nearest to node ``index`` if near enough."""
         reference = self._references()
         here = reference[index]
@@ -240,7 +293,7 @@ class Karto:
             dx, dy = reference[k, 0] - here[0], reference[k, 1] - here[1]
             if dx * dx + dy * dy < best:
                 closest, best = k, dx * dx + dy * dy
-        if closest >= 0 and best < self.config.link_scan_maximum_distance ** 2 + _TOLERANCE:
+        if closest >= 0 and best < self.config.link_scan_maximum_distance**2 + _TOLERANCE:
             self.graph.link(closest, index, self._base_pose(laser_mean), covariance)
 
     def _add_edges(self, index: int, covariance: NDArray[np.float64]) -> None:
@@ -270,7 +323,7 @@ class Karto:
     def _add_running(self, index: int) -> None:
         c = self.config
         self.running.append(index)
-        limit = c.scan_buffer_maximum_scan_distance ** 2 - _TOLERANCE
+        limit = c.scan_buffer_maximum_scan_distance**2 - _TOLERANCE
         while True:
             front, back = self._laser_pose(self.running[0]), self._laser_pose(self.running[-1])
             dx, dy = back[0] - front[0], back[1] - front[1]
@@ -283,9 +336,13 @@ class Karto:
         """CorrectPoses: optimize the whole graph and move every node."""
         edges = self.graph.edges
         started = time.perf_counter()
-        result = optimize_pose_graph(self.graph.poses(), np.array([e.source for e in edges]),
-                                     np.array([e.target for e in edges]), np.array([e.mean for e in edges]),
-                                     np.array([information(e.covariance) for e in edges]))
+        result = optimize_pose_graph(
+            self.graph.poses(),
+            np.array([e.source for e in edges]),
+            np.array([e.target for e in edges]),
+            np.array([e.mean for e in edges]),
+            np.array([information(e.covariance) for e in edges]),
+        )
         self.optimizations.append((len(self.graph.nodes), len(edges), time.perf_counter() - started, result.iterations))
         self.graph.set_poses(result.poses)
 
@@ -294,32 +351,58 @@ class Karto:
         c = self.config
         node = self.graph.nodes[index]
         start = 0
-        chain, start = find_loop_closure_chain(self.graph, index, self._references(), c.loop_search_maximum_distance,
-                                               c.loop_match_minimum_chain_size, start)
+        chain, start = find_loop_closure_chain(
+            self.graph,
+            index,
+            self._references(),
+            c.loop_search_maximum_distance,
+            c.loop_match_minimum_chain_size,
+            start,
+        )
         while chain:
-            coarse = self._match(self.loop_matcher, self._laser_pose(index), index, chain, penalize=False,
-                                 refine=False)
-            bound = c.loop_match_maximum_variance_coarse ** 2
-            if (coarse.response > c.loop_match_minimum_response_coarse and coarse.covariance[0, 0] < bound
-                    and coarse.covariance[1, 1] < bound):
+            coarse = self._match(self.loop_matcher, self._laser_pose(index), index, chain, penalize=False, refine=False)
+            bound = c.loop_match_maximum_variance_coarse**2
+            if (
+                coarse.response > c.loop_match_minimum_response_coarse
+                and coarse.covariance[0, 0] < bound
+                and coarse.covariance[1, 1] < bound
+            ):
                 fine = self._match(self.sequential, coarse.pose, index, chain, penalize=False)
                 if fine.response >= c.loop_match_minimum_response_fine:
                     node.pose = self._base_pose(fine.pose)
                     self._link_chain(chain, index, fine.pose, fine.covariance)
                     self._optimize()
                     self.loop_closures += 1
-            chain, start = find_loop_closure_chain(self.graph, index, self._references(),
-                                                   c.loop_search_maximum_distance, c.loop_match_minimum_chain_size, start)
+            chain, start = find_loop_closure_chain(
+                self.graph,
+                index,
+                self._references(),
+                c.loop_search_maximum_distance,
+                c.loop_match_minimum_chain_size,
+                start,
+            )
 
-    def _add_node(self, frame_index: int, t: float, odometry: NDArray[np.float64], predicted: NDArray[np.float64],
-                  ranges: NDArray[np.float64]) -> ScanNode:
+    def _add_node(
+        self,
+        frame_index: int,
+        t: float,
+        odometry: NDArray[np.float64],
+        predicted: NDArray[np.float64],
+        ranges: NDArray[np.float64],
+    ) -> ScanNode:
         c = self.config
         started = time.perf_counter()
         node = self._scan_node(frame_index, t, odometry, predicted, ranges)
         covariance = np.eye(3)
         if c.use_scan_matching and self.graph.nodes:
-            result = self.sequential.match(compose1(predicted, self.mount), node.lx, node.ly,
-                                           self._points(self.running), penalize=True, refine=True)
+            result = self.sequential.match(
+                compose1(predicted, self.mount),
+                node.lx,
+                node.ly,
+                self._points(self.running),
+                penalize=True,
+                refine=True,
+            )
             node.pose = self._base_pose(result.pose)
             covariance = result.covariance
         index = self.graph.add_node(node)

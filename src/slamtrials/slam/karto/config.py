@@ -93,12 +93,18 @@ class KartoConfig(BaseModel):
     minimum_travel_heading: float = Field(0.5, ge=0.0, le=2.0 * math.pi, description="node after this turn (rad)")
     scan_buffer_size: int = Field(10, ge=1, le=10_000, description="running buffer length (nodes)")
     scan_buffer_maximum_scan_distance: float = Field(10.0, gt=0.0, le=1000.0, description="running buffer extent (m)")
-    link_match_minimum_response_fine: float = Field(0.1, ge=0.0, le=1.0, description="least response to link a near chain")
-    link_scan_maximum_distance: float = Field(1.5, gt=0.0, le=1000.0, description="largest distance of linked scans (m)")
+    link_match_minimum_response_fine: float = Field(
+        0.1, ge=0.0, le=1.0, description="least response to link a near chain"
+    )
+    link_scan_maximum_distance: float = Field(
+        1.5, gt=0.0, le=1000.0, description="largest distance of linked scans (m)"
+    )
     loop_search_maximum_distance: float = Field(3.0, gt=0.0, le=1000.0, description="loop candidates within (m)")
     do_loop_closing: bool = Field(True, description="close loops")
     loop_match_minimum_chain_size: int = Field(10, ge=1, le=10_000, description="least scans in a chain")
-    loop_match_maximum_variance_coarse: float = Field(3.0, gt=0.0, le=1000.0, description="coarse loop variance bound (sqrt of m^2)")
+    loop_match_maximum_variance_coarse: float = Field(
+        3.0, gt=0.0, le=1000.0, description="coarse loop variance bound (sqrt of m^2)"
+    )
     loop_match_minimum_response_coarse: float = Field(0.35, ge=0.0, le=1.0, description="least coarse loop response")
     loop_match_minimum_response_fine: float = Field(0.45, ge=0.0, le=1.0, description="least fine loop response")
     correlation_search_space_dimension: float = Field(0.5, gt=0.0, le=100.0, description="sequential search side (m)")
@@ -116,8 +122,12 @@ class KartoConfig(BaseModel):
     minimum_distance_penalty: float = Field(0.5, ge=0.0, le=1.0, description="distance penalty floor")
     use_response_expansion: bool = Field(True, description="widen the angular search on a zero response")
     min_pass_through: int = Field(2, ge=0, le=1000, description="map: crossings before a cell is known")
-    occupancy_threshold: float = Field(0.1, ge=0.0, lt=1.0, description="map: occupied when hits/crossings exceeds this")
-    initial_pose: tuple[float, float, float] | None = Field(None, description="base pose of the first scan; None: first odometry pose")
+    occupancy_threshold: float = Field(
+        0.1, ge=0.0, lt=1.0, description="map: occupied when hits/crossings exceeds this"
+    )
+    initial_pose: tuple[float, float, float] | None = Field(
+        None, description="base pose of the first scan; None: first odometry pose"
+    )
 
     @field_validator("initial_pose")
     @classmethod
@@ -127,19 +137,29 @@ class KartoConfig(BaseModel):
         return value
 
     @model_validator(mode="after")
-    def _consistent(self) -> "KartoConfig":
+    def _consistent(self) -> KartoConfig:
         # Karto's smearing kernel spans two deviations and must fit 0.5 to 10 cells (CorrelationGrid)
-        for prefix, smear, cell in (("correlation_search_space", self.correlation_search_space_smear_deviation,
-                                     self.correlation_search_space_resolution),
-                                    ("loop_search_space", self.loop_search_space_smear_deviation,
-                                     self.loop_search_space_resolution)):
+        for prefix, smear, cell in (
+            (
+                "correlation_search_space",
+                self.correlation_search_space_smear_deviation,
+                self.correlation_search_space_resolution,
+            ),
+            ("loop_search_space", self.loop_search_space_smear_deviation, self.loop_search_space_resolution),
+        ):
             if not 0.5 * cell <= smear <= 10.0 * cell:
-                raise ValueError(f"{prefix}_smear_deviation ({smear} m) must be between 0.5 and 10 times "
-                                 f"{prefix}_resolution ({cell} m)")
+                raise ValueError(
+                    f"{prefix}_smear_deviation ({smear} m) must be between 0.5 and 10 times "
+                    f"{prefix}_resolution ({cell} m)"
+                )
         if self.fine_search_angle_offset > 0.5 * self.coarse_angle_resolution:
-            raise ValueError(f"fine_search_angle_offset ({self.fine_search_angle_offset} rad) must not exceed half of "
-                             f"coarse_angle_resolution ({self.coarse_angle_resolution} rad)")
+            raise ValueError(
+                f"fine_search_angle_offset ({self.fine_search_angle_offset} rad) must not exceed half of "
+                f"coarse_angle_resolution ({self.coarse_angle_resolution} rad)"
+            )
         if self.coarse_angle_resolution > self.coarse_search_angle_offset:
-            raise ValueError(f"coarse_angle_resolution ({self.coarse_angle_resolution} rad) must not exceed "
-                             f"coarse_search_angle_offset ({self.coarse_search_angle_offset} rad)")
+            raise ValueError(
+                f"coarse_angle_resolution ({self.coarse_angle_resolution} rad) must not exceed "
+                f"coarse_search_angle_offset ({self.coarse_search_angle_offset} rad)"
+            )
         return self

@@ -26,8 +26,15 @@ from numpy.typing import NDArray
 
 from slamtrials import stablemath
 
-__all__ = ["OCCUPIED_VALUE", "MAX_VARIANCE", "karto_round", "smear_kernel", "find_valid_points", "add_points",
-           "correlate"]
+__all__ = [
+    "OCCUPIED_VALUE",
+    "MAX_VARIANCE",
+    "karto_round",
+    "smear_kernel",
+    "find_valid_points",
+    "add_points",
+    "correlate",
+]
 
 #: Value of a cell holding a scan point (Karto's GridStates_Occupied).
 OCCUPIED_VALUE = 100
@@ -163,9 +170,31 @@ def _response(grid, row, col, dcol, drow, a, norm):  # pragma: no cover - compil
 
 
 @njit(cache=True, nogil=True)
-def correlate(grid, border, ox, oy, resolution, lx, ly, n_beams, cx, cy, ctheta, search_offset, search_step,
-              angle_offset, angle_step, penalize, distance_variance, minimum_distance_penalty, angle_variance,
-              minimum_angle_penalty, fine, mean, covariance):  # pragma: no cover - compiled
+def correlate(
+    grid,
+    border,
+    ox,
+    oy,
+    resolution,
+    lx,
+    ly,
+    n_beams,
+    cx,
+    cy,
+    ctheta,
+    search_offset,
+    search_step,
+    angle_offset,
+    angle_step,
+    penalize,
+    distance_variance,
+    minimum_distance_penalty,
+    angle_variance,
+    minimum_angle_penalty,
+    fine,
+    mean,
+    covariance,
+):  # pragma: no cover - compiled
     """Karto's CorrelateScan: search around ``(cx, cy, ctheta)``; return the best response (<= 1).
 
     ``lx, ly``: the scan's points in the laser frame (m), only beams that have one; ``n_beams`` all
@@ -224,8 +253,9 @@ def correlate(grid, border, ox, oy, resolution, lx, ly, n_beams, cx, cy, ctheta,
     mean[1] = sum_y / count
     mean[2] = math.atan2(sum_s / count, sum_c / count)
     if not fine:
-        _positional_covariance(responses, best, mean[0] - cx, mean[1] - cy, search_offset, search_step, angle_step,
-                               covariance)
+        _positional_covariance(
+            responses, best, mean[0] - cx, mean[1] - cy, search_offset, search_step, angle_step, covariance
+        )
     else:
         row = int(_round((mean[1] - oy) * inv_res)) + border
         col = int(_round((mean[0] - ox) * inv_res)) + border
@@ -253,8 +283,9 @@ def correlate(grid, border, ox, oy, resolution, lx, ly, n_beams, cx, cy, ctheta,
 
 
 @njit(cache=True, nogil=True)
-def _positional_covariance(responses, best, dx, dy, search_offset, search_step, angle_step,
-                           covariance):  # pragma: no cover - compiled
+def _positional_covariance(
+    responses, best, dx, dy, search_offset, search_step, angle_step, covariance
+):  # pragma: no cover - compiled
     """Karto's ComputePositionalCovariance over the best response of each searched position."""
     for i in range(3):
         for j in range(3):

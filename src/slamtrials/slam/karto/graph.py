@@ -99,8 +99,14 @@ class PoseGraph:
         if (source, target) in self._pairs or source == target:
             return False
         origin = self.nodes[source].pose
-        self.edges.append(Edge(source, target, ominus1(origin, target_pose),
-                               rotate_covariance(np.asarray(covariance, dtype=np.float64), -float(origin[2]))))
+        self.edges.append(
+            Edge(
+                source,
+                target,
+                ominus1(origin, target_pose),
+                rotate_covariance(np.asarray(covariance, dtype=np.float64), -float(origin[2])),
+            )
+        )
         self._pairs.add((source, target))
         self.neighbours[source].append(target)
         self.neighbours[target].append(source)

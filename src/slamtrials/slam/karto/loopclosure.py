@@ -29,7 +29,9 @@ def _squared_distance(reference: NDArray[np.float64], a: int, b: int) -> float:
     return float(dx * dx + dy * dy)
 
 
-def find_near_chains(graph: PoseGraph, new: int, reference: NDArray[np.float64], max_distance: float) -> list[list[int]]:
+def find_near_chains(
+    graph: PoseGraph, new: int, reference: NDArray[np.float64], max_distance: float
+) -> list[list[int]]:
     """Chains of consecutive nodes within ``max_distance`` (m) of node ``new`` (see the module)."""
     limit = max_distance * max_distance + _TOLERANCE
     chains: list[list[int]] = []
@@ -63,8 +65,9 @@ def find_near_chains(graph: PoseGraph, new: int, reference: NDArray[np.float64],
     return chains
 
 
-def find_loop_closure_chain(graph: PoseGraph, new: int, reference: NDArray[np.float64], max_distance: float,
-                            minimum_size: int, start: int) -> tuple[list[int], int]:
+def find_loop_closure_chain(
+    graph: PoseGraph, new: int, reference: NDArray[np.float64], max_distance: float, minimum_size: int, start: int
+) -> tuple[list[int], int]:
     """The next loop-closure candidate chain for node ``new``, scanning nodes from index ``start``.
 
     Returns the chain (empty when there is none left) and the index to continue from.

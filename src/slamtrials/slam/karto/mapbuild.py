@@ -52,8 +52,15 @@ class NodeMap:
         Karto's cell rule (module docstring).
     """
 
-    def __init__(self, resolution: float, laser: LaserGeometry, *, max_urange: float, min_pass_through: int,
-                 occupancy_threshold: float):
+    def __init__(
+        self,
+        resolution: float,
+        laser: LaserGeometry,
+        *,
+        max_urange: float,
+        min_pass_through: int,
+        occupancy_threshold: float,
+    ):
         self.grid = GridMap(resolution)
         self.laser = laser
         self.max_urange = float(max_urange)
@@ -83,20 +90,28 @@ class NodeMap:
             end = start + 1
             while end < len(ranges) and ranges[end].shape == ranges[start].shape:
                 end += 1
-            self.grid.integrate_many(np.array(poses[start:end]), np.stack(ranges[start:end]),
-                                     self.laser.beam_angles(ranges[start].shape[0]), np.array(weights[start:end]),
-                                     range_min=self.laser.range_min, range_max=self.laser.range_max,
-                                     max_urange=self.max_urange)
+            self.grid.integrate_many(
+                np.array(poses[start:end]),
+                np.stack(ranges[start:end]),
+                self.laser.beam_angles(ranges[start].shape[0]),
+                np.array(weights[start:end]),
+                range_min=self.laser.range_min,
+                range_max=self.laser.range_max,
+                max_urange=self.max_urange,
+            )
             start = end
-        self._poses = laser_poses[:len(scans)].copy()
-        self._occupancy = OccupancyGrid(grid=_classify(self.grid.hits, self.grid.visits, self.min_pass_through,
-                                                       self.occupancy_threshold),
-                                        resolution=self.grid.resolution, origin=self.grid.origin)
+        self._poses = laser_poses[: len(scans)].copy()
+        self._occupancy = OccupancyGrid(
+            grid=_classify(self.grid.hits, self.grid.visits, self.min_pass_through, self.occupancy_threshold),
+            resolution=self.grid.resolution,
+            origin=self.grid.origin,
+        )
         return len(ranges)
 
     def occupancy(self) -> OccupancyGrid:
         """The grid as of the last :meth:`update` (an empty 0 x 0 grid before the first)."""
         if self._occupancy is None:
-            return OccupancyGrid(grid=np.zeros((0, 0), dtype=np.int8), resolution=self.grid.resolution,
-                                 origin=np.zeros(3))
+            return OccupancyGrid(
+                grid=np.zeros((0, 0), dtype=np.int8), resolution=self.grid.resolution, origin=np.zeros(3)
+            )
         return self._occupancy

@@ -199,8 +199,13 @@ def _scalar_order(n_free: int, source: NDArray[np.int64], target: NDArray[np.int
     return (3 * nodes[:, None] + np.arange(3)[None, :]).reshape(-1)
 
 
-def optimize_pose_graph(poses: NDArray[np.float64], source: NDArray[np.int64], target: NDArray[np.int64],
-                        means: NDArray[np.float64], weights: NDArray[np.float64]) -> OptimizerResult:
+def optimize_pose_graph(
+    poses: NDArray[np.float64],
+    source: NDArray[np.int64],
+    target: NDArray[np.int64],
+    means: NDArray[np.float64],
+    weights: NDArray[np.float64],
+) -> OptimizerResult:
     """Minimise the pose-graph cost (module docstring) over every node but node 0.
 
     Parameters
@@ -245,7 +250,7 @@ def optimize_pose_graph(poses: NDArray[np.float64], source: NDArray[np.int64], t
                 break
         iteration += 1
         lam = 1.0 / radius
-        damped = (permuted + scipy.sparse.diags(lam * diagonal[order], format="csc"))
+        damped = permuted + scipy.sparse.diags(lam * diagonal[order], format="csc")
         upper = scipy.sparse.triu(damped, format="csc")
         upper.sort_indices()
         try:

@@ -17,8 +17,14 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from slamtrials.slam.karto.correlation import (MAX_VARIANCE, add_points, correlate, find_valid_points, karto_round,
-                                               smear_kernel)
+from slamtrials.slam.karto.correlation import (
+    MAX_VARIANCE,
+    add_points,
+    correlate,
+    find_valid_points,
+    karto_round,
+    smear_kernel,
+)
 
 __all__ = ["MatchResult", "MatcherSettings", "ScanMatcher", "points_in_map"]
 
@@ -57,8 +63,9 @@ class MatcherSettings:
     use_response_expansion: bool
 
 
-def points_in_map(laser_pose: NDArray[np.float64], lx: NDArray[np.float64],
-                  ly: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def points_in_map(
+    laser_pose: NDArray[np.float64], lx: NDArray[np.float64], ly: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Laser-frame points ``[B]`` (NaN where a beam has none) seen from ``laser_pose`` ``[3]``: map-frame x, y."""
     c, s = math.cos(float(laser_pose[2])), math.sin(float(laser_pose[2]))
     return laser_pose[0] + c * lx - s * ly, laser_pose[1] + s * lx + c * ly
@@ -81,8 +88,14 @@ class ScanMatcher:
         Angular search and penalties.
     """
 
-    def __init__(self, search_dimension: float, resolution: float, smear_deviation: float, range_threshold: float,
-                 settings: MatcherSettings):
+    def __init__(
+        self,
+        search_dimension: float,
+        resolution: float,
+        smear_deviation: float,
+        range_threshold: float,
+        settings: MatcherSettings,
+    ):
         self.resolution = float(resolution)
         self.settings = settings
         self.search_side = karto_round(search_dimension / resolution) + 1
@@ -96,13 +109,20 @@ class ScanMatcher:
     def _clear(self) -> None:
         r0, r1, c0, c1 = (int(v) for v in self._box)
         if r1 >= r0:
-            self.grid[r0:r1 + 1, c0:c1 + 1] = 0
+            self.grid[r0 : r1 + 1, c0 : c1 + 1] = 0
         size = self.grid.shape[0]
         self._box[:] = (size, -1, size, -1)
 
-    def match(self, laser_pose: NDArray[np.float64], lx: NDArray[np.float64], ly: NDArray[np.float64],
-              base: Sequence[tuple[NDArray[np.float64], NDArray[np.float64]]], *, penalize: bool = True,
-              refine: bool = True) -> MatchResult:
+    def match(
+        self,
+        laser_pose: NDArray[np.float64],
+        lx: NDArray[np.float64],
+        ly: NDArray[np.float64],
+        base: Sequence[tuple[NDArray[np.float64], NDArray[np.float64]]],
+        *,
+        penalize: bool = True,
+        refine: bool = True,
+    ) -> MatchResult:
         """Match a scan taken at ``laser_pose`` (map frame, the search centre) against ``base`` scans.
 
         Parameters
@@ -125,7 +145,7 @@ class ScanMatcher:
         covariance = np.zeros((3, 3))
         if n_beams == 0:
             covariance[0, 0] = covariance[1, 1] = MAX_VARIANCE
-            covariance[2, 2] = 4.0 * s.coarse_angle_resolution ** 2
+            covariance[2, 2] = 4.0 * s.coarse_angle_resolution**2
             return MatchResult(0.0, mean, covariance)
         res = self.resolution
         ox = pose[0] - 0.5 * (self.roi - 1) * res
@@ -140,21 +160,78 @@ class ScanMatcher:
         coarse_offset = 0.5 * (self.search_side - 1) * res
         coarse_step = 2.0 * res
         args = (s.distance_variance, s.minimum_distance_penalty, s.angle_variance, s.minimum_angle_penalty)
-        best = correlate(self.grid, self.border, ox, oy, res, mx, my, n_beams, pose[0], pose[1], pose[2], coarse_offset,
-                         coarse_step, s.coarse_search_angle_offset, s.coarse_angle_resolution, penalize, *args, False,
-                         mean, covariance)
+        best = correlate(
+            self.grid,
+            self.border,
+            ox,
+            oy,
+            res,
+            mx,
+            my,
+            n_beams,
+            pose[0],
+            pose[1],
+            pose[2],
+            coarse_offset,
+            coarse_step,
+            s.coarse_search_angle_offset,
+            s.coarse_angle_resolution,
+            penalize,
+            *args,
+            False,
+            mean,
+            covariance,
+        )
         if s.use_response_expansion and abs(best) < 1e-9:
             angle_offset = s.coarse_search_angle_offset
             for _ in range(3):
                 angle_offset += math.radians(20.0)
-                best = correlate(self.grid, self.border, ox, oy, res, mx, my, n_beams, pose[0], pose[1], pose[2],
-                                 coarse_offset, coarse_step, angle_offset, s.coarse_angle_resolution, penalize, *args,
-                                 False, mean, covariance)
+                best = correlate(
+                    self.grid,
+                    self.border,
+                    ox,
+                    oy,
+                    res,
+                    mx,
+                    my,
+                    n_beams,
+                    pose[0],
+                    pose[1],
+                    pose[2],
+                    coarse_offset,
+                    coarse_step,
+                    angle_offset,
+                    s.coarse_angle_resolution,
+                    penalize,
+                    *args,
+                    False,
+                    mean,
+                    covariance,
+                )
                 if abs(best) >= 1e-9:
                     break
         if refine:
             center = mean.copy()
-            best = correlate(self.grid, self.border, ox, oy, res, mx, my, n_beams, center[0], center[1], center[2],
-                             res, res, 0.5 * s.coarse_angle_resolution, s.fine_search_angle_offset, penalize, *args,
-                             True, mean, covariance)
+            best = correlate(
+                self.grid,
+                self.border,
+                ox,
+                oy,
+                res,
+                mx,
+                my,
+                n_beams,
+                center[0],
+                center[1],
+                center[2],
+                res,
+                res,
+                0.5 * s.coarse_angle_resolution,
+                s.fine_search_angle_offset,
+                penalize,
+                *args,
+                True,
+                mean,
+                covariance,
+            )
         return MatchResult(float(best), mean, covariance)

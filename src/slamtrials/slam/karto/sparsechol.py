@@ -162,8 +162,9 @@ def _solve(lp, li, lx, b):  # pragma: no cover - compiled
     return x
 
 
-def cholesky(indptr: NDArray[np.int64], indices: NDArray[np.int64],
-             data: NDArray[np.float64]) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]:
+def cholesky(
+    indptr: NDArray[np.int64], indices: NDArray[np.int64], data: NDArray[np.float64]
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]:
     """Factor ``A = L L^T`` from A's upper triangle in compressed columns; return L's compressed columns
     (diagonal first in each column).
 
@@ -173,15 +174,17 @@ def cholesky(indptr: NDArray[np.int64], indices: NDArray[np.int64],
         A pivot is not positive.
     """
     n = indptr.shape[0] - 1
-    lp, li, lx, ok = _cholesky(n, np.asarray(indptr, dtype=np.int64), np.asarray(indices, dtype=np.int64),
-                               np.asarray(data, dtype=np.float64))
+    lp, li, lx, ok = _cholesky(
+        n, np.asarray(indptr, dtype=np.int64), np.asarray(indices, dtype=np.int64), np.asarray(data, dtype=np.float64)
+    )
     if not ok:
         raise NotPositiveDefinite("the matrix is not positive definite")
     return lp, li, lx
 
 
-def cholesky_solve(factor: tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]],
-                   b: NDArray[np.float64]) -> NDArray[np.float64]:
+def cholesky_solve(
+    factor: tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]], b: NDArray[np.float64]
+) -> NDArray[np.float64]:
     """Solve ``L L^T x = b`` with a factor of :func:`cholesky`."""
     lp, li, lx = factor
     return _solve(lp, li, lx, np.asarray(b, dtype=np.float64))

@@ -46,7 +46,9 @@ def _vertices(path: Path, doc: Any, text: str) -> np.ndarray:
     if not isinstance(doc, dict):
         raise FormatError(path, "expected a JSON object with a 'verts' field (HouseExpo layout)", line=1)
     if "verts" not in doc:
-        raise FormatError(path, "no 'verts' field: a HouseExpo layout needs the wall polygon [[x, y], ...] in metres", line=1)
+        raise FormatError(
+            path, "no 'verts' field: a HouseExpo layout needs the wall polygon [[x, y], ...] in metres", line=1
+        )
     raw = doc["verts"]
     if not isinstance(raw, list) or not raw:
         raise FormatError(path, f"verts: expected a non-empty list of [x, y] points, got {raw!r:.60}", line=line)
@@ -134,7 +136,9 @@ def load_houseexpo(
     draw.line(points + points[:1], fill=0, width=1)
     free = np.asarray(canvas, dtype=bool)
     if not free.any():
-        raise FormatError(path, f"verts: the polygon has no free cell at resolution {res:g} m", line=_line_of(text, "verts"))
+        raise FormatError(
+            path, f"verts: the polygon has no free cell at resolution {res:g} m", line=_line_of(text, "verts")
+        )
 
     metadata: dict[str, Any] = {"source": str(path), "format": "houseexpo"}
     for key in ("id", "room_num"):

@@ -125,7 +125,9 @@ def _check_level(name: str, value: float) -> float:
 def check_resolution(resolution: object, source: str | Path) -> float:
     """Validate a resolution (metres per pixel): a finite number > 0, else :class:`WorldError`."""
     if resolution is None:
-        raise WorldError(f"{source}: a bare image has no scale; give its resolution in metres per pixel (e.g. resolution=0.05)")
+        raise WorldError(
+            f"{source}: a bare image has no scale; give its resolution in metres per pixel (e.g. resolution=0.05)"
+        )
     if isinstance(resolution, bool):
         raise WorldError(f"{source}: resolution must be a number of metres per pixel, got {resolution!r}")
     try:
@@ -146,7 +148,9 @@ def as_pose(value: object, what: str, source: str | Path) -> NDArray[np.float64]
     if pose.shape == (2,):
         pose = np.append(pose, 0.0)
     if pose.shape != (3,) or not np.all(np.isfinite(pose)):
-        raise WorldError(f"{source}: {what} must be finite numbers (x, y[, theta]) in metres and radians, got {value!r}")
+        raise WorldError(
+            f"{source}: {what} must be finite numbers (x, y[, theta]) in metres and radians, got {value!r}"
+        )
     return pose
 
 

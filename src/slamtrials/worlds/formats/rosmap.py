@@ -59,7 +59,9 @@ def _parse(path: Path) -> tuple[Any, dict[str, int], Any]:
     finally:
         loader.dispose()
     if not isinstance(doc, dict):
-        raise FormatError(path, "expected a YAML mapping with the map_server keys image, resolution, origin, ...", line=1)
+        raise FormatError(
+            path, "expected a YAML mapping with the map_server keys image, resolution, origin, ...", line=1
+        )
     return doc, _key_lines(node), node
 
 
@@ -180,7 +182,9 @@ def load_rosmap(path: str | Path, *, name: str | None = None) -> World:
     fields = _Fields(path, doc, lines)
     missing = [key for key in _REQUIRED if key not in doc]
     if missing:
-        raise FormatError(path, f"missing map_server key(s) {', '.join(missing)} (needs image, resolution, origin)", line=1)
+        raise FormatError(
+            path, f"missing map_server key(s) {', '.join(missing)} (needs image, resolution, origin)", line=1
+        )
     image = doc["image"]
     if not isinstance(image, str) or not image.strip():
         raise fields.fail("image", f"expected the image file name, got {image!r}")
@@ -223,7 +227,9 @@ def load_rosmap(path: str | Path, *, name: str | None = None) -> World:
     try:
         colour, alpha = read_pixels(image_path)
     except FormatError as exc:
-        raise FormatError(exc.path, f"{exc.problem} (the image of {path.name}:{lines.get('image')})", offset=exc.offset) from exc
+        raise FormatError(
+            exc.path, f"{exc.problem} (the image of {path.name}:{lines.get('image')})", offset=exc.offset
+        ) from exc
     free, occupied = classify_rosmap(
         colour, alpha, negate=bool(negate), occupied_thresh=occupied_thresh, free_thresh=free_thresh, mode=mode
     )
@@ -265,7 +271,11 @@ def _slamtrials_block(path: Path, doc: dict, lines: dict[str, int], root: Any) -
     if block is None:
         return {}
     if not isinstance(block, dict):
-        raise FormatError(path, f"slamtrials: expected a mapping with name, start, metadata, got {block!r}", line=lines.get("slamtrials"))
+        raise FormatError(
+            path,
+            f"slamtrials: expected a mapping with name, start, metadata, got {block!r}",
+            line=lines.get("slamtrials"),
+        )
     fields = _Fields(path, block, _sub_lines(root, "slamtrials"), prefix="slamtrials.")
     out: dict[str, Any] = {}
     if block.get("name") is not None:

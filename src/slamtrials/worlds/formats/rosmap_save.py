@@ -30,7 +30,9 @@ def save_rosmap(world: World, yaml_path: str | Path, image_name: str | None = No
     yaml_path = Path(yaml_path)
     image_name = image_name or yaml_path.with_suffix(".png").name
     grey = np.where(world.occupied, OCCUPIED_GREY, FREE_GREY).astype(np.uint8)
-    atomic_write(yaml_path.parent / image_name, lambda h: Image.fromarray(grey, mode="L").save(h, format="PNG", optimize=True))
+    atomic_write(
+        yaml_path.parent / image_name, lambda h: Image.fromarray(grey, mode="L").save(h, format="PNG", optimize=True)
+    )
     doc = {
         "image": image_name,
         "resolution": float(world.resolution),

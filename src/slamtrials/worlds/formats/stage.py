@@ -94,7 +94,7 @@ class Entity:
     file: Path
     line: int
     props: dict[str, Prop] = field(default_factory=dict)
-    children: list["Entity"] = field(default_factory=list)
+    children: list[Entity] = field(default_factory=list)
 
 
 @dataclass
@@ -301,7 +301,11 @@ class _Units:
         if length is not None:
             unit = _string(length, "unit_length")
             if unit not in _UNIT_LENGTH:
-                raise FormatError(length.file, f"unit_length: expected one of {', '.join(_UNIT_LENGTH)}, got {unit!r}", line=length.line)
+                raise FormatError(
+                    length.file,
+                    f"unit_length: expected one of {', '.join(_UNIT_LENGTH)}, got {unit!r}",
+                    line=length.line,
+                )
             self.metres = _UNIT_LENGTH[unit]
         if angle is not None:
             unit = _string(angle, "unit_angle")
@@ -325,7 +329,9 @@ def _floorplan(world: WorldFile) -> tuple[Entity, dict[str, Prop]]:
         if "bitmap" in props:
             candidates.append((model, props))
     if not candidates:
-        raise FormatError(world.path, "no floorplan: no top-level model has a bitmap (as in floorplan( bitmap \"map.png\" size [...] ))")
+        raise FormatError(
+            world.path, 'no floorplan: no top-level model has a bitmap (as in floorplan( bitmap "map.png" size [...] ))'
+        )
     for model, props in candidates:
         if "floorplan" in type_chain(world, model.type):
             return model, props
@@ -342,7 +348,9 @@ def _robot_start(world: WorldFile, units: _Units, floorplan: Entity) -> tuple[ND
     for model, chain in zip(models, chains):
         unresolved = chain[-1] not in STAGE_BASE_TYPES
         if unresolved and any(_ROBOT_HINT.search(name) for name in chain):
-            return units.pose(resolved_props(world, model).get("pose")), f"{model.type} (type name; include not available)"
+            return units.pose(
+                resolved_props(world, model).get("pose")
+            ), f"{model.type} (type name; include not available)"
     return None, None
 
 
@@ -423,10 +431,16 @@ def load_stage_world(
     bitmap = _string(bitmap_prop, "bitmap")
     size_prop = props.get("size")
     if size_prop is None:
-        raise FormatError(path, f"the floorplan model (line {floorplan.line}) has no size [x y z] in metres", line=floorplan.line)
+        raise FormatError(
+            path, f"the floorplan model (line {floorplan.line}) has no size [x y z] in metres", line=floorplan.line
+        )
     size = np.array(_numbers(size_prop, "size", (3, 2))[:2]) * units.metres
     if not np.all(size > 0):
-        raise FormatError(size_prop.file, f"size: the floorplan's size must be positive, got {list(size_prop.values)}", line=size_prop.line)
+        raise FormatError(
+            size_prop.file,
+            f"size: the floorplan's size must be positive, got {list(size_prop.values)}",
+            line=size_prop.line,
+        )
     image_path = Path(bitmap) if Path(bitmap).is_absolute() else path.parent / bitmap
     if not image_path.is_file():
         raise FormatError(
@@ -438,7 +452,10 @@ def load_stage_world(
     rows = np.flatnonzero(obstacle.any(axis=1))
     cols = np.flatnonzero(obstacle.any(axis=0))
     if rows.size == 0:
-        raise FormatError(image_path, f"the floorplan bitmap has no obstacle pixel (grey <= {STAGE_OBSTACLE_MAX}); Stage cannot scale it to size")
+        raise FormatError(
+            image_path,
+            f"the floorplan bitmap has no obstacle pixel (grey <= {STAGE_OBSTACLE_MAX}); Stage cannot scale it to size",
+        )
     crop = (slice(rows[0], rows[-1] + 1), slice(cols[0], cols[-1] + 1))
     blocked = first[crop] < float(free_level) * 255.0
     src_h, src_w = blocked.shape
@@ -458,7 +475,9 @@ def load_stage_world(
         origin = compose(centre, -half)
         origin[2] = centre[2]
     if grid.all():
-        raise WorldError(f"{path}: the floorplan {bitmap!r} has no free space (no pixel brighter than free_level={free_level:g})")
+        raise WorldError(
+            f"{path}: the floorplan {bitmap!r} has no free space (no pixel brighter than free_level={free_level:g})"
+        )
 
     start, how = _robot_start(world, units, floorplan)
     floor_name = props.get("name")
@@ -478,6 +497,11 @@ def load_stage_world(
         try:
             return World(occupied=grid, resolution=res, origin=origin, name=world_name, start=start, metadata=metadata)
         except WorldError:
-            log.warning("%s: the robot's pose (%.2f, %.2f) is not in free space; choosing a start pose", path, start[0], start[1])
+            log.warning(
+                "%s: the robot's pose (%.2f, %.2f) is not in free space; choosing a start pose",
+                path,
+                start[0],
+                start[1],
+            )
             metadata["start_from"] = f"automatic ({how} at ({start[0]:.2f}, {start[1]:.2f}) is not in free space)"
     return World(occupied=grid, resolution=res, origin=origin, name=world_name, start=None, metadata=metadata)

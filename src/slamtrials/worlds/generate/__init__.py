@@ -79,8 +79,15 @@ def generate_world(kind: str, area: float, *, seed: int, resolution: float = 0.0
     for _ in range(_MAX_PASSES if area > 2000 else 2 * _MAX_PASSES):
         built = build_grid(spec, shape_area, gross, seed, resolution)
         ratio = built.free_area / area
-        _log.debug("%s %g m^2 seed %d: footprint %.0f m^2 -> free %.0f m^2 (%.3f of the request)",
-                   kind, area, seed, gross, built.free_area, ratio)
+        _log.debug(
+            "%s %g m^2 seed %d: footprint %.0f m^2 -> free %.0f m^2 (%.3f of the request)",
+            kind,
+            area,
+            seed,
+            gross,
+            built.free_area,
+            ratio,
+        )
         if best is None or abs(math.log(ratio)) < abs(math.log(best.free_area / area)):
             best = built
         if abs(ratio - 1.0) <= _TOLERANCE:

@@ -20,7 +20,7 @@ from slamtrials.worlds.generate.furniture import furnish_room
 from slamtrials.worlds.generate.kinds import KindSpec
 from slamtrials.worlds.generate.placement import Placer
 from slamtrials.worlds.generate.raster import CIRCULATION, Grid, draw_walls, paint_labels, wall_pixels
-from slamtrials.worlds.generate.rooms import neighbour_of, clean_labels, merge_room
+from slamtrials.worlds.generate.rooms import clean_labels, merge_room, neighbour_of
 from slamtrials.worlds.generate.skeleton import build_plan, choose_shape
 
 __all__ = ["Built", "build_grid", "keep_largest_region"]
@@ -187,7 +187,14 @@ def build_grid(spec: KindSpec, shape_area: float, gross: float, seed: int, resol
             continue
         present += 1
         r0, c0 = box[0].start, box[1].start
-        furnish_room(placer, k, (r0 + int(rows[0]), r0 + int(rows[-1]) + 1, c0 + int(cols[0]), c0 + int(cols[-1]) + 1), use, style, rng)
+        furnish_room(
+            placer,
+            k,
+            (r0 + int(rows[0]), r0 + int(rows[-1]) + 1, c0 + int(cols[0]), c0 + int(cols[-1]) + 1),
+            use,
+            style,
+            rng,
+        )
     keep_largest_region(occupied)
     start = _start_pose(occupied, labels, grid)
     footprint = float(np.count_nonzero(labels)) * resolution**2

@@ -37,12 +37,11 @@ MIX = {
 
 def _wall_rows(occ: np.ndarray, centre: int, col: int, reach: int) -> tuple[int, int]:
     """Rows of the first occupied cells above and below ``centre`` in column ``col`` (-1 if none in reach)."""
-    top = occ[max(0, centre - reach):centre, col]
-    bottom = occ[centre:centre + reach, col]
+    top = occ[max(0, centre - reach) : centre, col]
+    bottom = occ[centre : centre + reach, col]
     up = np.flatnonzero(top)
     down = np.flatnonzero(bottom)
-    return (max(0, centre - reach) + int(up[-1]) if len(up) else -1,
-            centre + int(down[0]) if len(down) else -1)
+    return (max(0, centre - reach) + int(up[-1]) if len(up) else -1, centre + int(down[0]) if len(down) else -1)
 
 
 def _corridor(p: Placer, rows: slice, cols: slice, horizontal: bool, style: str, rng: np.random.Generator) -> None:
@@ -92,6 +91,11 @@ def furnish_circulation(p: Placer, plan: Plan, rng: np.random.Generator) -> None
         if not inside.any():
             continue
         r_idx, c_idx = np.flatnonzero(inside.any(axis=1)), np.flatnonzero(inside.any(axis=0))
-        box = (rows.start + int(r_idx[0]), rows.start + int(r_idx[-1]) + 1, cols.start + int(c_idx[0]), cols.start + int(c_idx[-1]) + 1)
+        box = (
+            rows.start + int(r_idx[0]),
+            rows.start + int(r_idx[-1]) + 1,
+            cols.start + int(c_idx[0]),
+            cols.start + int(c_idx[-1]) + 1,
+        )
         pillars(p, CIRCULATION, box, rng, spacing=float(rng.uniform(4.5, 7.0)))
         along_walls(p, CIRCULATION, box, rng, 3, (1.2, 2.5), (0.4, 0.6))

@@ -91,7 +91,9 @@ def _door_cells(width: float, grid: Grid) -> int:
     return int(math.ceil(max(width, MIN_DOOR) / grid.resolution - 1e-6))
 
 
-def _place(segs: Segments, s: int, n: int, margin: int, rng: np.random.Generator, avoid: list[tuple[int, int]] = ()) -> Door | None:
+def _place(
+    segs: Segments, s: int, n: int, margin: int, rng: np.random.Generator, avoid: list[tuple[int, int]] = ()
+) -> Door | None:
     """A door of ``n`` cells on segment ``s``, ``margin`` cells clear of its ends and of ``avoid`` spans."""
     lo, hi = int(segs.start[s]) + margin, int(segs.stop[s]) - margin - n
     if hi < lo:
@@ -109,8 +111,14 @@ def _place(segs: Segments, s: int, n: int, margin: int, rng: np.random.Generator
     return None
 
 
-def plan_doors(labels: NDArray[np.int32], uses: list[tuple[str, str]], boxes: dict[int, tuple[slice, slice]],
-               grid: Grid, wall_k: int, rng: np.random.Generator) -> tuple[list[Door], list[int]]:
+def plan_doors(
+    labels: NDArray[np.int32],
+    uses: list[tuple[str, str]],
+    boxes: dict[int, tuple[slice, slice]],
+    grid: Grid,
+    wall_k: int,
+    rng: np.random.Generator,
+) -> tuple[list[Door], list[int]]:
     """Choose the doors of every room (``boxes``: label -> bounding box of the rooms present).
 
     Returns the doors and the rooms that could not be given a way in (to be merged by the caller).
@@ -189,7 +197,9 @@ def door_box(door: Door, wall_k: int, across: int = 0, along: int = 0) -> tuple[
     return slice(c0, c1), slice(a0, a1)
 
 
-def carve_doors(occupied: NDArray[np.bool_], doors: list[Door], grid: Grid, wall_k: int) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+def carve_doors(
+    occupied: NDArray[np.bool_], doors: list[Door], grid: Grid, wall_k: int
+) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
     """Open every door in ``occupied`` (in place).
 
     Returns the mask of door cells and the *reserved* mask: the opening plus 1.2 m on both sides of
@@ -203,7 +213,7 @@ def carve_doors(occupied: NDArray[np.bool_], doors: list[Door], grid: Grid, wall
         occupied[box] = False
         door_mask[box] = True
         rows, cols = door_box(door, wall_k, across=deep, along=side)
-        reserved[max(0, rows.start):rows.stop, max(0, cols.start):cols.stop] = True
+        reserved[max(0, rows.start) : rows.stop, max(0, cols.start) : cols.stop] = True
     return door_mask, reserved
 
 

@@ -32,8 +32,16 @@ def _side(rng: np.random.Generator) -> str:
     return SIDES[int(rng.integers(4))]
 
 
-def along_walls(p: Placer, label: int, box: Box, rng: np.random.Generator, count: int,
-                length: tuple[float, float], depth: tuple[float, float], tries: int = 6) -> int:
+def along_walls(
+    p: Placer,
+    label: int,
+    box: Box,
+    rng: np.random.Generator,
+    count: int,
+    length: tuple[float, float],
+    depth: tuple[float, float],
+    tries: int = 6,
+) -> int:
     """Up to ``count`` items against random walls; returns how many went in."""
     done = 0
     for _ in range(count * tries):
@@ -43,8 +51,17 @@ def along_walls(p: Placer, label: int, box: Box, rng: np.random.Generator, count
     return done
 
 
-def island_grid(p: Placer, label: int, box: Box, rng: np.random.Generator, item: tuple[float, float],
-                aisle: float, gap: float = 1.0, skip: float = 0.0, round_: bool = False) -> int:
+def island_grid(
+    p: Placer,
+    label: int,
+    box: Box,
+    rng: np.random.Generator,
+    item: tuple[float, float],
+    aisle: float,
+    gap: float = 1.0,
+    skip: float = 0.0,
+    round_: bool = False,
+) -> int:
     """Free-standing items of ``item = (rows_m, cols_m)`` on a grid with ``aisle`` m between them."""
     r0, r1, c0, c1 = box
     h, w = p.px(item[0]), p.px(item[1])
@@ -179,8 +196,9 @@ def _house(p: Placer, label: int, box: Box, rng: np.random.Generator) -> None:
         along_walls(p, label, box, rng, 2, (0.8, 1.7), (0.5, 0.75))
     elif area < 16.0 and rng.random() < 0.75:  # bedroom or kitchen
         if rng.random() < 0.7:
-            p.against(label, box, _side(rng), _u(rng, 1.4, 1.6), 2.0, _where(rng)) or \
-                p.against(label, box, _side(rng), _u(rng, 0.9, 1.2), 2.0, _where(rng))
+            p.against(label, box, _side(rng), _u(rng, 1.4, 1.6), 2.0, _where(rng)) or p.against(
+                label, box, _side(rng), _u(rng, 0.9, 1.2), 2.0, _where(rng)
+            )
             along_walls(p, label, box, rng, 2, (1.0, 2.0), (0.5, 0.6))
         else:
             along_walls(p, label, box, rng, 3, (1.5, 3.0), (0.6, 0.6))
@@ -192,10 +210,22 @@ def _house(p: Placer, label: int, box: Box, rng: np.random.Generator) -> None:
 
 #: (style, role) -> recipe. Roles: "small", "room", "big", "hall".
 RECIPES: dict[tuple[str, str], Recipe] = {
-    ("office", "small"): _office, ("office", "room"): _office, ("office", "big"): _open_plan, ("office", "hall"): _open_plan,
-    ("school", "small"): _school_small, ("school", "room"): _classroom, ("school", "big"): _classroom, ("school", "hall"): _school_hall,
-    ("lab", "small"): _lab, ("lab", "room"): _lab, ("lab", "big"): _lab, ("lab", "hall"): _workshop,
-    ("house", "small"): _house, ("house", "room"): _house, ("house", "big"): _house, ("house", "hall"): _house,
+    ("office", "small"): _office,
+    ("office", "room"): _office,
+    ("office", "big"): _open_plan,
+    ("office", "hall"): _open_plan,
+    ("school", "small"): _school_small,
+    ("school", "room"): _classroom,
+    ("school", "big"): _classroom,
+    ("school", "hall"): _school_hall,
+    ("lab", "small"): _lab,
+    ("lab", "room"): _lab,
+    ("lab", "big"): _lab,
+    ("lab", "hall"): _workshop,
+    ("house", "small"): _house,
+    ("house", "room"): _house,
+    ("house", "big"): _house,
+    ("house", "hall"): _house,
 }
 
 

@@ -60,14 +60,58 @@ class Style:
 
 
 STYLES: dict[str, Style] = {
-    "office": Style("office", corridor=(1.8, 2.4), depth=(4.0, 5.8), room_width=(2.8, 5.0), big_room_prob=0.15,
-                    small_room_prob=0.12, door=(0.9, 1.1), hall_prob=0.5, lobby_prob=0.7, connect_prob=0.12, recess_prob=0.15),
-    "school": Style("school", corridor=(2.4, 3.0), depth=(6.5, 8.5), room_width=(6.5, 9.0), big_room_prob=0.1,
-                    small_room_prob=0.25, door=(1.0, 1.3), hall_prob=0.7, lobby_prob=0.8, connect_prob=0.05, recess_prob=0.2),
-    "lab": Style("lab", corridor=(2.0, 2.6), depth=(5.5, 7.5), room_width=(4.0, 7.5), big_room_prob=0.25,
-                 small_room_prob=0.15, door=(1.0, 1.4), hall_prob=0.5, lobby_prob=0.5, connect_prob=0.2, recess_prob=0.15),
-    "house": Style("house", corridor=(1.2, 1.5), depth=(3.0, 4.5), room_width=(2.6, 4.5), big_room_prob=0.2,
-                   small_room_prob=0.2, door=(0.9, 1.0), hall_prob=0.0, lobby_prob=0.0, connect_prob=0.1, recess_prob=0.0),
+    "office": Style(
+        "office",
+        corridor=(1.8, 2.4),
+        depth=(4.0, 5.8),
+        room_width=(2.8, 5.0),
+        big_room_prob=0.15,
+        small_room_prob=0.12,
+        door=(0.9, 1.1),
+        hall_prob=0.5,
+        lobby_prob=0.7,
+        connect_prob=0.12,
+        recess_prob=0.15,
+    ),
+    "school": Style(
+        "school",
+        corridor=(2.4, 3.0),
+        depth=(6.5, 8.5),
+        room_width=(6.5, 9.0),
+        big_room_prob=0.1,
+        small_room_prob=0.25,
+        door=(1.0, 1.3),
+        hall_prob=0.7,
+        lobby_prob=0.8,
+        connect_prob=0.05,
+        recess_prob=0.2,
+    ),
+    "lab": Style(
+        "lab",
+        corridor=(2.0, 2.6),
+        depth=(5.5, 7.5),
+        room_width=(4.0, 7.5),
+        big_room_prob=0.25,
+        small_room_prob=0.15,
+        door=(1.0, 1.4),
+        hall_prob=0.5,
+        lobby_prob=0.5,
+        connect_prob=0.2,
+        recess_prob=0.15,
+    ),
+    "house": Style(
+        "house",
+        corridor=(1.2, 1.5),
+        depth=(3.0, 4.5),
+        room_width=(2.6, 4.5),
+        big_room_prob=0.2,
+        small_room_prob=0.2,
+        door=(0.9, 1.0),
+        hall_prob=0.0,
+        lobby_prob=0.0,
+        connect_prob=0.1,
+        recess_prob=0.0,
+    ),
 }
 
 
@@ -97,11 +141,33 @@ class KindSpec:
 
 
 KINDS: dict[str, KindSpec] = {
-    "office": KindSpec("office", "offices and meeting rooms off corridors, open-plan areas with cubicles", ("office",), (80.0, 12000.0), 0.84),
-    "school": KindSpec("school", "long wide corridors with lockers, large classrooms, gym or library halls", ("school",), (150.0, 12000.0), 0.86),
-    "lab": KindSpec("lab", "laboratories full of benches, tables and cabinets, workshop halls", ("lab",), (80.0, 12000.0), 0.79),
-    "multiwing": KindSpec("multiwing", "several wings (L, T, U, H, comb shapes) joined by corridors, mixed use", ("office", "school", "lab"), (1000.0, 15000.0), 0.85),
-    "house": KindSpec("house", "a small house or flat: hallway, bedrooms, living room, kitchen", ("house",), (50.0, 400.0), 0.79),
+    "office": KindSpec(
+        "office",
+        "offices and meeting rooms off corridors, open-plan areas with cubicles",
+        ("office",),
+        (80.0, 12000.0),
+        0.84,
+    ),
+    "school": KindSpec(
+        "school",
+        "long wide corridors with lockers, large classrooms, gym or library halls",
+        ("school",),
+        (150.0, 12000.0),
+        0.86,
+    ),
+    "lab": KindSpec(
+        "lab", "laboratories full of benches, tables and cabinets, workshop halls", ("lab",), (80.0, 12000.0), 0.79
+    ),
+    "multiwing": KindSpec(
+        "multiwing",
+        "several wings (L, T, U, H, comb shapes) joined by corridors, mixed use",
+        ("office", "school", "lab"),
+        (1000.0, 15000.0),
+        0.85,
+    ),
+    "house": KindSpec(
+        "house", "a small house or flat: hallway, bedrooms, living room, kitchen", ("house",), (50.0, 400.0), 0.79
+    ),
 }
 
 #: Names of the building kinds, in a stable order.

@@ -124,8 +124,17 @@ def room_widths(length: float, style: Style, rng: np.random.Generator) -> list[t
     return pieces
 
 
-def _strip(wing: Wing, plan: Plan, u0: float, u1: float, v0: float, v1: float, rng: np.random.Generator,
-           corridor_side: int | None, shaft_prob: float = 0.0) -> list[float]:
+def _strip(
+    wing: Wing,
+    plan: Plan,
+    u0: float,
+    u1: float,
+    v0: float,
+    v1: float,
+    rng: np.random.Generator,
+    corridor_side: int | None,
+    shaft_prob: float = 0.0,
+) -> list[float]:
     """Partition ``[u0, u1] x [v0, v1]`` into rooms side by side along u; return the inner boundaries."""
     u = u0
     bounds = []
@@ -202,7 +211,9 @@ def wing_plan(wing: Wing, rng: np.random.Generator) -> Plan:
         first, last = wing.band_range(corridors[0])[0], wing.band_range(corridors[-1])[1]
         cross_axis = "y" if wing.horizontal else "x"
         for c in wing.cross:
-            plan.corridors.append((wing.rect(c - corridor_width / 2, first, c + corridor_width / 2, last), cross_axis, wing.style.name))
+            plan.corridors.append(
+                (wing.rect(c - corridor_width / 2, first, c + corridor_width / 2, last), cross_axis, wing.style.name)
+            )
     if wing.lobby and length - a0 - a1 > 14.0:
         _lobby(wing, plan, rng)
     return plan

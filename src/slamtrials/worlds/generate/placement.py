@@ -70,19 +70,33 @@ class Placer:
         self.walls = self.occupied.copy()
         self.clear = np.zeros_like(self.occupied)
 
-    def _zones(self, r0: int, r1: int, c0: int, c1: int, back: str, g: int) -> tuple[tuple[int, int, int, int], tuple[int, int, int, int]]:
+    def _zones(
+        self, r0: int, r1: int, c0: int, c1: int, back: str, g: int
+    ) -> tuple[tuple[int, int, int, int], tuple[int, int, int, int]]:
         """(strict zone, widened zone) of an item, as (r0, r1, c0, c1); the strict zone must hold no wall."""
         if not back:
             box = (r0 - g, r1 + g, c0 - g, c1 + g)
             return box, box
         if len(back) == 1:
-            front = {"N": (r1, r1 + g, c0, c1), "S": (r0 - g, r0, c0, c1),
-                     "W": (r0, r1, c1, c1 + g), "E": (r0, r1, c0 - g, c0)}[back]
-            wide = {"N": (r1, r1 + g, c0 - g, c1 + g), "S": (r0 - g, r0, c0 - g, c1 + g),
-                    "W": (r0 - g, r1 + g, c1, c1 + g), "E": (r0 - g, r1 + g, c0 - g, c0)}[back]
+            front = {
+                "N": (r1, r1 + g, c0, c1),
+                "S": (r0 - g, r0, c0, c1),
+                "W": (r0, r1, c1, c1 + g),
+                "E": (r0, r1, c0 - g, c0),
+            }[back]
+            wide = {
+                "N": (r1, r1 + g, c0 - g, c1 + g),
+                "S": (r0 - g, r0, c0 - g, c1 + g),
+                "W": (r0 - g, r1 + g, c1, c1 + g),
+                "E": (r0 - g, r1 + g, c0 - g, c0),
+            }[back]
             return front, wide
-        box = (r0 - (g if "S" in back else 0), r1 + (g if "N" in back else 0),
-               c0 - (g if "E" in back else 0), c1 + (g if "W" in back else 0))
+        box = (
+            r0 - (g if "S" in back else 0),
+            r1 + (g if "N" in back else 0),
+            c0 - (g if "E" in back else 0),
+            c1 + (g if "W" in back else 0),
+        )
         return box, box
 
     def _sides_ok(self, r0: int, r1: int, c0: int, c1: int, back: str, g: int) -> bool:
@@ -95,10 +109,10 @@ class Placer:
             r0, r1, c0, c1 = c0, c1, r0, r1
             back = "N" if back == "W" else "S"
         rows = slice(r0, r1 + g) if back == "N" else slice(r0 - g, r1)
-        blocked = np.flatnonzero(occ[rows, c0 - g:c0].any(axis=0))
+        blocked = np.flatnonzero(occ[rows, c0 - g : c0].any(axis=0))
         if len(blocked) and not occ[r0:r1, c0 - g + int(blocked[-1])].all():
             return False
-        blocked = np.flatnonzero(occ[rows, c1:c1 + g].any(axis=0))
+        blocked = np.flatnonzero(occ[rows, c1 : c1 + g].any(axis=0))
         return not (len(blocked) and not occ[r0:r1, c1 + int(blocked[0])].all())
 
     def fits(self, label: int, r0: int, c0: int, h: int, w: int, back: str = "", gap: float = 1.0) -> bool:
@@ -124,9 +138,11 @@ class Placer:
         if not all(behind[side].all() for side in back):
             return False
         rg = self.px(0.3)
-        return not self.reserved[max(0, r0 - rg):r1 + rg, max(0, c0 - rg):c1 + rg].any()
+        return not self.reserved[max(0, r0 - rg) : r1 + rg, max(0, c0 - rg) : c1 + rg].any()
 
-    def put(self, label: int, r0: int, c0: int, h: int, w: int, back: str = "", gap: float = 1.0, round_: bool = False) -> bool:
+    def put(
+        self, label: int, r0: int, c0: int, h: int, w: int, back: str = "", gap: float = 1.0, round_: bool = False
+    ) -> bool:
         """Place the item if it fits; ``round_`` draws the inscribed ellipse instead of the rectangle."""
         if h < 1 or w < 1 or not self.fits(label, r0, c0, h, w, back, gap):
             return False
@@ -134,17 +150,25 @@ class Placer:
             yy, xx = np.ogrid[:h, :w]
             cy, cx = (h - 1) / 2.0, (w - 1) / 2.0
             disk = ((yy - cy) / max(h / 2.0, 0.5)) ** 2 + ((xx - cx) / max(w / 2.0, 0.5)) ** 2 <= 1.0
-            self.occupied[r0:r0 + h, c0:c0 + w] |= disk
+            self.occupied[r0 : r0 + h, c0 : c0 + w] |= disk
         else:
-            self.occupied[r0:r0 + h, c0:c0 + w] = True
+            self.occupied[r0 : r0 + h, c0 : c0 + w] = True
         _strict, wide = self._zones(r0, r0 + h, c0, c0 + w, back, self.px(gap))
         zone = (slice(wide[0], wide[1]), slice(wide[2], wide[3]))
         self.clear[zone] |= (self.labels[zone] == label) & ~self.occupied[zone]
         self.placed += 1
         return True
 
-    def against(self, label: int, box: tuple[int, int, int, int], side: str, length: float, depth: float,
-                where: float | str, gap: float = 1.0) -> bool:
+    def against(
+        self,
+        label: int,
+        box: tuple[int, int, int, int],
+        side: str,
+        length: float,
+        depth: float,
+        where: float | str,
+        gap: float = 1.0,
+    ) -> bool:
         """An item ``length`` m along wall ``side`` of the room box ``(r0, r1, c0, c1)``, ``depth`` m deep.
 
         ``where`` is a fraction 0..1 along the wall, or ``"start"``/``"end"`` to sit in a corner.

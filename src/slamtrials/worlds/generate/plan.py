@@ -39,7 +39,7 @@ class Rect:
         """Area (m^2)."""
         return max(0.0, self.width) * max(0.0, self.height)
 
-    def shifted(self, dx: float, dy: float) -> "Rect":
+    def shifted(self, dx: float, dy: float) -> Rect:
         """The rectangle moved by (dx, dy) metres."""
         return Rect(self.x0 + dx, self.y0 + dy, self.x1 + dx, self.y1 + dy)
 
@@ -86,9 +86,11 @@ class Plan:
     def bounds(self) -> Rect:
         """The bounding rectangle of every room and circulation area."""
         rects = [r.rect for r in self.rooms] + [c[0] for c in self.corridors] + [lob[0] for lob in self.lobbies]
-        return Rect(min(r.x0 for r in rects), min(r.y0 for r in rects), max(r.x1 for r in rects), max(r.y1 for r in rects))
+        return Rect(
+            min(r.x0 for r in rects), min(r.y0 for r in rects), max(r.x1 for r in rects), max(r.y1 for r in rects)
+        )
 
-    def shifted(self, dx: float, dy: float) -> "Plan":
+    def shifted(self, dx: float, dy: float) -> Plan:
         """The plan moved by (dx, dy) metres."""
         return Plan(
             rooms=[RoomSpec(r.rect.shifted(dx, dy), r.use, r.style) for r in self.rooms],
@@ -98,7 +100,7 @@ class Plan:
             shape=self.shape,
         )
 
-    def extend(self, other: "Plan") -> None:
+    def extend(self, other: Plan) -> None:
         """Append another plan's rooms and circulation to this one."""
         self.rooms.extend(other.rooms)
         self.corridors.extend(other.corridors)

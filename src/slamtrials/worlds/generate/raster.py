@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
+
 from slamtrials.worlds.generate.plan import Plan, Rect
 
 __all__ = ["Grid", "CIRCULATION", "OUTSIDE", "paint_labels", "draw_walls", "wall_pixels"]
@@ -35,7 +36,7 @@ class Grid:
     margin: float
 
     @classmethod
-    def for_plan(cls, plan: Plan, resolution: float, margin: float = 1.0) -> "Grid":
+    def for_plan(cls, plan: Plan, resolution: float, margin: float = 1.0) -> Grid:
         """A grid covering the plan's bounds (which start at 0, 0) plus the margin."""
         box = plan.bounds()
         cols = int(math.ceil((box.x1 + 2 * margin) / resolution))

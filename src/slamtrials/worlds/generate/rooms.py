@@ -21,13 +21,17 @@ Box = tuple[slice, slice]
 def grow_box(box: Box, by: int, shape: tuple[int, int]) -> Box:
     """The box enlarged by ``by`` cells on every side, clipped to ``shape``."""
     rows, cols = box
-    return (slice(max(0, rows.start - by), min(shape[0], rows.stop + by)),
-            slice(max(0, cols.start - by), min(shape[1], cols.stop + by)))
+    return (
+        slice(max(0, rows.start - by), min(shape[0], rows.stop + by)),
+        slice(max(0, cols.start - by), min(shape[1], cols.stop + by)),
+    )
 
 
 def _union(a: Box, b: Box) -> Box:
-    return (slice(min(a[0].start, b[0].start), max(a[0].stop, b[0].stop)),
-            slice(min(a[1].start, b[1].start), max(a[1].stop, b[1].stop)))
+    return (
+        slice(min(a[0].start, b[0].start), max(a[0].stop, b[0].stop)),
+        slice(min(a[1].start, b[1].start), max(a[1].stop, b[1].stop)),
+    )
 
 
 def room_boxes(labels: NDArray[np.int32]) -> dict[int, Box]:
@@ -63,8 +67,9 @@ def _trim_thin(labels: NDArray[np.int32], boxes: dict[int, Box], size: int) -> N
     for label, box in boxes.items():
         window = labels[box]
         mask = (window == label).view(np.uint8)
-        opened = ndimage.maximum_filter(ndimage.minimum_filter(mask, size=size, mode="constant", cval=0), size=size,
-                                        mode="constant", cval=0)
+        opened = ndimage.maximum_filter(
+            ndimage.minimum_filter(mask, size=size, mode="constant", cval=0), size=size, mode="constant", cval=0
+        )
         window[(mask > opened)] = OUTSIDE
 
 
@@ -82,8 +87,10 @@ def _split_pieces(labels: NDArray[np.int32], uses: list[tuple[str, str]], boxes:
         keep = int(np.argmax(sizes)) + 1
         for part in range(1, count + 1):
             rows, cols = np.nonzero(parts == part)
-            sub = (slice(box[0].start + rows.min(), box[0].start + rows.max() + 1),
-                   slice(box[1].start + cols.min(), box[1].start + cols.max() + 1))
+            sub = (
+                slice(box[0].start + rows.min(), box[0].start + rows.max() + 1),
+                slice(box[1].start + cols.min(), box[1].start + cols.max() + 1),
+            )
             if part == keep:
                 boxes[label] = sub
                 continue
@@ -93,8 +100,9 @@ def _split_pieces(labels: NDArray[np.int32], uses: list[tuple[str, str]], boxes:
             boxes[new] = sub
 
 
-def clean_labels(labels: NDArray[np.int32], uses: list[tuple[str, str]], grid: Grid, *,
-                 min_area: float = 2.5, min_width: float = 1.2) -> dict[int, Box]:
+def clean_labels(
+    labels: NDArray[np.int32], uses: list[tuple[str, str]], grid: Grid, *, min_area: float = 2.5, min_width: float = 1.2
+) -> dict[int, Box]:
     """Make every room a clean, reachable shape.
 
     Parts of a room narrower than ``min_width`` metres (slivers left by corridors painted over room

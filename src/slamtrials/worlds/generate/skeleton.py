@@ -43,8 +43,13 @@ def _bands(style: Style, rng: np.random.Generator, corridors: int, single_loaded
             return (Band("rooms", _depth(style, rng)), Band("corridor", cw))
         return (Band("rooms", _depth(style, rng)), Band("corridor", cw), Band("rooms", _depth(style, rng)))
     core = float(rng.uniform(1.7, 2.3)) * (style.depth[0] + style.depth[1]) / 2 + WALL
-    return (Band("rooms", _depth(style, rng)), Band("corridor", cw), Band("core", core), Band("corridor", cw),
-            Band("rooms", _depth(style, rng)))
+    return (
+        Band("rooms", _depth(style, rng)),
+        Band("corridor", cw),
+        Band("core", core),
+        Band("corridor", cw),
+        Band("rooms", _depth(style, rng)),
+    )
 
 
 def _width(bands: tuple[Band, ...]) -> float:
@@ -116,7 +121,9 @@ def _single(spec: KindSpec, shape: str, design: float, gross: float, rng: np.ran
         wanted = corridors == 2 or draw < (0.9 if style.name == "house" else 0.6)
         end_depth.append(e if wanted and length > 2.5 * e + 6.0 else 0.0)
     cross = _cross(length, (end_depth[0], end_depth[1]), bands[1].depth, rng) if corridors == 2 else ()
-    wing = Wing(0.0, 0.0, True, length, bands, (end_depth[0], end_depth[1]), cross, style, lobby=rng.random() < style.lobby_prob)
+    wing = Wing(
+        0.0, 0.0, True, length, bands, (end_depth[0], end_depth[1]), cross, style, lobby=rng.random() < style.lobby_prob
+    )
     return wing_plan(wing, rng)
 
 
@@ -166,7 +173,11 @@ def _arm_sizes(layout, narrow, wide, spine_bands, design, gross, gaps, rng):
         return area / (ws + rho * float(np.sum(shares * widths)))
 
     bands = list(narrow)
-    if len(layout) <= 4 and design >= 4000 and spine_for(design, np.array([_width(b) for b in narrow])) > 1.6 * np.sqrt(design):
+    if (
+        len(layout) <= 4
+        and design >= 4000
+        and spine_for(design, np.array([_width(b) for b in narrow])) > 1.6 * np.sqrt(design)
+    ):
         bands = list(wide)
     wa = np.array([_width(b) for b in bands])
     spine_len = spine_for(gross, wa)
@@ -175,7 +186,9 @@ def _arm_sizes(layout, narrow, wide, spine_bands, design, gross, gaps, rng):
     for side in (+1, -1):
         on_side = [i for i, (_, s) in enumerate(layout) if s == side]
         if on_side:
-            need = max(need, float(np.sum(wa[on_side])) + gaps * (len(on_side) - 1) + (0.0 if len(on_side) > 1 else 4.0))
+            need = max(
+                need, float(np.sum(wa[on_side])) + gaps * (len(on_side) - 1) + (0.0 if len(on_side) > 1 else 4.0)
+            )
     if spine_len < need:
         spine_len = need
         rest = max(gross - ws * spine_len, 0.15 * gross)
@@ -219,7 +232,9 @@ def _arms(spec: KindSpec, shape: str, design: float, gross: float, rng: np.rando
             end_depth[k] = float(rng.uniform(0.9, 1.2)) * spine_bands[0].depth
     ends = (end_depth[0], end_depth[1])
     cross = _cross(spine_len, ends, spine_bands[1].depth, rng) if len(spine_bands) > 3 else ()
-    spine = Wing(0.0, 0.0, True, spine_len, spine_bands, ends, cross, spine_style, lobby=rng.random() < spine_style.lobby_prob)
+    spine = Wing(
+        0.0, 0.0, True, spine_len, spine_bands, ends, cross, spine_style, lobby=rng.random() < spine_style.lobby_prob
+    )
     plan = wing_plan(spine, rng)
     spine_corr = [spine.band_range(i) for i in spine.corridor_indices()]
     for (_pos, side), bands, style, centre, length in zip(layout, arm_bands, arm_styles, centres, arm_len):
@@ -240,7 +255,11 @@ def _arms(spec: KindSpec, shape: str, design: float, gross: float, rng: np.rando
             c0, c1 = arm.band_range(arm.corridor_indices()[0])
             cx0, cx1 = x0 + c0, x0 + c1
             grow_x, grow_y = float(rng.uniform(1.5, 3.5)), float(rng.uniform(1.5, 3.5))
-            lobby = Rect(max(0.0, cx0 - grow_x), sy0 - (grow_y if side < 0 else 0.0),
-                         min(spine_len, cx1 + grow_x), sy1 + (grow_y if side > 0 else 0.0))
+            lobby = Rect(
+                max(0.0, cx0 - grow_x),
+                sy0 - (grow_y if side < 0 else 0.0),
+                min(spine_len, cx1 + grow_x),
+                sy1 + (grow_y if side > 0 else 0.0),
+            )
             plan.lobbies.append((lobby, style.name))
     return plan

@@ -32,7 +32,7 @@ from slamtrials.metric.matching import DEFAULT_TOLERANCE, relations_meet
 from slamtrials.metric.relerrors import evaluate_relations
 from slamtrials.metric.runcount import runs_needed
 from slamtrials.metric.stats import EnvironmentStats, environment_stats
-from slamtrials.record import OccupancyGrid, Relations, RunRecord, Trajectory
+from slamtrials.record import OccupancyGrid, Relations, RunRecord
 from slamtrials.slam.offline import run_over_recording
 
 __all__ = [
@@ -207,8 +207,7 @@ def _one_run(record: RunRecord, relations: Relations, settings: RepeatSettings, 
     started = time.perf_counter()
     result = run_over_recording(record, s.algorithm, preset=s.preset, overrides=s.overrides, seed=seed)
     seconds = time.perf_counter() - started
-    estimate = Trajectory(t=result.trajectory.t, poses=result.trajectory.poses)
-    errors = evaluate_relations(estimate, relations, tolerance=s.tolerance, allow_outside=True)
+    errors = evaluate_relations(result.trajectory, relations, tolerance=s.tolerance, allow_outside=True)
     if len(errors) == 0:
         raise MetricError(f"seed {seed}: no relation matched a pose of the estimate within {s.tolerance:g} s")
     return RepeatedRun(
@@ -255,6 +254,8 @@ def repeat_slam(
     ConfigError
         Bad settings, a recording without frames, or relations that do not belong to the recording.
     """
+    from distributed import as_completed
+
     from slamtrials.campaign.cluster import dask_client
     from slamtrials.slam import get_algorithm, resolve_config
 
@@ -275,7 +276,7 @@ def repeat_slam(
 
         def run_seeds(seeds: range, planned: int) -> None:
             futures = [client.submit(_one_run, shared, relations, settings, seed, pure=False) for seed in seeds]
-            for future in _as_completed(futures):
+            for future in as_completed(futures):
                 run = future.result()
                 done[run.seed] = run
                 if on_run is not None:
@@ -318,12 +319,6 @@ def repeat_slam(
         source=source,
         relations_source=relations_source,
     )
-
-
-def _as_completed(futures: list[Any]) -> Any:
-    from distributed import as_completed
-
-    return as_completed(futures)
 
 
 def write_repeat_outputs(result: RepeatedSlam, out_dir: str | Path, *, overwrite: bool = False) -> list[Path]:

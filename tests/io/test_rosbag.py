@@ -220,7 +220,7 @@ def test_ros1_reader_sees_the_stage_layout(tmp_path):
     stamps = origin + np.rint(record.t * 1e9).astype(np.int64)
 
     info = json.loads(by_topic["/slamtrials/run"][0]["msg"]["data"])
-    assert info["time_origin_ns"] == origin and info["laser"] == record.laser
+    assert info["time_origin_ns"] == origin and info["laser"] == record.laser.to_dict()
 
     laser = record.laser
     beams = record.scans.shape[1]

@@ -50,7 +50,7 @@ def test_a_changed_config_dumps_and_loads_back_equal():
         {
             "worlds": ["a.yaml", "b"],
             "seed": 12,
-            "runs": {"initial": 3, "max_runs": 7},
+            "runs": {"initial": 5, "max_runs": 7},
             "slam": {"algorithm": "gmapping", "params": {"particles": 5}},
             "sim": {"laser": {"mount": [0.1, 0.0, 0.2]}},
         }
@@ -108,8 +108,8 @@ def test_small_campaign_config():
     assert config.worlds == ["office_small_01", "lab_small_01", "house_small_01"]
     assert (config.runs.initial, config.runs.max_runs, config.seed) == (5, 10, 4)
     assert config.slam.algorithm == "gmapping" and config.slam.preset == "paper"
-    odometry = small_campaign_config(["room"], initial=2, max_runs=3, slam={"algorithm": "odometry", "preset": None})
-    assert odometry.slam.algorithm == "odometry" and odometry.runs.max_runs == 3
+    odometry = small_campaign_config(["room"], initial=5, max_runs=6, slam={"algorithm": "odometry", "preset": None})
+    assert odometry.slam.algorithm == "odometry" and odometry.runs.max_runs == 6
     with pytest.raises(ConfigError, match="max_runs"):
         small_campaign_config(initial=5, max_runs=3)
 

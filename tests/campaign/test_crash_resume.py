@@ -108,7 +108,7 @@ def test_a_crash_between_rename_and_commit_is_redone(tmp_path, rooms, client):
         {
             "worlds": rooms[:1],
             "seed": 2,
-            "runs": {"initial": 4, "max_runs": 4},
+            "runs": {"initial": 5, "max_runs": 5},
             "slam": {"algorithm": "odometry", "preset": None},
         }
     )

@@ -14,15 +14,19 @@ from slamtrials.metric import replay_run_count
 Z2 = 2.5758293035489004**2  # two-sided normal quantile of 99 %, squared
 
 
+#: The paper's rule: 10 runs first, normal quantile at 99 % (the default quantile is Student t).
+PAPER = RunSettings(distribution="normal")
+
+
 def alternating(n: int, mean: float = 0.3, half: float = 0.05) -> dict[int, tuple[float, float]]:
     """eps_t = mean +- half alternately (known sample variance), eps_r constant 0.01."""
     return {i: (mean + (half if i % 2 == 0 else -half), 0.01) for i in range(n)}
 
 
 def test_first_batch_is_the_initial_runs():
-    step = next_step({}, RunSettings())
+    step = next_step({}, PAPER)
     assert step.target == 10 and step.missing == tuple(range(10)) and not step.finished and step.decision is None
-    step = next_step({0: (0.1, 0.1), 3: (0.2, 0.1)}, RunSettings())
+    step = next_step({0: (0.1, 0.1), 3: (0.2, 0.1)}, PAPER)
     assert step.missing == (1, 2, 4, 5, 6, 7, 8, 9)
 
 
@@ -30,20 +34,20 @@ def test_hand_computed_run_counts():
     # 10 runs at 0.3 +- 0.05: s^2 = 10 * 0.0025 / 9, N_t = ceil(z^2 s^2 / 0.02^2) = ceil(46.08) = 47
     s2 = 10 * 0.0025 / 9
     assert math.ceil(Z2 * s2 / 0.0004) == 47
-    step = next_step(alternating(10), RunSettings())
+    step = next_step(alternating(10), PAPER)
     assert step.target == 47 and step.missing == tuple(range(10, 47)) and step.decision.needed == 47
     # with 47 runs (24 high, 23 low) s^2 = (47 * 0.0025 - 47 * (0.05 / 47)^2) / 46 -> N = ceil(42.35) = 43 <= 47: stop
     s2 = (47 * 0.0025 - 47 * (0.05 / 47) ** 2) / 46
     assert math.ceil(Z2 * s2 / 0.0004) == 43
-    step = next_step(alternating(47), RunSettings())
+    step = next_step(alternating(47), PAPER)
     assert step.finished and not step.capped and step.target == 47 and step.decision.needed == 43
     assert [d.done for d in step.history] == [10, 47]
     # results beyond the target do not change the decisions
-    assert next_step(alternating(80), RunSettings()) == step
+    assert next_step(alternating(80), PAPER) == step
 
 
 def test_enough_after_the_first_batch_when_the_spread_is_small():
-    step = next_step(alternating(10, half=0.005), RunSettings())
+    step = next_step(alternating(10, half=0.005), PAPER)
     assert step.finished and step.target == 10 and step.decision.needed == 10  # N_t = 1 but at least initial
 
 
@@ -57,7 +61,7 @@ def test_the_cap_stops_a_world_and_is_reported():
 
 def test_rotational_errors_count_too():
     results = {i: (0.3, 0.05 + (0.04 if i % 2 else -0.04)) for i in range(10)}
-    step = next_step(results, RunSettings())
+    step = next_step(results, PAPER)
     assert step.decision.needed_t <= 10 < step.decision.needed_r == step.target
 
 

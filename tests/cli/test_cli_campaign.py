@@ -44,7 +44,7 @@ def write_config(path, worlds, **changes):
         "worlds": worlds,
         "slam": {"algorithm": "odometry", "preset": None},
         "termination": {"small_period": 60.0, "max_time": 300.0},
-        "runs": {"initial": 2, "max_runs": 2},
+        "runs": {"initial": 5, "max_runs": 5},
         **changes,
     }
     path.write_text(yaml.safe_dump(data))
@@ -104,7 +104,7 @@ def test_a_small_real_campaign_status_resume_and_replay(tmp_path):
     result = runner.invoke(app, ["campaign", "run", str(config), "--out", str(out), "--workers", "1"])
     assert result.exit_code == 0, result.output
     assert (
-        "room: done with 2 runs" in result.output or "room: capped with 2 runs" in result.output
+        "room: done with 5 runs" in result.output or "room: capped with 5 runs" in result.output
     ) and "eps_t" in result.output
     assert f"summary: {out / 'summary.csv'}" in result.output.replace("\n", "")
     assert (out / "summary.csv").is_file() and (out / "runs" / "room" / "001" / "run.json").is_file()

@@ -15,7 +15,7 @@ def test_known_answer():
     """eps_t = 1..10 m: s^2 = 55/6; z(99 %) = 2.5758, z^2 s^2 / 1^2 = 6.6349 * 9.1667 = 60.82 -> 61 runs."""
     eps_t = np.arange(1.0, 11.0)
     eps_r = np.full(10, 0.05)  # no spread: N_r = 0
-    rc = runs_needed(eps_t, eps_r, margin_t=1.0, margin_r=0.01)
+    rc = runs_needed(eps_t, eps_r, margin_t=1.0, margin_r=0.01, distribution="normal")  # the paper's quantile
     assert rc.std_t == pytest.approx(math.sqrt(55 / 6))
     assert rc.std_r == 0.0
     assert (rc.needed_t, rc.needed_r, rc.needed, rc.done) == (61, 0, 61, 10)
@@ -26,7 +26,7 @@ def test_known_answer():
 def test_max_of_translation_and_rotation_and_the_floor_of_min_runs():
     eps_t = np.array([0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1])
     eps_r = np.array([0.0, 0.2] * 5)  # s^2 = 10/9 * 0.01
-    rc = runs_needed(eps_t, eps_r, margin_t=0.01, margin_r=0.05, confidence=0.95)
+    rc = runs_needed(eps_t, eps_r, margin_t=0.01, margin_r=0.05, confidence=0.95, distribution="normal")
     assert rc.needed_r == math.ceil(1.959964**2 * (0.01 * 10 / 9) / 0.05**2)  # 17.07 -> 18
     assert rc.needed == 18 and rc.needed_t == 0
     small = runs_needed(eps_t, eps_t, margin_t=0.01, margin_r=0.01)  # no spread at all: still 10 runs
@@ -57,11 +57,19 @@ def test_replay_stops_when_the_new_estimate_is_not_larger_than_the_runs_done():
     """Alternating errors +-1 around a mean: 10 runs ask for 18 (s^2 = 10/9); 18 runs ask for 17 (s^2 = 18/17): stop at 18."""
     eps_t = np.array([0.0, 2.0] * 50)
     eps_r = np.zeros(100)
-    first = runs_needed(eps_t[:10], eps_r[:10], margin_t=0.5, margin_r=0.1, confidence=0.95)
+    paper = {"margin_t": 0.5, "margin_r": 0.1, "confidence": 0.95, "distribution": "normal"}
+    first = runs_needed(eps_t[:10], eps_r[:10], **paper)
     assert first.needed == 18
-    final = replay_run_count(eps_t, eps_r, margin_t=0.5, margin_r=0.1, confidence=0.95)
+    final = replay_run_count(eps_t, eps_r, **paper)
     assert final is not None and final.done == 18 and final.needed == 17 and final.enough
-    assert replay_run_count(eps_t[:15], eps_r[:15], margin_t=0.5, margin_r=0.1, confidence=0.95) is None
+    assert replay_run_count(eps_t[:15], eps_r[:15], **paper) is None
+
+
+def test_the_default_quantile_is_student_t_with_runs_minus_one_degrees_of_freedom():
+    """10 runs, s^2 = 10/9 around 1: t(0.975, 9) = 2.2622 gives ceil(2.2622^2 * 10/9 / 0.25) = 23 runs (normal: 18)."""
+    eps_t = np.array([0.0, 2.0] * 5)
+    rc = runs_needed(eps_t, np.zeros(10), margin_t=0.5, margin_r=0.1, confidence=0.95)
+    assert rc.critical == pytest.approx(2.2622, abs=1e-4) and rc.needed == 23
 
 
 def test_bad_input():

@@ -53,13 +53,13 @@ def test_critical_value_refuses_bad_settings(kwargs, problem):
 
 
 def test_environment_stats_population_and_sample_forms():
-    s = environment_stats([1.0, 2.0, 3.0, 4.0], confidence=0.95)
+    s = environment_stats([1.0, 2.0, 3.0, 4.0], confidence=0.95, distribution="normal")
     assert s.n == 4 and s.mean == 2.5
     assert s.std_population == pytest.approx(math.sqrt(1.25))  # the paper's Definition III.3 (divisor |R_E|)
     assert s.std_sample == pytest.approx(math.sqrt(5 / 3))
     assert s.half_width == pytest.approx(1.959964 * math.sqrt(5 / 3) / 2, rel=1e-6)
     assert (s.ci_low, s.ci_high) == pytest.approx((2.5 - s.half_width, 2.5 + s.half_width))
-    t = environment_stats([1.0, 2.0, 3.0, 4.0], confidence=0.95, distribution="t")
+    t = environment_stats([1.0, 2.0, 3.0, 4.0], confidence=0.95)  # Student t by default
     assert t.half_width == pytest.approx(3.182446 * math.sqrt(5 / 3) / 2, rel=1e-6)
 
 

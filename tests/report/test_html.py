@@ -200,7 +200,7 @@ def test_rebuilding_removes_only_stale_figures(campaign, tmp_path):
 
 
 def test_a_campaign_without_finished_runs_still_renders(tmp_path):
-    folder = fake_campaign(tmp_path / "c", FailingIn(None), WORLDS[:2], initial=2, max_runs=2)
+    folder = fake_campaign(tmp_path / "c", FailingIn(None), WORLDS[:2], initial=5, max_runs=5)
     page = build_report(folder, pdf=False)
     parsed = Page(page.read_text(encoding="utf-8"))
     assert [r[0] for r in parsed.tables["summary-table"]] == WORLDS[:2]
@@ -275,10 +275,10 @@ def test_compare_report_verdicts_statistics_and_trap(two_levels, tmp_path):
 
 def test_compare_problems_are_config_errors(two_levels, tmp_path):
     a, _ = two_levels
-    other = fake_campaign(tmp_path / "elsewhere", FakeTrial(), [WORLDS[2]], initial=2, max_runs=2)
+    other = fake_campaign(tmp_path / "elsewhere", FakeTrial(), [WORLDS[2]], initial=5, max_runs=5)
     with pytest.raises(ConfigError, match="no world in common"):
         compare_report(a, other, tmp_path / "x")
-    empty = fake_campaign(tmp_path / "empty", FailingIn(None), WORLDS[:1], initial=2, max_runs=2)
+    empty = fake_campaign(tmp_path / "empty", FailingIn(None), WORLDS[:1], initial=5, max_runs=5)
     with pytest.raises(ConfigError, match="has no finished run"):
         compare_report(a, empty, tmp_path / "x")
     with pytest.raises(ConfigError, match="alpha"):
@@ -317,7 +317,7 @@ def real_campaign(tmp_path_factory):
             "worlds": worlds,
             "seed": 2,
             "termination": {"small_period": 60.0, "max_time": 300.0},
-            "runs": {"initial": 3, "max_runs": 3},
+            "runs": {"initial": 5, "max_runs": 5},
         }
     )
     with (
@@ -335,7 +335,7 @@ def test_report_of_a_real_campaign(real_campaign, tmp_path):
     page_path = build_report(folder, tmp_path / "report", repeats=40)
     page = Page(page_path.read_text(encoding="utf-8"))
     data = load_campaign(folder)
-    assert len(data.done) == 6 and set(data.done["termination"]) <= {"map_converged", "no_frontiers", "time_cap"}
+    assert len(data.done) == 10 and set(data.done["termination"]) <= {"map_converged", "no_frontiers", "time_cap"}
     assert [r[0] for r in page.tables["summary-table"]] == ["rooms_6m", "rooms_5m"]
     for src in page.images:
         assert (page_path.parent / src).read_bytes()[:8] == PNG_MAGIC

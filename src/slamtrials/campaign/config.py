@@ -18,7 +18,7 @@ import json
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, ValidationInfo, field_validator, model_validator
 
 from slamtrials.errors import ConfigError, FormatError, validation_problems
 from slamtrials.explore import ExploreConfig, TerminationConfig
@@ -33,6 +33,8 @@ __all__ = ["CampaignConfig", "MetricSettings", "RunSettings", "DEFAULT_MAX_RUNS"
 
 _MODEL_CONFIG = ConfigDict(extra="forbid", frozen=True)
 
+#: Smallest ``runs.initial`` of a new campaign (a stored one of an earlier version keeps its own).
+MIN_INITIAL_RUNS = 5
 #: Default cap on the runs of one world.
 DEFAULT_MAX_RUNS = 60
 #: Largest root seed (seeds are stored as SQLite 64-bit signed integers).
@@ -69,7 +71,10 @@ class RunSettings(BaseModel):
     model_config = _MODEL_CONFIG
 
     initial: int = Field(
-        DEFAULT_MIN_RUNS, ge=2, le=100_000, description="runs of the first variance estimate (10 in the paper)"
+        DEFAULT_MIN_RUNS,
+        ge=2,
+        le=100_000,
+        description=f"runs of the first variance estimate (10 in the paper; at least {MIN_INITIAL_RUNS})",
     )
     max_runs: int = Field(
         DEFAULT_MAX_RUNS,
@@ -84,10 +89,23 @@ class RunSettings(BaseModel):
     margin_r: float = Field(
         0.02, gt=0.0, le=3.2, description="margin of error of a world's mean rotational error (rad)"
     )
-    distribution: Literal["normal", "t"] = Field("normal", description="quantile of the confidence level: normal or t")
+    distribution: Literal["normal", "t"] = Field(
+        "t", description="quantile of the confidence level: t (R - 1 degrees of freedom) or normal (the paper's)"
+    )
     retries: int = Field(
         2, ge=0, le=100, description="times a run is retried when its worker dies or it fails unexpectedly"
     )
+
+    @field_validator("initial")
+    @classmethod
+    def _enough_initial_runs(cls, value: int, info: ValidationInfo) -> int:
+        # a stored campaign of an earlier version keeps the value it ran with
+        if value < MIN_INITIAL_RUNS and not (info.context or {}).get("stored"):
+            raise ValueError(
+                f"must be at least {MIN_INITIAL_RUNS}: with fewer runs the spread of the per-run errors is too "
+                "uncertain for the run-count rule (the interval's true coverage drops far below its confidence)"
+            )
+        return value
 
     @model_validator(mode="after")
     def _cap_not_below_initial(self) -> RunSettings:
@@ -191,7 +209,7 @@ class CampaignConfig(BaseModel):
         Campaigns stored before the explore section lost its robot fields (:data:`ROBOT_FIELDS`) carry
         them; those versions replaced them by ``sim.robot``'s values anyway, so they are dropped.
         """
-        return cls.model_validate(upgrade_stored_config(doc))
+        return cls.model_validate(upgrade_stored_config(doc), context={"stored": True})
 
     @classmethod
     def from_dict(cls, data: Any, *, source: str = "campaign config") -> CampaignConfig:

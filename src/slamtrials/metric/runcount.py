@@ -67,7 +67,7 @@ def runs_needed(
     margin_t: float,
     margin_r: float,
     confidence: float = 0.99,
-    distribution: Distribution = "normal",
+    distribution: Distribution = "t",
     sides: int = 2,
     min_runs: int = DEFAULT_MIN_RUNS,
     max_runs: int | None = None,
@@ -83,7 +83,8 @@ def runs_needed(
     confidence:
         Confidence level (default 0.99).
     distribution, sides:
-        Quantile: two-sided normal by default; ``"t"`` uses ``R - 1`` degrees of freedom.
+        Quantile: two-sided Student t with ``R - 1`` degrees of freedom by default; ``"normal"`` is the
+        paper's (too small with few runs).
     min_runs:
         Runs before the first variance estimate (10 in the paper; at least 2).
     max_runs:

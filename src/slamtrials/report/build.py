@@ -345,7 +345,7 @@ def _fig1(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame) -> str:
         fig = figs.new(min(4 + 0.18 * n, 14) * 2 / 1.6, 3.4)
         axes = fig.subplots(1, 2)
         for ax, metric in zip(axes, METRICS):
-            cf.draw_world_errors(ax, done, world, metric, confidence=data.confidence)
+            cf.draw_world_errors(ax, done, world, metric, confidence=data.confidence, distribution=data.distribution)
         gallery.append(
             figs.save(
                 fig,

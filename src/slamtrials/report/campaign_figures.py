@@ -22,6 +22,7 @@ from scipy import stats
 
 from slamtrials.geometry import as_poses, compose, inverse
 from slamtrials.metric.matching import DEFAULT_TOLERANCE
+from slamtrials.metric.quantiles import Distribution
 from slamtrials.metric.rule import SamplingRule
 from slamtrials.metric.sampling import sample_relations
 from slamtrials.metric.stats import environment_stats
@@ -92,9 +93,17 @@ def _world_values(runs: pd.DataFrame, world: str, metric: str) -> tuple[NDArray[
     return values[here], runs["run"].to_numpy()[here]
 
 
-def draw_world_errors(ax, runs: pd.DataFrame, world: str, metric: str = "eps_t", *, confidence: float = 0.99) -> None:
+def draw_world_errors(
+    ax,
+    runs: pd.DataFrame,
+    world: str,
+    metric: str = "eps_t",
+    *,
+    confidence: float = 0.99,
+    distribution: Distribution = "t",
+) -> None:
     """The runs' errors of one world as bars, largest first (the paper's Fig. 1), with the mean and its
-    confidence band (normal quantile, :func:`slamtrials.metric.stats.environment_stats`).
+    confidence band (quantile ``distribution``, :func:`slamtrials.metric.stats.environment_stats`).
 
     Bars are in ``ax.containers[0]``, labelled on the x axis by run index (up to 40 runs).
     """
@@ -102,7 +111,7 @@ def draw_world_errors(ax, runs: pd.DataFrame, world: str, metric: str = "eps_t",
     order = np.argsort(-values, kind="stable")
     x = np.arange(1, len(values) + 1)
     ax.bar(x, values[order], width=0.8, color="tab:blue", label="runs", gid="runs")
-    st = environment_stats(values, confidence=confidence)
+    st = environment_stats(values, confidence=confidence, distribution=distribution)
     unit = UNITS[metric]
     ax.axhline(st.mean, color="tab:red", lw=1.5, label=f"mean {st.mean:.3g} {unit}", gid="mean")
     if st.n >= 2:

@@ -58,7 +58,7 @@ import pandas as pd
 from slamtrials.atomicfile import atomic_write, atomic_write_text
 from slamtrials.campaign.store import DB_FILE, RUNS_DIR, STORE_FORMAT
 from slamtrials.errors import ConfigError, FormatError
-from slamtrials.metric.stats import environment_stats
+from slamtrials.metric.quantiles import Distribution
 from slamtrials.report.tables import METRICS, outlier_mask, world_summary
 
 __all__ = ["CampaignData", "load_campaign", "export_table", "RUN_COLUMNS", "WORLD_COLUMNS", "TABLES", "FORMATS"]
@@ -168,6 +168,11 @@ class CampaignData:
         """The confidence level of the worlds' intervals (``runs.confidence`` of the config)."""
         return float(self.config.get("runs", {}).get("confidence", 0.99))
 
+    @property
+    def distribution(self) -> Distribution:
+        """The quantile of the worlds' intervals (``runs.distribution`` of the config)."""
+        return "normal" if self.config.get("runs", {}).get("distribution") == "normal" else "t"
+
     def run_folder(self, world: str, run: int) -> Path:
         """The absolute folder of run ``run`` of ``world`` (as recorded in the catalog)."""
         rows = self.runs[(self.runs["world"] == world) & (self.runs["run"] == int(run))]
@@ -275,20 +280,13 @@ def _worlds_frame(rows: list[tuple], runs: pd.DataFrame, config: dict[str, Any])
         worlds[f"runs_{status}"] = worlds["world"].map(counts).fillna(0).astype("int64")
     settings = config.get("runs", {}) if isinstance(config.get("runs"), dict) else {}
     confidence = float(settings.get("confidence", 0.99))
-    distribution = settings.get("distribution", "normal")
+    distribution = settings.get("distribution", "t")
     done = runs[(runs["status"] == "done") & np.isfinite(runs["eps_t"]) & np.isfinite(runs["eps_r"])]
-    table = world_summary(done, confidence=confidence) if len(done) else pd.DataFrame(columns=["world"])
-    if distribution != "normal" and len(done):
-        for i, world in enumerate(table["world"]):
-            for metric in METRICS:
-                st = environment_stats(
-                    done.loc[done["world"] == world, metric], confidence=confidence, distribution=distribution
-                )
-                table.loc[i, [f"{metric}_ci_low", f"{metric}_ci_high", f"{metric}_half_width"]] = [
-                    st.ci_low,
-                    st.ci_high,
-                    st.half_width,
-                ]
+    table = (
+        world_summary(done, confidence=confidence, distribution=distribution)
+        if len(done)
+        else pd.DataFrame(columns=["world"])
+    )
     table = table.drop(columns=["runs", "confidence"], errors="ignore")
     worlds = worlds.merge(table, on="world", how="left")
     for metric in METRICS:

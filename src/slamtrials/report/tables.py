@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
+from slamtrials.metric.quantiles import Distribution
 from slamtrials.metric.stats import environment_stats
 
 __all__ = [
@@ -88,16 +89,16 @@ def world_outliers(runs: pd.DataFrame, metric: str = "eps_t") -> pd.Series:
     )
 
 
-def world_summary(runs: pd.DataFrame, confidence: float = 0.99) -> pd.DataFrame:
+def world_summary(runs: pd.DataFrame, confidence: float = 0.99, distribution: Distribution = "t") -> pd.DataFrame:
     """The paper's Table I for every world: runs, mean, spread and confidence interval of the errors.
 
     Parameters
     ----------
     runs:
         One row per finished run with columns ``world``, ``run``, ``eps_t`` (m), ``eps_r`` (rad).
-    confidence:
-        Confidence level of the intervals of the means (normal quantile, as
-        :func:`slamtrials.metric.stats.environment_stats` and the run-count rule use).
+    confidence, distribution:
+        Confidence level and quantile of the intervals of the means (Student t by default; use the
+        campaign's run-count rule's, :func:`slamtrials.metric.stats.environment_stats`).
 
     Returns
     -------
@@ -121,7 +122,7 @@ def world_summary(runs: pd.DataFrame, confidence: float = 0.99) -> pd.DataFrame:
         row: dict[str, object] = {"world": world, "runs": int(here.sum())}
         for metric in METRICS:
             v = values[metric][here]
-            stats = environment_stats(v, confidence=confidence)
+            stats = environment_stats(v, confidence=confidence, distribution=distribution)
             row.update(
                 {
                     f"{metric}_mean": stats.mean,

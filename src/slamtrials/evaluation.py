@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from enum import Enum
 from pathlib import Path
 
-from slamtrials.errors import FormatError, MetricError
+from slamtrials.errors import ConfigError, FormatError, MetricError
 from slamtrials.metric.matching import DEFAULT_TOLERANCE, RUN_TOLERANCE
 from slamtrials.metric.rule import SamplingRule
 from slamtrials.record import Relations, Trajectory
@@ -184,6 +184,18 @@ def _check_belong(relations: Relations, relations_path: Path, sources: dict[str,
     )
 
 
+def _check_covers(source: _Source, run_t, run: Path, tolerance: float) -> None:
+    """Refuse an estimate whose time span does not cover the run's: a trajectory of another run."""
+    t = source.trajectory.t
+    if len(t) == 0 or t[0] > run_t[0] + tolerance or t[-1] < run_t[-1] - tolerance:
+        span = f"{float(t[0])!r} to {float(t[-1])!r} s" if len(t) else "no poses"
+        raise FormatError(
+            source.path,
+            f"its poses span {span} but the run {run} spans {float(run_t[0])!r} to {float(run_t[-1])!r} s: "
+            "not an estimate of this run",
+        )
+
+
 def _with_lines(exc: MetricError, sources: dict[str, _Source], relations_path: Path | None) -> Exception:
     """Turn a MetricError that names an index into a FormatError that names the file and line."""
     if exc.what == "relations" and relations_path is not None and exc.index is not None:
@@ -316,6 +328,7 @@ def evaluate_run(
     tolerance: float = RUN_TOLERANCE,
     interpolate: bool = False,
     write: bool = True,
+    out: Path | None = None,
 ) -> EvaluationResult:
     """Sample relations from a run folder's ground truth and evaluate the run's estimate on them.
 
@@ -336,12 +349,19 @@ def evaluate_run(
         Matching options. The run's odometry carries ground-truth timestamps without an
         estimated pose within ``tolerance`` (default 1 ms: the same frame) to the nearest estimated pose.
     write:
-        Write ``relations.txt`` and ``errors.npz`` into the folder.
+        Write ``relations.txt`` and ``errors.npz``: into ``out``, by default a new folder
+        ``evaluations/<name>`` of the run (``<name>`` the estimate file's stem, ``estimate`` or
+        ``odometry``), never over the run's own files (a campaign's relations stay as they were scored).
+    out:
+        Folder to write them into (created); it must not hold them already.
 
     Raises
     ------
     FormatError
-        An unreadable run folder or estimate file, or data the metric refuses.
+        An unreadable run folder or estimate file, data the metric refuses, or an estimate file whose
+        timestamps do not cover the run's (a trajectory of another run).
+    ConfigError
+        ``out`` already holds relations.
     """
     from slamtrials.io.errorsfile import write_errors
     from slamtrials.io.relations import write_relations
@@ -358,6 +378,7 @@ def evaluate_run(
         estimate = files.estimate
     if estimate is not None:
         source = _read_trajectory(Path(estimate), estimate_pose, "estimate")
+        _check_covers(source, record.t, run, tolerance)
     elif record.estimate is not None:
         source = _Source(
             Trajectory(t=record.t, poses=record.estimate), files.frames, "run", f"{run} (the run's estimate)"
@@ -379,14 +400,22 @@ def evaluate_run(
     except MetricError as exc:
         raise _with_lines(exc, sources, None) from None
     written: tuple[Path, ...] = ()
-    relations_path = files.relations
+    name = (
+        Path(estimate).name.split(".")[0]
+        if estimate is not None
+        else ("estimate" if record.estimate is not None else "odometry")
+    )
+    target = RunFolder(Path(out) if out is not None else files.new_evaluation(name or "estimate"))
+    relations_path = target.relations
     if write:
+        if relations_path.exists():
+            raise ConfigError(f"{target.path}: already holds relations.txt; choose another --out")
         written = (
             write_relations(relations_path, sampled.relations),
-            write_errors(files.errors, sampled.relations, sampled.errors),
+            write_errors(target.errors, sampled.relations, sampled.errors),
         )
     trans, rot = _summaries(sampled.errors)
-    label = f"{files.relations if write else 'sampled'} ({len(sampled.relations)} relations sampled from the ground truth, seed {seed})"
+    label = f"{relations_path if write else 'sampled'} ({len(sampled.relations)} relations sampled from the ground truth, seed {seed})"
     return EvaluationResult(
         sampled.relations,
         sampled.errors,

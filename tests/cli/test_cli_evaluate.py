@@ -133,15 +133,40 @@ def test_run_folder_samples_relations_and_writes_them(tmp_path):
     result = runner.invoke(app, ["evaluate", str(folder), "--seed", "3", "--margin-t", "0.005", "--margin-r", "0.005"])
     assert result.exit_code == 0, result.output
     assert "the run's odometry" in result.output and "sampling:  pilot 500 pairs" in result.output
-    relations = read_relations(folder / "relations.txt")
+    written = folder / "evaluations" / "odometry"  # a new folder in the run: never the run's own files
+    relations = read_relations(written / "relations.txt")
+    assert not (folder / "relations.txt").exists()
     trans, rot = _summary_rows(result.output)
     assert trans[4] == len(relations) == rot[4] and trans[0] > 0.0 and rot[0] > 0.0
-    with np.load(folder / "errors.npz") as npz:
+    with np.load(written / "errors.npz") as npz:
         assert len(npz["translational"]) == len(relations)
         assert npz["translational"].mean() == pytest.approx(trans[0], rel=1e-5)
-    first = (folder / "relations.txt").read_text()
+    first = (written / "relations.txt").read_text()
     again = runner.invoke(app, ["evaluate", str(folder), "--seed", "3", "--margin-t", "0.005", "--margin-r", "0.005"])
-    assert again.exit_code == 0 and (folder / "relations.txt").read_text() == first  # seeded
+    assert (
+        again.exit_code == 0 and (folder / "evaluations" / "odometry-2" / "relations.txt").read_text() == first
+    )  # seeded
+    chosen = runner.invoke(app, ["evaluate", str(folder), "--seed", "3", "--out", str(tmp_path / "mine")])
+    assert chosen.exit_code == 0 and (tmp_path / "mine" / "relations.txt").is_file()
+    taken = runner.invoke(app, ["evaluate", str(folder), "--seed", "3", "--out", str(tmp_path / "mine")])
+    assert taken.exit_code == 2 and "already holds relations.txt" in taken.output
+
+
+def test_a_trajectory_of_another_run_is_refused_and_nothing_is_written(tmp_path):
+    folder, record = _run(tmp_path)
+    campaign_relations = b"the relations a campaign scored the run on"
+    (folder / "relations.txt").write_bytes(campaign_relations)
+    short = tmp_path / "other.tum"
+    write_tum(short, Trajectory(t=record.t[: len(record) // 2], poses=record.truth[: len(record) // 2]))
+    result = runner.invoke(app, ["evaluate", str(folder), "--estimate", str(short)])
+    assert result.exit_code == 2 and "other.tum" in result.output and "not an estimate of this run" in result.output
+    assert "spans 0.0 to" in result.output and len(result.output.strip().splitlines()) == 1
+    assert not (folder / "evaluations").exists() and (folder / "relations.txt").read_bytes() == campaign_relations
+    whole = tmp_path / "same.tum"
+    write_tum(whole, Trajectory(t=record.t, poses=record.truth))
+    done = runner.invoke(app, ["evaluate", str(folder), "--estimate", str(whole)])
+    assert done.exit_code == 0 and (folder / "evaluations" / "same" / "relations.txt").is_file()
+    assert (folder / "relations.txt").read_bytes() == campaign_relations
 
 
 def test_run_folder_with_an_estimate_file(tmp_path):
@@ -167,7 +192,9 @@ def test_run_folder_with_a_sparse_estimate_uses_the_odometry_between_its_poses(t
     assert "0 through the odometry" not in result.output
     coarse = runner.invoke(app, ["evaluate", str(folder), "--seed", "1", "--tolerance", "0.1"])
     assert _summary_rows(coarse.output)[0][0] > 10 * trans[0]
-    result = runner.invoke(app, ["evaluate", str(folder), "--relations", str(folder / "relations.txt")])
+    result = runner.invoke(
+        app, ["evaluate", str(folder), "--relations", str(folder / "evaluations" / "estimate" / "relations.txt")]
+    )
     assert result.exit_code == 2 and "drop --relations" in result.output
 
 
@@ -198,7 +225,8 @@ def test_run_folder_with_an_estimate_that_covers_nothing(tmp_path):
     write_tum(folder / "estimate.tum", Trajectory(t=record.t + 1000.0, poses=record.truth))
     result = runner.invoke(app, ["evaluate", str(folder)])
     assert result.exit_code == 2
-    assert f"{folder / 'estimate.tum'}: the estimate covers 0 of the 400 ground-truth poses" in result.output
+    assert f"{folder / 'estimate.tum'}: its poses span 1000.0 to" in result.output
+    assert "not an estimate of this run" in result.output
 
 
 def test_pose_indices_map_to_file_lines(tmp_path):

@@ -69,6 +69,14 @@ def evaluate(
             help="Report relations outside the estimate's time span as unmatched instead of refusing them.",
         ),
     ] = False,
+    out: Annotated[
+        Path | None,
+        typer.Option(
+            "--out",
+            "-o",
+            help="RUN: folder for relations.txt and errors.npz (default: a new RUN/evaluations/<name>/; the run's own files are never overwritten).",
+        ),
+    ] = None,
     errors_out: Annotated[
         Path | None, typer.Option("--errors", help="Write per-relation errors here (.npz, or a text table).")
     ] = None,
@@ -127,8 +135,11 @@ def evaluate(
             rule=rule,
             tolerance=tolerance,
             interpolate=interpolate,
+            out=out,
         )
     else:
+        if out is not None:
+            raise ConfigError("--out is for a RUN folder's sampled relations: drop it, or use --errors FILE")
         if estimate is None or relations is None:
             raise ConfigError("give a RUN folder, or both --estimate FILE and --relations FILE")
         result = evaluate_files(

@@ -39,6 +39,8 @@ class RunFolder:
     ERRORS = "errors.npz"
     #: ``run.png``: the true and estimated paths on the floor plan.
     PICTURE = "run.png"
+    #: ``evaluations/``: one folder per later evaluation (``slamtrials evaluate RUN``), never over the above.
+    EVALUATIONS = "evaluations"
 
     def __init__(self, path: str | Path) -> None:
         object.__setattr__(self, "path", Path(path))
@@ -87,6 +89,20 @@ class RunFolder:
     def picture(self) -> Path:
         """``run.png``."""
         return self.path / self.PICTURE
+
+    @property
+    def evaluations(self) -> Path:
+        """``evaluations/``, where later evaluations of the run write their relations and errors."""
+        return self.path / self.EVALUATIONS
+
+    def new_evaluation(self, name: str) -> Path:
+        """A folder ``evaluations/<name>`` that does not exist yet (``<name>-2``, ``-3``, ... if taken); not created."""
+        folder = self.evaluations / name
+        k = 2
+        while folder.exists():
+            folder = self.evaluations / f"{name}-{k}"
+            k += 1
+        return folder
 
     def is_complete(self) -> bool:
         """Whether ``run.json`` is there (it is written last)."""

@@ -40,10 +40,7 @@ from slamtrials.trial.coverage import (
 from slamtrials.trial.summary import TrialSummary
 from slamtrials.worlds import World
 
-__all__ = ["run_trial", "TrialProgress", "TRIAL_FORMAT"]
-
-#: Version of the trial metadata layout in run.json.
-TRIAL_FORMAT = "slamtrials-trial/1"
+__all__ = ["run_trial", "TrialProgress"]
 
 
 @dataclass(frozen=True)

@@ -149,3 +149,16 @@ def test_resuming_a_complete_campaign_runs_nothing_and_starts_no_cluster(source,
     assert (source / DB_FILE).stat().st_mtime_ns == before
     replay_campaign(source, tmp_path / "r", scheduler=client)
     assert replay_campaign(source, tmp_path / "r", scheduler=NO_SCHEDULER).complete
+
+
+def test_a_driver_starting_while_the_lock_is_probed_gets_it(tmp_path):
+    import fcntl
+    import os
+    import threading
+
+    (tmp_path / ".campaign.lock").touch()
+    fd = os.open(tmp_path / ".campaign.lock", os.O_RDONLY)
+    fcntl.flock(fd, fcntl.LOCK_EX)  # a probe holding it (far longer than a real one)
+    threading.Timer(0.08, os.close, (fd,)).start()
+    with campaign_lock(tmp_path):
+        assert driver_alive(tmp_path) is True

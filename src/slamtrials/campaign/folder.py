@@ -39,6 +39,9 @@ log = logging.getLogger(__name__)
 
 LOCK_FILE = ".campaign.lock"
 
+#: Tries (50 ms apart) to take the lock before concluding that another driver holds it.
+_LOCK_ATTEMPTS = 5
+
 
 def open_campaign(folder: Path, config: CampaignConfig, worlds: Sequence[WorldInfo], *, kind: str) -> CampaignStore:
     """Create or open the campaign in ``folder`` (see the module docstring).
@@ -88,10 +91,14 @@ def campaign_lock(folder: Path) -> Iterator[None]:
         return
     fd = os.open(Path(folder) / LOCK_FILE, os.O_RDWR | os.O_CREAT, 0o644)
     try:
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            raise ConfigError(f"{folder}: another slamtrials process is running this campaign") from None
+        for attempt in range(_LOCK_ATTEMPTS):  # a few tries: driver_alive may be probing it this instant
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except OSError:
+                if attempt == _LOCK_ATTEMPTS - 1:
+                    raise ConfigError(f"{folder}: another slamtrials process is running this campaign") from None
+                time.sleep(0.05)
         yield
     finally:
         os.close(fd)
@@ -103,7 +110,7 @@ def driver_alive(folder: Path) -> bool | None:
     The lock is probed, not waited for: taken and released at once if free (its file is not created
     if missing: a folder never run has no driver). A driver killed in any way, ``kill -9`` included,
     released it, so a free lock means that the runs its catalog says are running were interrupted.
-    A driver starting within the microseconds of the probe is refused as if another were running.
+    A driver starting during the probe's microseconds tries again (:func:`campaign_lock`).
     """
     try:
         import fcntl

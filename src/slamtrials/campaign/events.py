@@ -71,6 +71,8 @@ class CampaignResult:
         Seconds this call took.
     notes:
         Things the reader must know (capped worlds, failed worlds, replay's paths).
+    complete:
+        The campaign was already complete when this call started (nothing was run, no cluster started).
     """
 
     folder: Path
@@ -80,3 +82,4 @@ class CampaignResult:
     runs_failed: int
     wall_time: float
     notes: tuple[str, ...] = field(default_factory=tuple)
+    complete: bool = False

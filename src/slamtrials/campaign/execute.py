@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -25,7 +26,13 @@ from slamtrials.campaign.cluster import check_workers, dask_client
 from slamtrials.campaign.config import CampaignConfig
 from slamtrials.campaign.driver import Plan, drive
 from slamtrials.campaign.events import CampaignEvent, CampaignResult
-from slamtrials.campaign.folder import campaign_lock, check_campaign_folder, open_campaign, prepare_resume
+from slamtrials.campaign.folder import (
+    campaign_lock,
+    check_campaign_folder,
+    completed_result,
+    open_campaign,
+    prepare_resume,
+)
 from slamtrials.campaign.loop import next_step
 from slamtrials.campaign.seeds import run_seed
 from slamtrials.campaign.store import CampaignStore, WorldInfo, is_campaign
@@ -122,6 +129,12 @@ def run_campaign(
     on_event:
         Called with a :class:`CampaignEvent` for progress.
 
+    Returns
+    -------
+    CampaignResult
+        With ``complete`` set (and nothing run, no cluster started) if every world of the folder's
+        campaign was already done or capped.
+
     Raises
     ------
     ConfigError
@@ -156,6 +169,10 @@ def run_campaign(
         )
 
     check_campaign_folder(folder, config, worlds, kind="campaign")  # before starting a cluster; touches nothing
+    complete = completed_result(folder, ("done", "capped"))
+    if complete is not None:
+        summary = list(complete.summary)
+        return replace(complete, notes=result_notes(summary))
     planner = CampaignPlanner(config, folder, trial_fn)
     with dask_client(scheduler, workers, allowed_failures=config.runs.retries) as client:
         store = open_campaign(folder, config, worlds, kind="campaign")

@@ -8,8 +8,9 @@ seed). Each replayed run becomes a complete run folder of the new campaign: ``fr
 frames with the new estimate), ``estimate.tum``, the new map, ``relations.txt``, ``errors.npz`` and a
 ``run.json`` whose ``replay`` entry names the source run folder, the algorithm and its configuration.
 
-The new campaign's config is the source's with ``slam`` replaced and ``replay_of`` set to the source
-folder; its catalog has the same worlds and run indices. The run-count rule cannot add runs in a
+The new campaign's config is the source's with ``slam`` changed (:func:`replay_slam_settings`: the
+source's algorithm, preset and parameters, with the given overrides on top) and ``replay_of`` set to
+the source folder; its catalog has the same worlds and run indices. The run-count rule cannot add runs in a
 replay: a world whose errors under the new algorithm would need more runs than were recorded is
 reported as ``short``. Note that the robot's paths are those it explored with the first algorithm's
 maps (:data:`~slamtrials.campaign.events.REPLAY_NOTE`); the output says so.
@@ -17,18 +18,25 @@ maps (:data:`~slamtrials.campaign.events.REPLAY_NOTE`); the output says so.
 
 from __future__ import annotations
 
+import enum
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from slamtrials.campaign.cluster import check_workers, dask_client
 from slamtrials.campaign.config import CampaignConfig, MetricSettings
 from slamtrials.campaign.driver import Plan, drive
 from slamtrials.campaign.events import REPLAY_NOTE, CampaignEvent, CampaignResult
 from slamtrials.campaign.execute import result_notes
-from slamtrials.campaign.folder import campaign_lock, check_campaign_folder, open_campaign, prepare_resume
+from slamtrials.campaign.folder import (
+    campaign_lock,
+    check_campaign_folder,
+    completed_result,
+    open_campaign,
+    prepare_resume,
+)
 from slamtrials.campaign.loop import next_step
 from slamtrials.campaign.results import RunResult
 from slamtrials.campaign.runfiles import publish_run
@@ -41,7 +49,81 @@ from slamtrials.record import RunRecord
 from slamtrials.slam.offline import run_over_recording
 from slamtrials.trial import SlamSettings
 
-__all__ = ["replay_campaign", "ReplayTask", "replay_one", "replay_slam"]
+__all__ = [
+    "replay_campaign",
+    "replay_config",
+    "replay_slam_settings",
+    "SOURCE_PRESET",
+    "ReplayTask",
+    "replay_one",
+    "replay_slam",
+]
+
+
+class _Source(enum.Enum):
+    PRESET = "the source campaign's preset"
+
+
+#: ``preset`` argument of :func:`replay_campaign`: keep the source campaign's preset (for the same
+#: algorithm; another algorithm then runs with its defaults).
+SOURCE_PRESET = _Source.PRESET
+
+PresetChoice = str | None | Literal[_Source.PRESET]
+
+
+def replay_slam_settings(
+    source: SlamSettings,
+    algorithm: str | None = None,
+    preset: PresetChoice = SOURCE_PRESET,
+    params: dict[str, Any] | None = None,
+) -> SlamSettings:
+    """The SLAM settings of a replay of a campaign that ran with ``source``.
+
+    Parameters
+    ----------
+    source:
+        The source campaign's SLAM settings.
+    algorithm:
+        The replay's algorithm; None: the source's.
+    preset:
+        :data:`SOURCE_PRESET`: the source's preset when the algorithm is the source's, the algorithm's
+        defaults (no preset) for another algorithm; else the named preset, or None for the defaults.
+    params:
+        Parameter overrides. For the source's algorithm they go on top of the source's own overrides
+        (which are kept, whatever the preset); another algorithm gets only these.
+    """
+    algorithm = source.algorithm if algorithm is None else algorithm
+    same = algorithm == source.algorithm
+    if preset is SOURCE_PRESET:
+        preset = source.preset if same else None
+    merged = {**source.params, **(params or {})} if same else dict(params or {})
+    return SlamSettings(algorithm=algorithm, preset=preset, params=merged)
+
+
+def replay_config(
+    source_config: CampaignConfig,
+    source: str | Path,
+    folder: str | Path,
+    algorithm: str | None = None,
+    preset: PresetChoice = SOURCE_PRESET,
+    params: dict[str, Any] | None = None,
+) -> CampaignConfig:
+    """The config of the replay in ``folder`` of the campaign in ``source`` (config ``source_config``).
+
+    ``slam`` is :func:`replay_slam_settings` of the source's; ``replay_of`` is ``source``, ``output``
+    is ``folder`` (both absolute).
+
+    Raises
+    ------
+    ConfigError
+        An unknown algorithm or preset, or a bad parameter (named).
+    """
+    slam = replay_slam_settings(source_config.slam, algorithm, preset, params)
+    data = source_config.model_dump(mode="json")
+    data.update(
+        slam=slam.model_dump(mode="json"), replay_of=str(Path(source).absolute()), output=str(Path(folder).absolute())
+    )
+    return CampaignConfig.from_dict(data, source="replay")
 
 
 @dataclass(frozen=True)
@@ -193,8 +275,8 @@ def _recorded_runs(store: CampaignStore) -> dict[str, dict[int, tuple[int, str]]
 def replay_campaign(
     source: str | Path,
     folder: str | Path,
-    algorithm: str,
-    preset: str | None = None,
+    algorithm: str | None = None,
+    preset: PresetChoice = SOURCE_PRESET,
     params: dict[str, Any] | None = None,
     *,
     scheduler: Any = None,
@@ -212,14 +294,17 @@ def replay_campaign(
     folder:
         Folder of the new (replay) campaign.
     algorithm, preset, params:
-        The SLAM algorithm, its preset (None: its defaults) and parameter overrides.
+        The SLAM algorithm (None: the source's), its preset (:data:`SOURCE_PRESET`: the source's for
+        the same algorithm, the defaults for another; None: the defaults) and parameter overrides, on
+        top of the source's own for the same algorithm (:func:`replay_slam_settings`).
     scheduler, workers, on_event:
         As for :func:`slamtrials.campaign.run_campaign`.
 
     Returns
     -------
     CampaignResult
-        Its ``notes`` start with :data:`~slamtrials.campaign.events.REPLAY_NOTE`.
+        Its ``notes`` start with :data:`~slamtrials.campaign.events.REPLAY_NOTE`; ``complete`` is set
+        (nothing run) if the replay in ``folder`` was already complete.
 
     Raises
     ------
@@ -238,15 +323,12 @@ def replay_campaign(
         base = src.config()
         worlds = src.world_infos()
         recorded = _recorded_runs(src)
-    data = base.model_dump(mode="json")
-    data.update(
-        slam={"algorithm": algorithm, "preset": preset, "params": dict(params or {})},
-        replay_of=str(source),
-        output=str(folder),
-    )
-    config = CampaignConfig.from_dict(data, source="replay")
+    config = replay_config(base, source, folder, algorithm, preset, params)
 
     check_campaign_folder(folder, config, worlds, kind="replay")  # before starting a cluster; touches nothing
+    complete = completed_result(folder, ("done", "capped", "short"))
+    if complete is not None:
+        return replace(complete, notes=(REPLAY_NOTE, *result_notes(list(complete.summary))))
     planner = ReplayPlanner(config, folder, source, recorded)
     with dask_client(scheduler, workers, allowed_failures=config.runs.retries) as client:
         store = open_campaign(folder, config, worlds, kind="replay")

@@ -57,6 +57,8 @@ __all__ = [
     "is_campaign",
     "check_new_folder",
     "config_differences",
+    "differing_fields",
+    "ABSENT",
 ]
 
 STORE_FORMAT = "slamtrials-campaign/1"
@@ -168,11 +170,25 @@ def _flatten(value: Any, prefix: str = "") -> dict[str, Any]:
     return {prefix: value}
 
 
+#: What :func:`differing_fields` gives for a field that one of the two dicts lacks.
+ABSENT = "<absent>"
+
+
+def differing_fields(first: dict[str, Any], second: dict[str, Any]) -> list[tuple[str, Any, Any]]:
+    """``(dotted.field, first value, second value)`` for every leaf that differs, sorted by field name.
+
+    Nested dicts are walked (``slam.params.particles``); any other value (lists included) is a leaf. A
+    field that only one side has gives :data:`ABSENT` for the other.
+    """
+    a, b = _flatten(first), _flatten(second)
+    keys = [k for k in sorted(set(a) | set(b)) if a.get(k, ABSENT) != b.get(k, ABSENT)]
+    return [(k, a.get(k, ABSENT), b.get(k, ABSENT)) for k in keys]
+
+
 def config_differences(stored: dict[str, Any], given: dict[str, Any], limit: int = 3) -> str:
     """``field: stored X, given Y`` for the first ``limit`` differing fields of two config dicts."""
-    a, b = _flatten(stored), _flatten(given)
-    keys = [k for k in sorted(set(a) | set(b)) if a.get(k, "<absent>") != b.get(k, "<absent>")]
-    parts = [f"{k}: stored {a.get(k, '<absent>')!r}, given {b.get(k, '<absent>')!r}" for k in keys[:limit]]
+    keys = differing_fields(stored, given)
+    parts = [f"{k}: stored {a!r}, given {b!r}" for k, a, b in keys[:limit]]
     if len(keys) > limit:
         parts.append(f"and {len(keys) - limit} more")
     return "; ".join(parts)

@@ -3,8 +3,12 @@
 * ``campaign run CONFIG.yaml --out DIR [--scheduler ADDRESS] [--workers N]``: run a campaign; the same
   command, or ``campaign run --out DIR`` without a config, resumes an interrupted one.
 * ``campaign status DIR``: progress and the summary so far.
-* ``campaign replay DIR --algorithm NAME [--preset P] [--set key=value ...] --out NEW``: evaluate
-  another SLAM algorithm or configuration on the recorded runs of DIR, without simulating.
+* ``campaign replay DIR [--algorithm NAME] [--preset P | --no-preset] [--set key=value ...] --out NEW``:
+  evaluate another SLAM algorithm or configuration on the recorded runs of DIR, without simulating. The
+  replay keeps DIR's algorithm, preset and parameters and changes only what is given; it first prints
+  every setting that differs from DIR's (``slam.params.particles: 40 -> 80``).
+
+Resuming a campaign (or replay) that is already complete prints one line saying so and exits 0.
 
 The end of ``run`` and ``replay`` is the per-world table (the paper's Table I: runs, mean and standard
 deviation of eps_t and eps_r, confidence intervals), also saved as ``DIR/summary.csv``.
@@ -20,7 +24,7 @@ import typer
 from slamtrials.cli.common import fmt_number, make_app, make_console, quiet_dask, table_one
 from slamtrials.errors import ConfigError
 
-__all__ = ["app", "register", "summary_table", "EXIT_INTERRUPTED"]
+__all__ = ["app", "register", "summary_table", "print_differences", "EXIT_INTERRUPTED"]
 
 app = make_app(help="Run, resume, watch and replay campaigns: repeat runs until every world's error is known.")
 
@@ -157,7 +161,19 @@ def run(
     except KeyboardInterrupt:
         typer.echo(f"interrupted; resume with: slamtrials campaign run --out {folder}", err=True)
         raise typer.Exit(EXIT_INTERRUPTED) from None
+    if result.complete:
+        _say_complete(console, result)
+        return
     _finish(console, result, confidence, f"Campaign {result.folder}")
+
+
+def _say_complete(console, result) -> None:
+    console.print(
+        f"{result.folder}: complete, every world is finished; nothing to run "
+        f"(see 'slamtrials campaign status {result.folder}')",
+        highlight=False,
+        soft_wrap=True,
+    )
 
 
 @app.command("status")
@@ -171,6 +187,7 @@ def status(folder: Annotated[Path, typer.Argument(help="Campaign folder.")]) -> 
     console = make_console()
     config = state.config
     what = f"replay of {config.replay_of}" if state.kind == "replay" else "campaign"
+    interrupted = state.interrupted
     console.print(
         f"{folder}: {what}, algorithm {config.slam.algorithm} (preset {config.slam.preset}), seed {config.seed}, "
         f"runs: initial {config.runs.initial}, cap {config.runs.max_runs}, margins {config.runs.margin_t:g} m / "
@@ -184,7 +201,7 @@ def status(folder: Annotated[Path, typer.Argument(help="Campaign folder.")]) -> 
         ("status", "left"),
         ("done", "right"),
         ("needed", "right"),
-        ("running", "right"),
+        ("interrupted" if interrupted else "running", "right"),
         ("failed", "right"),
         ("note", "left"),
     ):
@@ -196,51 +213,101 @@ def status(folder: Annotated[Path, typer.Argument(help="Campaign folder.")]) -> 
             world.status,
             str(counts.get("done", 0)),
             "-" if world.runs_target is None else str(world.runs_target),
-            str(counts.get("running", 0)),
+            str(counts.get("interrupted" if interrupted else "running", 0)),
             str(counts.get("failed", 0)),
             world.note or "",
         )
     console.print(table)
     console.print(summary_table(state.summary, config.runs.confidence, "Errors so far"))
-    console.print(f"{state.runs_done} runs done; {'finished' if state.finished else 'not finished'}", highlight=False)
+    if state.finished:
+        progress = "finished"
+    elif state.driver is False:
+        again = "campaign run --out" if state.kind == "campaign" else "campaign replay ... --out"
+        cause = "interrupted; " if interrupted else ""
+        progress = f"not finished, no driver alive ({cause}resume with 'slamtrials {again} {folder}')"
+    else:
+        progress = "not finished"
+    console.print(f"{state.runs_done} runs done; {progress}", highlight=False, soft_wrap=True)
 
 
 @app.command("replay")
 def replay(
     source: Annotated[Path, typer.Argument(help="Folder of the campaign whose recorded runs are re-evaluated.")],
-    algorithm: Annotated[
-        str, typer.Option("--algorithm", "-a", help="SLAM algorithm to evaluate (built-in: gmapping, karto, odometry).")
-    ],
     out: Annotated[
         Path, typer.Option("--out", "-o", help="Folder of the new campaign (an existing replay is resumed).")
     ],
-    preset: Annotated[str | None, typer.Option("--preset", "-p", help="Named parameter set of the algorithm.")] = None,
+    algorithm: Annotated[
+        str | None,
+        typer.Option(
+            "--algorithm",
+            "-a",
+            help="SLAM algorithm to evaluate (built-in: gmapping, karto, odometry); default: the source's.",
+        ),
+    ] = None,
+    preset: Annotated[
+        str | None,
+        typer.Option(
+            "--preset",
+            "-p",
+            help="Named parameter set of the algorithm; default: the source's for its algorithm, none for another.",
+        ),
+    ] = None,
+    no_preset: Annotated[
+        bool, typer.Option("--no-preset", help="Run the algorithm's defaults (with the overrides), no preset.")
+    ] = False,
     settings: Annotated[
-        list[str] | None, typer.Option("--set", help="Parameter override key=value (value read as YAML); repeatable.")
+        list[str] | None,
+        typer.Option(
+            "--set",
+            help="Parameter override key=value (value read as YAML), on top of the source's parameters; repeatable.",
+        ),
     ] = None,
     scheduler: SchedulerOpt = None,
     workers: WorkersOpt = None,
 ) -> None:
-    """Evaluate another SLAM algorithm or configuration on a campaign's recorded runs, with no simulation."""
+    """Evaluate another SLAM algorithm or configuration on a campaign's recorded runs, with no simulation.
+
+    The replay keeps the source's algorithm, preset and parameters and changes only what is given.
+    """
     from slamtrials.campaign import REPLAY_NOTE, replay_campaign
+    from slamtrials.campaign.differences import setting_differences
+    from slamtrials.campaign.replay import SOURCE_PRESET, replay_config
     from slamtrials.campaign.store import CampaignStore
     from slamtrials.cli.slam import parse_settings
 
+    if preset is not None and no_preset:
+        raise ConfigError("give --preset NAME or --no-preset, not both")
+    chosen = None if no_preset else (SOURCE_PRESET if preset is None else preset)
     params = parse_settings(settings or [])
     with CampaignStore.open(source) as store:
-        confidence = store.config().runs.confidence
+        base = store.config()
+    config = replay_config(base, source, out, algorithm, chosen, params)  # checks the settings before any output
     quiet_dask()
     console = make_console()
+    print_differences(console, setting_differences(base, config), str(source), str(out))
     console.print(f"note: {REPLAY_NOTE}", highlight=False, soft_wrap=True)
     try:
         with _Progress(console) as progress:
             result = replay_campaign(
-                source, out, algorithm, preset, params, scheduler=scheduler, workers=workers, on_event=progress
+                source, out, algorithm, chosen, params, scheduler=scheduler, workers=workers, on_event=progress
             )
     except KeyboardInterrupt:
         typer.echo("interrupted; resume with the same command", err=True)
         raise typer.Exit(EXIT_INTERRUPTED) from None
-    _finish(console, result, confidence, f"Replay of {source} with {algorithm}")
+    if result.complete:
+        _say_complete(console, result)
+        return
+    _finish(console, result, base.runs.confidence, f"Replay of {source} with {config.slam.algorithm}")
+
+
+def print_differences(console, differences, name_a: str, name_b: str) -> None:
+    """Print the settings that differ from campaign ``name_a`` to ``name_b``, one line each (or that none do)."""
+    if not differences:
+        console.print(f"settings: {name_b} has the same settings as {name_a}", highlight=False, soft_wrap=True)
+        return
+    console.print(f"settings that differ ({name_a} -> {name_b}):", highlight=False, soft_wrap=True)
+    for difference in differences:
+        console.print(f"  {difference}", highlight=False, soft_wrap=True, markup=False)
 
 
 def register(root: typer.Typer) -> None:

@@ -3,7 +3,8 @@
 * ``report CAMPAIGN [--out DIR] [--run WORLD/IDX] [--repeats N] [--seed S] [--no-pdf]``: write the HTML
   report (``CAMPAIGN/report/index.html``, figures beside it) and print Table I and the page's path.
 * ``compare A B [--out DIR] [--alpha 0.05] [--correction holm|bh|none]``: compare two campaigns on their
-  common worlds; print per world and metric the difference B - A with its Welch interval, the corrected
+  common worlds; print every setting that differs between them (``slam.preset: paper -> null``), then per
+  world and metric the difference B - A with its Welch interval, the corrected
   p-value, the verdict and the share of single-run pairs that reverse it (the paper's Fig. 6 trap), then
   the overall verdicts; write ``compare.html`` and ``comparison.csv`` (default folder
   ``B/report/compare-<A>``).
@@ -151,6 +152,8 @@ def compare(
     pdf: Annotated[bool, typer.Option("--pdf/--no-pdf", help="Also save every figure as PDF.")] = True,
 ) -> None:
     """Compare two campaigns on the same worlds: Welch intervals, corrected p-values, verdicts, the Fig. 6 trap."""
+    from slamtrials.campaign.differences import campaign_differences
+    from slamtrials.cli.campaign import print_differences
     from slamtrials.errors import ConfigError
     from slamtrials.report.build import REPORT_DIR, compare_report, trap_sentences
 
@@ -160,6 +163,7 @@ def compare(
     folder = out if out is not None else campaign_b / REPORT_DIR / f"compare-{campaign_a.absolute().name}"
     result = compare_report(campaign_a, campaign_b, folder, alpha=alpha, correction=correction.value, pdf=pdf)
     console = make_console()
+    print_differences(console, campaign_differences(campaign_a, campaign_b), str(campaign_a), str(campaign_b))
     for metric in result.comparison.overall:
         console.print(comparison_table(result.comparison, metric))
     for note in result.notes:

@@ -358,3 +358,5 @@ def test_compare_a_real_campaign_with_its_replay(real_campaign, tmp_path):
         expected = NO_DIFFERENCE if row["p_adjusted"] > 0.05 else (B_BETTER if row["difference"] < 0 else A_BETTER)
         assert row["verdict"] == expected
     assert any("replay of the other campaign" in note for note in result.notes)
+    page = (tmp_path / "cmp" / "compare.html").read_text(encoding="utf-8")
+    assert "settings that differ (A -&gt; B)" in page and "slam.algorithm: gmapping -&gt; odometry" in page

@@ -45,6 +45,7 @@ import pandas as pd
 from slamtrials.__about__ import __version__, source_revision
 from slamtrials.atomicfile import atomic_write_text
 from slamtrials.campaign.config import MetricSettings
+from slamtrials.campaign.differences import campaign_differences
 from slamtrials.campaign.events import REPLAY_NOTE
 from slamtrials.errors import ConfigError, SlamtrialsError
 from slamtrials.io.layout import RunFolder
@@ -1090,6 +1091,7 @@ def compare_report(
             f"{int((d.runs['status'] == 'done').sum())} finished runs)"
         )
 
+    differences = campaign_differences(data_a.folder, data_b.folder)
     verdicts = [f"{SYMBOLS[m]}: {comparison.overall[m].statement}" for m in METRICS if m in comparison.overall]
     traps = trap_sentences(comparison)
     body = [
@@ -1099,6 +1101,7 @@ def compare_report(
                 [
                     (f"A = {name_a}", describe(data_a)),
                     (f"B = {name_b}", describe(data_b)),
+                    ("settings that differ (A -> B)", "; ".join(map(str, differences)) or "none"),
                     ("compared worlds", ", ".join(comparison.for_metric(METRICS[0])["world"])),
                     (
                         "test",

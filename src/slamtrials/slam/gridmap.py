@@ -328,6 +328,33 @@ class GridMap:
             np.asarray(weights, dtype=np.int64).reshape(-1),
         )
 
+    def integrate_scans(
+        self,
+        laser_poses: Sequence[NDArray[np.float64]],
+        scans: Sequence[NDArray[np.float32]],
+        weights: Sequence[int],
+        laser: LaserGeometry,
+        *,
+        max_urange: float,
+    ) -> None:
+        """Trace ``scans[k]`` taken from laser pose ``laser_poses[k]`` (map frame) with weight ``weights[k]``
+        (+1 adds a scan, -1 takes it out again), in runs of equal beam count: one compiled call per run."""
+        start = 0
+        while start < len(scans):
+            end = start + 1
+            while end < len(scans) and scans[end].shape == scans[start].shape:
+                end += 1
+            self.integrate_many(
+                np.array(laser_poses[start:end]),
+                np.stack(scans[start:end]),
+                laser.beam_angles(scans[start].shape[0]),
+                np.array(weights[start:end]),
+                range_min=laser.range_min,
+                range_max=laser.range_max,
+                max_urange=max_urange,
+            )
+            start = end
+
     def integrate_frame(
         self, base_pose: ArrayLike, ranges: ArrayLike, laser: LaserGeometry, *, max_urange: float | None = None
     ) -> None:

@@ -46,21 +46,7 @@ class PublishedMap:
     def _trace(self, poses: list[NDArray[np.float64]], scans: list[NDArray[np.float32]], weights: list[int]) -> None:
         """Trace scans ``scans[k]`` from laser poses ``poses[k]`` with weights ``weights[k]``, in runs of
         equal beam count (one compiled call per run)."""
-        start = 0
-        while start < len(scans):
-            end = start + 1
-            while end < len(scans) and scans[end].shape == scans[start].shape:
-                end += 1
-            self.grid.integrate_many(
-                np.array(poses[start:end]),
-                np.stack(scans[start:end]),
-                self.laser.beam_angles(scans[start].shape[0]),
-                np.array(weights[start:end]),
-                range_min=self.laser.range_min,
-                range_max=self.laser.range_max,
-                max_urange=self.max_urange,
-            )
-            start = end
+        self.grid.integrate_scans(poses, scans, weights, self.laser, max_urange=self.max_urange)
 
     def rebuild(self, path: NDArray[np.float64], scans: list[NDArray[np.float32]]) -> int:
         """Make the grid that of laser poses ``path`` ``[U, 3]`` with ``scans[u]`` taken at ``path[u]``.

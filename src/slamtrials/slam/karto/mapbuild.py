@@ -85,21 +85,7 @@ class NodeMap:
             poses.append(laser_poses[k])
             ranges.append(scans[k])
             weights.append(1)
-        start = 0
-        while start < len(ranges):  # one compiled call per run of scans with the same beam count
-            end = start + 1
-            while end < len(ranges) and ranges[end].shape == ranges[start].shape:
-                end += 1
-            self.grid.integrate_many(
-                np.array(poses[start:end]),
-                np.stack(ranges[start:end]),
-                self.laser.beam_angles(ranges[start].shape[0]),
-                np.array(weights[start:end]),
-                range_min=self.laser.range_min,
-                range_max=self.laser.range_max,
-                max_urange=self.max_urange,
-            )
-            start = end
+        self.grid.integrate_scans(poses, ranges, weights, self.laser, max_urange=self.max_urange)
         self._poses = laser_poses[: len(scans)].copy()
         self._occupancy = OccupancyGrid(
             grid=_classify(self.grid.hits, self.grid.visits, self.min_pass_through, self.occupancy_threshold),

@@ -32,14 +32,10 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-from numpy.typing import NDArray
-
 from slamtrials.atomicfile import atomic_write_text
 from slamtrials.errors import ConfigError, FormatError
 from slamtrials.record import RunRecord, Trajectory
-from slamtrials.slam import OccupancyGrid
-from slamtrials.slam.offline import estimate_per_frame, run_over_recording
+from slamtrials.slam.offline import SlamRun, run_over_recording
 
 __all__ = ["SlamResult", "run_slam", "write_slam_outputs", "load_recording", "OUTPUT_FILES", "SLAM_FILE"]
 
@@ -58,41 +54,18 @@ OUTPUT_FILES = (
 
 
 @dataclass(frozen=True, eq=False)
-class SlamResult:
-    """What one SLAM run over a recording produced.
+class SlamResult(SlamRun):
+    """What one SLAM run over a recording produced: the :class:`~slamtrials.slam.offline.SlamRun` and
+    the recording it ran over.
 
     Attributes
     ----------
-    algorithm:
-        Registry name.
-    preset:
-        Preset applied, or None.
-    config:
-        The resolved configuration (``model_dump`` of the algorithm's Config).
-    seed:
-        Seed of the algorithm's random stream.
-    trajectory:
-        The algorithm's :meth:`trajectory` after the last frame (map frame).
-    occupancy:
-        The final map.
-    timing:
-        float64 ``[T]`` wall-clock seconds of each ``process`` call.
-    updates:
-        The algorithm's update count after the last frame.
     record:
         The recording that was processed.
     source:
         Where the recording came from (for ``slam.json``).
     """
 
-    algorithm: str
-    preset: str | None
-    config: dict[str, Any]
-    seed: int
-    trajectory: Trajectory
-    occupancy: OccupancyGrid
-    timing: NDArray[np.float64]
-    updates: int
     record: RunRecord
     source: str = ""
 
@@ -135,7 +108,7 @@ def run_slam(
     return SlamResult(
         algorithm=algorithm_name,
         preset=preset,
-        config=run.config.model_dump(mode="json"),
+        config=run.config,
         seed=run.seed,
         trajectory=run.trajectory,
         occupancy=run.occupancy,
@@ -162,7 +135,7 @@ def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bo
     if (out / SLAM_FILE).exists() and not overwrite:
         raise ConfigError(f"{out}: already holds SLAM outputs; choose another --out or pass --overwrite")
     out.mkdir(parents=True, exist_ok=True)
-    estimate = estimate_per_frame(result.algorithm, result.trajectory, result.record)
+    estimate = result.estimate_per_frame(result.record)
     written = [write_tum(out / "trajectory.tum", result.trajectory)]
     as_run = replace(result.record, truth=estimate, estimate=estimate)  # first CARMEN triple = the estimate
     written.append(write_carmen(out / "trajectory.clf", carmen_from_run(as_run)))
@@ -181,7 +154,7 @@ def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bo
     summary = {
         "algorithm": result.algorithm,
         "preset": result.preset,
-        "config": result.config,
+        "config": result.config.model_dump(mode="json"),
         "seed": result.seed,
         "input": result.source,
         "frames": len(result.record),

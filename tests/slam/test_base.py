@@ -107,7 +107,7 @@ def test_user_algorithm_registered_works_end_to_end():
         register_algorithm(ShiftedOdometry)
         result = run_slam(_record(), "test-shifted", preset="far", seed=3)
         np.testing.assert_allclose(result.trajectory.poses[:, 0], np.arange(5) * 0.1 + 4.0)
-        assert result.updates == 5 and result.config == {"shift": 4.0} and result.timing.shape == (5,)
+        assert result.updates == 5 and result.config.model_dump() == {"shift": 4.0} and result.timing.shape == (5,)
         with pytest.raises(ConfigError, match=r"shift = 9.*<= 5"):
             run_slam(_record(), "test-shifted", overrides={"shift": 9})
     finally:

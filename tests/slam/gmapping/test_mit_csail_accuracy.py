@@ -33,7 +33,7 @@ def test_gmapping_defaults_on_mit_csail_meet_the_published_accuracy(tmp_path):
     record = load_recording(LOG)
     assert len(record) == 1988
     result = run_slam(record, "gmapping", seed=1, source=str(LOG))
-    assert result.config["particles"] == 30
+    assert result.config.particles == 30
     assert (
         result.updates == 430
     )  # the update rule depends on odometry only; the C++ original makes 430 (spec section 7)

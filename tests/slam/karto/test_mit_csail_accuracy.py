@@ -32,7 +32,7 @@ pytestmark = [
 def test_karto_defaults_on_mit_csail(tmp_path):
     record = load_recording(LOG)
     result = run_slam(record, "karto", seed=0, source=str(LOG))
-    assert result.config["minimum_travel_distance"] == 0.5
+    assert result.config.minimum_travel_distance == 0.5
     assert 500 <= result.updates <= 700  # one node per 0.5 m or 0.5 rad of odometry, at most every 0.5 s
     write_slam_outputs(result, tmp_path)
     evaluation = evaluate_files(tmp_path / "trajectory.clf", RELATIONS)
@@ -46,7 +46,7 @@ def test_karto_defaults_on_mit_csail(tmp_path):
 def test_karto_slam_karto_preset_on_mit_csail(tmp_path):
     record = load_recording(LOG)
     result = run_slam(record, "karto", preset="slam_karto", seed=0, source=str(LOG))
-    assert result.config["minimum_travel_distance"] == 0.2
+    assert result.config.minimum_travel_distance == 0.2
     write_slam_outputs(result, tmp_path)
     evaluation = evaluate_files(tmp_path / "trajectory.clf", RELATIONS)
     assert evaluation.translational.n == 1172

@@ -26,6 +26,9 @@ class RunDetails:
         Standard deviations of the pilot relations' errors (m, rad).
     relations_capped:
         Whether the relation count hit the sampling rule's cap.
+    se_t, se_r:
+        Standard errors of ``eps_t`` (m) and ``eps_r`` (rad): the std of the per-relation errors over
+        ``sqrt(N)`` (:func:`slamtrials.metric.standard_error`); None for runs stored by earlier versions.
     """
 
     frames: int
@@ -35,6 +38,8 @@ class RunDetails:
     relation_std_t: float
     relation_std_r: float
     relations_capped: bool
+    se_t: float | None = None
+    se_r: float | None = None
 
 
 @dataclass(frozen=True)

@@ -24,6 +24,7 @@ from slamtrials.metric.matching import (
     lookup_poses,
     match_relations,
 )
+from slamtrials.metric.noiseshare import metric_noise_share, standard_error
 from slamtrials.metric.quantiles import critical_value
 from slamtrials.metric.relerrors import RelationErrors, evaluate_relations, relative_pose_errors
 from slamtrials.metric.rule import SamplingRule
@@ -55,6 +56,8 @@ __all__ = [
     "sample_size",
     "EnvironmentStats",
     "environment_stats",
+    "metric_noise_share",
+    "standard_error",
     "SUMMARY_HEADER",
     "ErrorSummary",
     "summarize",

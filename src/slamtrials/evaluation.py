@@ -7,10 +7,11 @@ Two forms:
   ``t1 t2 x y z roll pitch yaw`` per line. An odometry log (a CARMEN log, whose laser lines' second
   triple is used, or a TUM file) carries a relation timestamp with no estimated pose within the
   tolerance to the nearest estimated pose.
-* :func:`evaluate_run`: a simulated run folder. Relations are sampled from its ground truth by the
-  IROS 2018 rule (pilot, ``N = ceil(z^2 s^2 / d^2)``, N fresh pairs) and the run's estimate is evaluated
-  on them: ``estimate.tum`` in the folder, else a given estimate file, else the run's odometry. Writes
-  ``relations.txt`` and ``errors.npz`` into the folder.
+* :func:`evaluate_run`: a simulated run folder. The estimate (a given estimate file, else the folder's
+  ``estimate.tum``, else the run's odometry) is scored on the run's own relation set (``relations.npz``),
+  or, for a folder without one or when asked, on relations sampled afresh from its ground truth (pilot,
+  ``N = ceil(z^2 s^2 / d^2)``, N fresh pairs). Writes ``relations.txt`` and ``errors.npz`` into a new
+  ``evaluations/<name>/`` folder of the run (or ``out``).
 
 This module composes io (reading and writing files) and metric (pure computation), like the CLI does,
 and does not print. The metric names bad relations or poses by index; this module maps an index back
@@ -323,14 +324,14 @@ def evaluate_run(
     *,
     estimate: Path | None = None,
     estimate_pose: PoseTriple = PoseTriple.auto,
-    seed: int = 0,
+    seed: int | None = None,
     rule: SamplingRule | None = None,
     tolerance: float = RUN_TOLERANCE,
     interpolate: bool = False,
     write: bool = True,
     out: Path | None = None,
 ) -> EvaluationResult:
-    """Sample relations from a run folder's ground truth and evaluate the run's estimate on them.
+    """Evaluate a run folder's estimate on the run's relation set, or on relations sampled from its truth.
 
     Parameters
     ----------
@@ -341,10 +342,11 @@ def evaluate_run(
         either, the run's odometry is evaluated.
     estimate_pose:
         Which pose triple of a CARMEN estimate to use.
-    seed:
-        Seed of the relation sampling.
-    rule:
-        The sampling rule (:class:`~slamtrials.metric.SamplingRule`); ``None`` means the defaults.
+    seed, rule:
+        Both None (the default): the run's own relation set (``relations.npz``, the relations its campaign
+        or trial scored it on) when the folder has one. Otherwise relations are sampled afresh from the
+        truth with ``seed`` (default 0) by ``rule`` (:class:`~slamtrials.metric.SamplingRule`, default
+        the precise rule), sized on the evaluated estimate.
     tolerance, interpolate:
         Matching options. The run's odometry carries ground-truth timestamps without an
         estimated pose within ``tolerance`` (default 1 ms: the same frame) to the nearest estimated pose.
@@ -363,10 +365,11 @@ def evaluate_run(
     ConfigError
         ``out`` already holds relations.
     """
+    from slamtrials.campaign.relationsetfile import read_relation_set
     from slamtrials.io.errorsfile import write_errors
     from slamtrials.io.relations import write_relations
     from slamtrials.io.runfolder import RunFolder, read_run
-    from slamtrials.metric import sample_relations
+    from slamtrials.metric import sample_relations, score_on_set
 
     run = Path(run)
     files = RunFolder(run)
@@ -387,16 +390,31 @@ def evaluate_run(
         source = _Source(odometry, files.frames, "run", f"{run} (no SLAM estimate in the folder: the run's odometry)")
     sources["estimate"] = source
     sources["odometry"] = _Source(odometry, files.frames, "run", "odometry")
+    stored = seed is None and rule is None and files.relation_set.is_file()
+    sampled = None
     try:
-        sampled = sample_relations(
-            truth,
-            source.trajectory,
-            rng=seed,
-            rule=SamplingRule() if rule is None else rule,
-            tolerance=tolerance,
-            interpolate=interpolate,
-            odometry=odometry,
-        )
+        if stored:
+            relation_set = read_relation_set(files.relation_set)
+            scored = score_on_set(
+                relation_set, truth, source.trajectory, tolerance=tolerance, odometry=odometry, what="estimate"
+            )
+            relations, errors = relation_set.relations(truth), scored.errors
+            drawn = (
+                f"the run's relation set {files.relation_set}: {len(relation_set)} relations, seed {relation_set.seed}, "
+                f"{relation_set.rule.rule} rule"
+            )
+        else:
+            sampled = sample_relations(
+                truth,
+                source.trajectory,
+                rng=0 if seed is None else seed,
+                rule=SamplingRule() if rule is None else rule,
+                tolerance=tolerance,
+                interpolate=interpolate,
+                odometry=odometry,
+            )
+            relations, errors = sampled.relations, sampled.errors
+            drawn = f"{len(relations)} relations sampled from the ground truth, seed {0 if seed is None else seed}"
     except MetricError as exc:
         raise _with_lines(exc, sources, None) from None
     written: tuple[Path, ...] = ()
@@ -411,14 +429,14 @@ def evaluate_run(
         if relations_path.exists():
             raise ConfigError(f"{target.path}: already holds relations.txt; choose another --out")
         written = (
-            write_relations(relations_path, sampled.relations),
-            write_errors(target.errors, sampled.relations, sampled.errors),
+            write_relations(relations_path, relations),
+            write_errors(target.errors, relations, errors),
         )
-    trans, rot = _summaries(sampled.errors)
-    label = f"{relations_path if write else 'sampled'} ({len(sampled.relations)} relations sampled from the ground truth, seed {seed})"
+    trans, rot = _summaries(errors)
+    label = f"{relations_path} ({drawn})" if write else drawn
     return EvaluationResult(
-        sampled.relations,
-        sampled.errors,
+        relations,
+        errors,
         trans,
         rot,
         source.label,
@@ -466,7 +484,8 @@ def format_report(result: EvaluationResult) -> str:
         out.write(
             f"sampling:  pilot {len(s.pilot_relations)} pairs, s_t = {s.std_t:.6g} {unit_t}, s_r = {s.std_r:.6g} {unit_r}; "
             f"z = {s.critical:.4f} ({s.rule.confidence:g} confidence, {s.rule.distribution}, {'two' if s.rule.sides == 2 else 'one'}-sided); "
-            f"margins {s.rule.margin_t:g} {unit_t}, {s.rule.margin_r:g} {unit_r} "
+            f"{s.rule.rule} rule, margins {s.margin_t:.3g} {unit_t}, {s.margin_r:.3g} {unit_r}"
+            f"{f' ({s.rule.relative_margin:g} of the pilot means)' if s.rule.relative_margin is not None else ''} "
             f"-> N_t = {s.needed_t}, N_r = {s.needed_r}, N = {s.count}{' (capped)' if s.capped else ''}\n"
         )
     out.write(f"Translational error ({unit_t}, {kind}):\n{SUMMARY_HEADER}\n{_row(result.translational)}\n")

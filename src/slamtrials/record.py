@@ -140,7 +140,10 @@ class RunRecord:
     metadata:
         Free-form JSON-serialisable facts about the run (world name, seed, drawn odometry bias, ...).
     estimate:
-        Optional float64 ``[T, 3]`` SLAM pose estimates (map frame), filled in by later stages.
+        Optional float64 ``[T, 3]`` SLAM pose estimates (map frame), filled in by later stages: the
+        algorithm's final trajectory (:meth:`SlamAlgorithm.trajectory` after the last frame).
+    online:
+        Optional float64 ``[T, 3]``: what the algorithm returned at each frame while running (map frame).
     map:
         Optional final SLAM map (:class:`OccupancyGrid`, map frame), filled in by a trial.
     """
@@ -154,6 +157,7 @@ class RunRecord:
     metadata: dict[str, Any] = field(default_factory=dict)
     estimate: NDArray[np.float64] | None = None
     map: OccupancyGrid | None = None
+    online: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.laser, LaserGeometry):

@@ -111,6 +111,7 @@ def run_slam(
         config=run.config,
         seed=run.seed,
         trajectory=run.trajectory,
+        online=run.online,
         occupancy=run.occupancy,
         timing=run.timing,
         updates=run.updates,

@@ -15,7 +15,11 @@ def test_defaults_are_the_papers():
     config = CampaignConfig(worlds=["office_small_01"])
     assert config.runs.initial == 10 and config.runs.max_runs >= 10
     assert config.metric.pilot == 500 and config.metric.confidence == 0.99
-    assert config.metric.margin_t == 0.02 and config.metric.margin_r == 0.02
+    # per-run relations: the precise rule by default, the paper's absolute margins as a named rule
+    assert config.metric.rule == "precise" and config.metric.relative_margin == 0.01
+    assert config.metric.min_relations == 5000 and config.metric.margin_t is None
+    paper = CampaignConfig.from_dict({"worlds": ["office_small_01"], "metric": {"rule": "paper"}}).metric
+    assert paper.margin_t == 0.02 and paper.margin_r == 0.02 and paper.relative_margin is None
     assert config.runs.margin_t == 0.02 and config.runs.margin_r == 0.02
     assert config.trial_config() == TrialConfig()
     assert config.seed == 0 and config.output is None

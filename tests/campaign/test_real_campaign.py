@@ -10,6 +10,7 @@ import pytest
 from slamtrials.campaign import REPLAY_NOTE, CampaignConfig, campaign_status, replay_campaign, run_campaign
 from slamtrials.campaign.store import CampaignStore
 from slamtrials.errors import ConfigError
+from slamtrials.metric import SamplingRule
 
 pytestmark = pytest.mark.slow
 
@@ -66,16 +67,25 @@ def test_a_real_campaign_on_two_worker_processes(campaign):
                 "map.yaml",
                 "map.pgm",
                 "map.png",
-                "relations.txt",
-                "errors.npz",
+                "relations.npz",
             ):
                 assert (run_dir / name).is_file(), name
             doc = json.loads((run_dir / "run.json").read_text())
             assert doc["seed"] == run.seed and doc["campaign"]["index"] == run.idx
-            assert run.mapped_fraction > 0.8 and run.sim_duration > 0 and run.relations >= 2
-            # the same numbers as 'slamtrials evaluate RUN --seed SEED' (up to the TUM file's rounding)
-            again = evaluate_run(run_dir, seed=run.seed, write=False)
+            assert run.mapped_fraction > 0.8 and run.sim_duration > 0 and run.relations >= 5000
+            scored = doc["campaign"]
+            assert scored["relations"] == run.relations and scored["metric"]["rule"] == "precise"
+            # the precise rule: the run's mean is known to about 1 % (z = 2.576 at 99 %)
+            assert 0 < scored["se_t"] <= 0.011 * run.eps_t / 2.576 or scored["relation_set"]["capped"]
+            assert set(scored["scores"]) == {"estimate", "online", "odometry"}
+            assert scored["scores"]["estimate"]["eps_t"] == run.eps_t
+            # the same numbers as 'slamtrials evaluate RUN', on the run's own relation set (up to the TUM
+            # file's rounding), and from the sampling seed alone
+            again = evaluate_run(run_dir, write=False)
             assert again.translational.mean == pytest.approx(run.eps_t, rel=1e-6, abs=1e-9)
+            assert len(again.relations) == run.relations
+            resampled = evaluate_run(run_dir, seed=run.seed, rule=SamplingRule(), write=False)
+            assert resampled.translational.mean == pytest.approx(run.eps_t, rel=1e-6, abs=1e-9)
             assert read_run(run_dir).estimate is not None
     assert campaign_status(folder).finished
 
@@ -102,6 +112,13 @@ def test_replay_with_another_algorithm(campaign, process_client, tmp_path):
         for run in store.runs():
             doc = json.loads((tmp_path / "odometry" / run.folder / "run.json").read_text())
             assert doc["replay"]["source_run"] == str(folder / run.folder) and doc["replay"]["algorithm"] == "odometry"
+            # scored on the source run's own relation set: the odometry algorithm's errors are the
+            # source run's odometry errors (relative errors do not depend on the frame)
+            assert (tmp_path / "odometry" / run.folder / "relations.npz").read_bytes() == (
+                folder / run.folder / "relations.npz"
+            ).read_bytes()
+            source_doc = json.loads((folder / run.folder / "run.json").read_text())
+            assert run.eps_t == pytest.approx(source_doc["campaign"]["scores"]["odometry"]["eps_t"], rel=1e-9)
     with CampaignStore.open(folder) as source:
         seeds = {(r.world, r.idx): r.seed for r in source.runs()}
         with CampaignStore.open(tmp_path / "odometry") as store:

@@ -89,13 +89,13 @@ def test_replay_without_a_preset_runs_the_defaults(source, tmp_path, client):
 def test_differences_list_exactly_the_changed_settings(rooms):
     a = source_config(rooms)
     data = a.model_dump(mode="json")
-    data["metric"]["margin_t"] = 0.01
+    data["metric"]["relative_margin"] = 0.02
     data["sim"]["odometry"]["noise_linear_per_m"] = 0.02
     data["output"] = "elsewhere"  # where the results are, not how they were made: not listed
     data["replay_of"] = "somewhere"
     b = CampaignConfig.from_dict(data)
     assert [str(d) for d in setting_differences(a, b)] == [
-        "metric.margin_t: 0.02 -> 0.01",
+        "metric.relative_margin: 0.01 -> 0.02",
         "sim.odometry.noise_linear_per_m: 0.0 -> 0.02",
     ]
     assert setting_differences(a, a) == []

@@ -130,7 +130,9 @@ def _run(tmp_path, n: int = 400) -> tuple[Path, RunRecord]:
 
 def test_run_folder_samples_relations_and_writes_them(tmp_path):
     folder, record = _run(tmp_path)
-    result = runner.invoke(app, ["evaluate", str(folder), "--seed", "3", "--margin-t", "0.005", "--margin-r", "0.005"])
+    result = runner.invoke(
+        app, ["evaluate", str(folder), "--seed", "3", "--rule", "paper", "--margin-t", "0.005", "--margin-r", "0.005"]
+    )
     assert result.exit_code == 0, result.output
     assert "the run's odometry" in result.output and "sampling:  pilot 500 pairs" in result.output
     written = folder / "evaluations" / "odometry"  # a new folder in the run: never the run's own files
@@ -142,7 +144,9 @@ def test_run_folder_samples_relations_and_writes_them(tmp_path):
         assert len(npz["translational"]) == len(relations)
         assert npz["translational"].mean() == pytest.approx(trans[0], rel=1e-5)
     first = (written / "relations.txt").read_text()
-    again = runner.invoke(app, ["evaluate", str(folder), "--seed", "3", "--margin-t", "0.005", "--margin-r", "0.005"])
+    again = runner.invoke(
+        app, ["evaluate", str(folder), "--seed", "3", "--rule", "paper", "--margin-t", "0.005", "--margin-r", "0.005"]
+    )
     assert (
         again.exit_code == 0 and (folder / "evaluations" / "odometry-2" / "relations.txt").read_text() == first
     )  # seeded
@@ -150,6 +154,39 @@ def test_run_folder_samples_relations_and_writes_them(tmp_path):
     assert chosen.exit_code == 0 and (tmp_path / "mine" / "relations.txt").is_file()
     taken = runner.invoke(app, ["evaluate", str(folder), "--seed", "3", "--out", str(tmp_path / "mine")])
     assert taken.exit_code == 2 and "already holds relations.txt" in taken.output
+
+
+def test_run_folder_is_scored_on_its_own_relation_set(tmp_path):
+    """A run with relations.npz (as a campaign or a trial writes it): every estimate is scored on that set."""
+    from slamtrials.campaign.config import MetricSettings
+    from slamtrials.campaign.score import score_run
+    from slamtrials.campaign.task import write_scored_run
+
+    folder, record = _run(tmp_path)
+    record.estimate = record.truth + np.random.default_rng(2).normal(0.0, 0.01, record.truth.shape)
+    score = score_run(record, 5, MetricSettings())
+    write_scored_run(folder, record, score)
+    result = runner.invoke(app, ["evaluate", str(folder)])
+    assert result.exit_code == 0, result.output
+    assert (
+        f"the run's relation set {folder / 'relations.npz'}: {len(score.relation_set)} relations, seed 5"
+        in result.output
+    )
+    trans, _ = _summary_rows(result.output)
+    assert trans[4] == len(score.relation_set) and trans[0] == pytest.approx(score.eps_t, abs=1e-6)
+    # another estimate of the same run: the same relations (paired), its own errors
+    other = tmp_path / "other.tum"
+    write_tum(other, Trajectory(t=record.t, poses=record.odometry))
+    result = runner.invoke(app, ["evaluate", str(folder), "--estimate", str(other)])
+    trans, _ = _summary_rows(result.output)
+    assert trans[4] == len(score.relation_set) and trans[0] == pytest.approx(score.odometry.eps_t, abs=1e-6)
+    relations = read_relations(folder / "evaluations" / "other" / "relations.txt")
+    np.testing.assert_array_equal(relations.t1, record.t[score.relation_set.first])
+    # asking for a sampling draws afresh
+    fresh = runner.invoke(app, ["evaluate", str(folder), "--seed", "6"])
+    assert "sampling:  pilot 500 pairs" in fresh.output and "precise rule" in fresh.output
+    bad = runner.invoke(app, ["evaluate", str(folder), "--margin-t", "0.01"])
+    assert bad.exit_code == 2 and "margin_t is an absolute margin of the paper rule" in bad.output
 
 
 def test_a_trajectory_of_another_run_is_refused_and_nothing_is_written(tmp_path):

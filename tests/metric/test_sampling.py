@@ -70,8 +70,9 @@ def test_pairs_are_distinct_ordered_and_uniform():
 
 def test_sampling_follows_the_rule_and_is_seeded():
     truth, estimate = _drive(600, seed=1)
-    a = sample_relations(truth, estimate, rng=7)
-    b = sample_relations(truth, estimate, rng=7)
+    paper = SamplingRule(rule="paper")
+    a = sample_relations(truth, estimate, rng=7, rule=paper)
+    b = sample_relations(truth, estimate, rng=7, rule=paper)
     np.testing.assert_array_equal(a.relations.t1, b.relations.t1)
     np.testing.assert_array_equal(a.errors.translational, b.errors.translational)
     assert len(a.pilot_relations) == 500
@@ -87,19 +88,59 @@ def test_sampling_follows_the_rule_and_is_seeded():
     # the sampled relations evaluate to the same errors through the general path
     again = evaluate_relations(estimate, a.relations)
     np.testing.assert_allclose(again.translational, a.errors.translational, atol=1e-12)
-    c = sample_relations(truth, estimate, rng=8)
+    c = sample_relations(truth, estimate, rng=8, rule=paper)
     assert not np.array_equal(a.relations.t1, c.relations.t1)
+
+
+def test_precise_rule_sizes_on_a_margin_relative_to_the_pilot_mean():
+    truth, estimate = _drive(600, seed=1)
+    a = sample_relations(truth, estimate, rng=7)
+    assert a.rule.rule == "precise" and a.rule.relative_margin == 0.01
+    z = critical_value(0.99)
+    assert a.mean_t == pytest.approx(np.mean(a.pilot_errors.translational))
+    assert a.margin_t == pytest.approx(0.01 * a.mean_t) and a.margin_r == pytest.approx(0.01 * a.mean_r)
+    assert a.needed_t == math.ceil(z**2 * a.std_t**2 / a.margin_t**2 * (1 - 1e-9))
+    assert a.needed_r == math.ceil(z**2 * a.std_r**2 / a.margin_r**2 * (1 - 1e-9))
+    wanted = max(a.needed_t, a.needed_r, 5000)
+    assert a.count == min(wanted, 200_000) and a.capped == (wanted > 200_000)
+    # frame indices of every relation: the relations are those poses' truth
+    np.testing.assert_array_equal(truth.t[a.first], a.relations.t1)
+    np.testing.assert_array_equal(truth.t[a.second], a.relations.t2)
+    # a larger relative margin needs fewer relations, down to the floor
+    loose = sample_relations(truth, estimate, rng=7, rule=SamplingRule(relative_margin=0.2, min_relations=50))
+    assert loose.count == max(loose.needed_t, loose.needed_r, 50) < a.count
+
+
+def test_rules_fill_their_fields_and_refuse_the_other_kind_of_margin():
+    precise, paper = SamplingRule(), SamplingRule(rule="paper")
+    assert (precise.min_relations, precise.max_relations, precise.margin_t) == (5000, 200_000, None)
+    assert (paper.relative_margin, paper.margin_t, paper.margin_r, paper.min_relations) == (None, 0.02, 0.02, 2)
+    assert SamplingRule(rule="paper", margin_t=0.05).margin_r == 0.02
+    with pytest.raises(ValidationError, match="margin_t is an absolute margin of the paper rule"):
+        SamplingRule(margin_t=0.05)
+    with pytest.raises(ValidationError, match="relative_margin belongs to rule: precise"):
+        SamplingRule(rule="paper", relative_margin=0.01)
+    with pytest.raises(ValidationError, match="rule"):
+        SamplingRule(rule="loose")
+    # a stored rule reads back as itself
+    assert SamplingRule.model_validate(paper.model_dump(mode="json")) == paper
 
 
 def test_sampling_options_cap_and_bad_input():
     truth, estimate = _drive(300, seed=2)
-    capped = sample_relations(truth, estimate, rng=0, rule=SamplingRule(margin_t=1e-4, max_relations=1000))
+    capped = sample_relations(
+        truth, estimate, rng=0, rule=SamplingRule(rule="paper", margin_t=1e-4, max_relations=1000)
+    )
     assert capped.capped and capped.count == 1000
     perfect = sample_relations(truth, truth, rng=0)
-    assert perfect.count == 2 and perfect.needed_t == 0 and np.allclose(perfect.errors.translational, 0.0, atol=1e-12)
+    assert perfect.count == 5000 and perfect.needed_t == 0 and perfect.needed_r == 0
+    perfect_paper = sample_relations(truth, truth, rng=0, rule=SamplingRule(rule="paper"))
+    assert perfect_paper.count == 2 and np.allclose(perfect.errors.translational, 0.0, atol=1e-12)
     t_based = sample_relations(truth, estimate, rng=0, rule=SamplingRule(distribution="t", sides=1, confidence=0.99))
     assert t_based.critical == pytest.approx(2.334, abs=1e-3)
-    squared = sample_relations(truth, estimate, rng=0, rule=SamplingRule(squared=True, margin_t=1e-3, margin_r=1e-3))
+    squared = sample_relations(
+        truth, estimate, rng=0, rule=SamplingRule(rule="paper", squared=True, margin_t=1e-3, margin_r=1e-3)
+    )
     assert squared.errors.squared
     far = Trajectory(t=truth.t + 1000.0, poses=truth.poses)
     with pytest.raises(MetricError, match="covers 0 of the 300"):
@@ -128,7 +169,9 @@ def test_sampled_mean_falls_within_the_margin_at_the_stated_confidence(confidenc
     margins = {"margin_t": margin, "margin_r": 10.0} if binding == "t" else {"margin_t": 100.0, "margin_r": margin}
     means, counts = [], []
     for seed in range(400):
-        sampled = sample_relations(truth, estimate, rng=seed, rule=SamplingRule(confidence=confidence, **margins))
+        sampled = sample_relations(
+            truth, estimate, rng=seed, rule=SamplingRule(rule="paper", confidence=confidence, **margins)
+        )
         errors = sampled.errors.translational if binding == "t" else sampled.errors.rotational
         means.append(errors.mean())
         counts.append(sampled.count)

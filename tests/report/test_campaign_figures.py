@@ -135,7 +135,7 @@ def _run_trajectories() -> tuple[Trajectory, Trajectory]:
 
 def test_repeated_sampling_means_uses_spawned_seeds() -> None:
     truth, estimate = _run_trajectories()
-    options = {"rule": SamplingRule(pilot=100, margin_t=0.01)}
+    options = {"rule": SamplingRule(rule="paper", pilot=100, margin_t=0.01)}
     means = cf.repeated_sampling_means(truth, estimate, 12, 7, **options)
     assert means.shape == (12,) and np.isfinite(means).all() and np.unique(means).size == 12
     children = np.random.SeedSequence(7).spawn(12)

@@ -42,19 +42,25 @@ MAX_SEED = 2**63 - 1
 
 
 class MetricSettings(SamplingRule):
-    """Relation sampling of each run: the :class:`~slamtrials.metric.rule.SamplingRule` (IROS 2018 rule:
-    pilot, then ``N = ceil(z^2 s^2 / d^2)`` relations) and the matching tolerance.
+    """Relation sampling of each run: the :class:`~slamtrials.metric.rule.SamplingRule` (``precise`` by
+    default, or ``{rule: paper}``: pilot, then ``N = ceil(z^2 s^2 / d^2)`` relations) and the matching
+    tolerance.
 
     A run's ``eps_t`` and ``eps_r`` are the mean translational (m) and rotational (rad) errors of its
-    estimate over the sampled relations (:func:`slamtrials.metric.sample_relations`).
+    estimate over its relation set (:func:`slamtrials.metric.draw_relation_set`).
     """
 
     tolerance: float = Field(
         RUN_TOLERANCE, gt=0.0, le=10.0, description="matching tolerance of estimate to ground-truth timestamps (s)"
     )
 
+    @classmethod
+    def of_stored(cls, doc: dict[str, Any]) -> MetricSettings:
+        """The ``metric`` section of a stored campaign config (an earlier version's means ``rule: paper``)."""
+        return cls.model_validate(upgrade_stored_config({"metric": doc})["metric"], context={"stored": True})
+
     @property
-    def rule(self) -> SamplingRule:
+    def sampling(self) -> SamplingRule:
         """The sampling rule alone (without the matching tolerance)."""
         return SamplingRule(**self.model_dump(exclude={"tolerance"}))
 
@@ -125,6 +131,9 @@ def _beside(folder: Path, entry: Any) -> Any:
 def upgrade_stored_config(doc: dict[str, Any]) -> dict[str, Any]:
     """A stored campaign config's JSON form, as this version writes it (a copy; ``doc`` is not changed)."""
     doc = copy.deepcopy(doc)
+    metric = doc.get("metric")
+    if isinstance(metric, dict) and "rule" not in metric:
+        metric["rule"] = "paper"  # earlier versions knew only the paper's absolute margins
     explore = doc.get("explore")
     if isinstance(explore, dict):
         for name in ROBOT_FIELDS:

@@ -3,10 +3,12 @@
 No simulation: for every done run of the source campaign, the recorded frames (laser, odometry, truth)
 are fed offline to the new algorithm, seeded like the trial's own SLAM stream (the second child of
 ``SeedSequence(run seed)``, so replaying the original algorithm and parameters reproduces the original
-estimate), and the estimate is evaluated exactly as in the campaign (same relation sampling, same
-seed). Each replayed run becomes a complete run folder of the new campaign: ``frames.npz`` (the source
-frames with the new estimate), ``estimate.tum``, the new map, ``relations.txt``, ``errors.npz`` and a
-``run.json`` whose ``replay`` entry names the source run folder, the algorithm and its configuration.
+estimate), and the estimate is scored on the source run's own relation set
+(:func:`~slamtrials.campaign.score.run_relation_set`), so each replayed run and its source are compared
+on the same relations. Each replayed run becomes a complete run folder of the new campaign:
+``frames.npz`` (the source frames with the new estimate), ``estimate.tum``, the new map,
+``relations.npz`` (the source's set) and a ``run.json`` whose ``replay`` entry names the source run
+folder, the algorithm and its configuration.
 
 The new campaign's config is the source's with ``slam`` changed (:func:`replay_slam_settings`: the
 source's algorithm, preset and parameters, with the given overrides on top) and ``replay_of`` set to
@@ -40,7 +42,7 @@ from slamtrials.campaign.folder import (
 from slamtrials.campaign.loop import next_step
 from slamtrials.campaign.results import RunResult
 from slamtrials.campaign.runfiles import publish_run
-from slamtrials.campaign.score import score_run
+from slamtrials.campaign.score import run_relation_set, score_run
 from slamtrials.campaign.store import CampaignStore, WorldInfo
 from slamtrials.campaign.summary import summarize_store, write_summary_csv
 from slamtrials.campaign.task import failure, outcome, write_scored_run
@@ -181,6 +183,7 @@ def replay_slam(record: RunRecord, slam: SlamSettings, seed: int) -> RunRecord:
         metadata=metadata,
         estimate=estimate,
         map=result.occupancy,
+        online=result.online,
     )
 
 
@@ -191,8 +194,9 @@ def replay_one(task: ReplayTask) -> RunResult:
     started = time.perf_counter()
     try:
         source = read_run(task.source)
+        relation_set = run_relation_set(task.source, source, task.seed, task.metric)
         record = replay_slam(source, task.slam, task.seed)
-        score = score_run(record, task.seed, task.metric)
+        score = score_run(record, task.seed, task.metric, relation_set)
     except SlamtrialsError as exc:
         return failure(task.world, task.index, exc)
     record.metadata["replay"] = {
@@ -207,9 +211,7 @@ def replay_one(task: ReplayTask) -> RunResult:
         "world": task.world,
         "index": task.index,
         "seed": task.seed,
-        "eps_t": score.eps_t,
-        "eps_r": score.eps_r,
-        "relations": int(score.sampled.count),
+        **score.to_dict(),
         "metric": task.metric.model_dump(mode="json"),
         **task.extra,
     }

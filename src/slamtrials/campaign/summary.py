@@ -7,22 +7,26 @@ ended. :func:`write_summary_csv` saves it as ``summary.csv`` (atomically).
 
 CSV columns: ``world, status, runs, runs_needed, capped, eps_t_mean, eps_t_std, eps_t_std_population,
 eps_t_ci_low, eps_t_ci_high, eps_r_mean, eps_r_std, eps_r_std_population, eps_r_ci_low, eps_r_ci_high,
-confidence, failed_runs, terminations`` (``std`` has divisor ``n - 1``, ``std_population`` divisor ``n``
-as printed in the paper; empty cells where a value is undefined; ``terminations`` as
-``reason:count;...``).
+confidence, failed_runs, terminations, eps_t_metric_share, eps_r_metric_share`` (``std`` has divisor
+``n - 1``, ``std_population`` divisor ``n`` as printed in the paper; empty cells where a value is
+undefined; ``terminations`` as ``reason:count;...``; ``*_metric_share``: the metric's share of the
+between-run variance, :func:`slamtrials.metric.metric_noise_share`, empty for runs stored without
+standard errors).
 """
 
 from __future__ import annotations
 
 import csv
 import io
+import json
 import math
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
 from slamtrials.atomicfile import atomic_write_text
-from slamtrials.campaign.store import CampaignStore
+from slamtrials.campaign.store import CampaignStore, RunRow
+from slamtrials.metric.noiseshare import metric_noise_share
 from slamtrials.metric.stats import EnvironmentStats, environment_stats
 
 __all__ = ["WorldSummary", "summarize_store", "load_summary", "write_summary_csv", "SUMMARY_FILE", "CSV_COLUMNS"]
@@ -47,6 +51,8 @@ CSV_COLUMNS = (
     "confidence",
     "failed_runs",
     "terminations",
+    "eps_t_metric_share",
+    "eps_r_metric_share",
 )
 
 
@@ -72,6 +78,10 @@ class WorldSummary:
         ``{termination reason: runs}``.
     note:
         The world's note (why it failed, why a replay is short).
+    metric_share_t, metric_share_r:
+        The metric's share of the between-run variance of ``eps_t`` and ``eps_r``
+        (:func:`~slamtrials.metric.metric_noise_share`); None when a run has no standard error (stored by
+        an earlier version) or fewer than 2 runs are done.
     """
 
     world: str
@@ -84,6 +94,8 @@ class WorldSummary:
     failed_runs: int
     terminations: dict[str, int]
     note: str | None = None
+    metric_share_t: float | None = None
+    metric_share_r: float | None = None
 
 
 def summarize_store(store: CampaignStore) -> list[WorldSummary]:
@@ -103,6 +115,7 @@ def summarize_store(store: CampaignStore) -> list[WorldSummary]:
                 [r.eps_r for r in done], confidence=settings.confidence, distribution=settings.distribution
             )
         reasons = Counter(r.termination or "unknown" for r in done)
+        share_t, share_r = _metric_shares(done)
         rows.append(
             WorldSummary(
                 world.name,
@@ -115,9 +128,25 @@ def summarize_store(store: CampaignStore) -> list[WorldSummary]:
                 sum(r.status == "failed" for r in mine),
                 dict(sorted(reasons.items())),
                 world.note,
+                share_t,
+                share_r,
             )
         )
     return rows
+
+
+def _metric_shares(done: list[RunRow]) -> tuple[float | None, float | None]:
+    """The metric's share of the between-run variance of eps_t and eps_r, from the runs' standard errors."""
+    details = [json.loads(r.details) if r.details else {} for r in done]
+    shares: list[float | None] = []
+    for metric in ("t", "r"):
+        se = [d.get(f"se_{metric}") for d in details]
+        if len(done) < 2 or any(value is None for value in se):
+            shares.append(None)
+            continue
+        share = metric_noise_share([getattr(r, f"eps_{metric}") for r in done], se)
+        shares.append(None if math.isnan(share) else share)
+    return shares[0], shares[1]
 
 
 def load_summary(folder: str | Path) -> list[WorldSummary]:
@@ -161,6 +190,8 @@ def write_summary_csv(folder: str | Path, rows: list[WorldSummary], confidence: 
                 repr(confidence),
                 row.failed_runs,
                 terminations,
+                _number(row.metric_share_t),
+                _number(row.metric_share_r),
             ]
         )
     return atomic_write_text(Path(folder) / SUMMARY_FILE, text.getvalue())

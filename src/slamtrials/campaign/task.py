@@ -5,10 +5,11 @@ world (cached per worker process), runs the trial (:func:`slamtrials.trial.run_t
 ``trial_fn``), evaluates it (:func:`slamtrials.campaign.score.score_run`) and publishes the run folder
 atomically (:func:`slamtrials.campaign.runfiles.publish_run`):
 
-``run.json`` (written last), ``frames.npz``, ``estimate.tum``, ``map.yaml``/``map.pgm``/``map.png``,
-``relations.txt`` (the sampled relations) and ``errors.npz`` (their errors). ``run.json`` also holds,
-under ``campaign``, the world, run index, seed, ``eps_t``, ``eps_r`` and the metric settings, besides the
-trial's own metadata (resolved trial config, termination reason, timings).
+``run.json`` (written last), ``frames.npz``, ``estimate.tum``, ``map.yaml``/``map.pgm``/``map.png`` and
+``relations.npz`` (the run's relation set). ``run.json`` also holds, under ``campaign``, the world, run
+index, seed, ``eps_t``, ``eps_r``, their standard errors, the relation count, the scores of the online
+estimate and the odometry on the same relations, and the metric settings, besides the trial's own
+metadata (resolved trial config, termination reason, timings).
 
 It returns a :class:`~slamtrials.campaign.results.RunDone` that the driver stores. Errors that are
 properties of the run (a :class:`~slamtrials.errors.SlamtrialsError`, e.g. a start pose in a wall) come
@@ -81,28 +82,25 @@ def worker_name() -> str:
 
 
 def write_scored_run(folder: Path, record: RunRecord, score: RunScore) -> None:
-    """Write relations, errors, then the run folder (``run.json`` last) into ``folder``."""
-    from slamtrials.io.errorsfile import write_errors
+    """Write the relation set, then the run folder (``run.json`` last) into ``folder``."""
+    from slamtrials.campaign.relationsetfile import write_relation_set
     from slamtrials.io.layout import RunFolder
-    from slamtrials.io.relations import write_relations
     from slamtrials.io.runfolder import write_run
 
-    files = RunFolder(folder)
-    write_relations(files.relations, score.sampled.relations)
-    write_errors(files.errors, score.sampled.relations, score.sampled.errors)
+    write_relation_set(RunFolder(folder).relation_set, score.relation_set)
     write_run(folder, record)
 
 
 def outcome(task_world: str, index: int, record: RunRecord, score: RunScore, started: float) -> RunDone:
     """What the driver stores for a done run."""
     trial = TrialSummary.of(record)
-    sampled = score.sampled
+    relation_set = score.relation_set
     return RunDone(
         world=task_world,
         index=index,
         eps_t=score.eps_t,
         eps_r=score.eps_r,
-        relations=int(sampled.count),
+        relations=len(relation_set),
         termination=trial.termination_reason if trial else None,
         mapped_fraction=trial.mapped_fraction if trial else None,
         sim_duration=float(record.t[-1] - record.t[0]) if len(record) else 0.0,
@@ -114,9 +112,11 @@ def outcome(task_world: str, index: int, record: RunRecord, score: RunScore, sta
             distance_m=trial.distance_m if trial else None,
             observed_fraction=trial.observed_fraction if trial else None,
             slam_updates=trial.slam_updates if trial else None,
-            relation_std_t=sampled.std_t,
-            relation_std_r=sampled.std_r,
-            relations_capped=bool(sampled.capped),
+            relation_std_t=relation_set.std_t,
+            relation_std_r=relation_set.std_r,
+            relations_capped=bool(relation_set.capped),
+            se_t=score.estimate.se_t,
+            se_r=score.estimate.se_r,
         ),
     )
 
@@ -143,9 +143,7 @@ def run_one(task: RunTask) -> RunResult:
         "ref": task.ref,
         "index": task.index,
         "seed": task.seed,
-        "eps_t": score.eps_t,
-        "eps_r": score.eps_r,
-        "relations": int(score.sampled.count),
+        **score.to_dict(),
         "metric": task.metric.model_dump(mode="json"),
         **task.extra,
     }

@@ -62,6 +62,21 @@ def summary_table(rows, confidence: float, title: str):
     return table
 
 
+def metric_share_line(rows) -> str | None:
+    """One line: per world, the metric's share of the between-run variance of eps_t / eps_r; None if unknown."""
+    parts = []
+    for row in rows:
+        if row.metric_share_t is None or row.metric_share_r is None:
+            continue
+        parts.append(f"{row.world} {100 * row.metric_share_t:.1f} % / {100 * row.metric_share_r:.1f} %")
+    if not parts:
+        return None
+    return (
+        "metric's share of the between-run variance (eps_t / eps_r; the runs' mean squared standard error over the "
+        "variance of their errors; below 10 % the differences between runs are real): " + ", ".join(parts)
+    )
+
+
 class _Progress:
     """Progress bars per world, fed by campaign events; a line per finished world when not a terminal."""
 
@@ -113,6 +128,9 @@ class _Progress:
 
 def _finish(console, result, config_confidence: float, title: str) -> None:
     console.print(summary_table(result.summary, config_confidence, title))
+    share = metric_share_line(result.summary)
+    if share:
+        console.print(share, highlight=False, soft_wrap=True)
     for note in result.notes:
         console.print(f"note: {note}", highlight=False, soft_wrap=True)
     console.print(
@@ -191,7 +209,8 @@ def status(folder: Annotated[Path, typer.Argument(help="Campaign folder.")]) -> 
     console.print(
         f"{folder}: {what}, algorithm {config.slam.algorithm} (preset {config.slam.preset}), seed {config.seed}, "
         f"runs: initial {config.runs.initial}, cap {config.runs.max_runs}, margins {config.runs.margin_t:g} m / "
-        f"{config.runs.margin_r:g} rad at {100 * config.runs.confidence:g} %; created {state.created}",
+        f"{config.runs.margin_r:g} rad at {100 * config.runs.confidence:g} %; relations: "
+        f"{config.metric.sampling.describe()}; created {state.created}",
         highlight=False,
         soft_wrap=True,
     )
@@ -219,6 +238,9 @@ def status(folder: Annotated[Path, typer.Argument(help="Campaign folder.")]) -> 
         )
     console.print(table)
     console.print(summary_table(state.summary, config.runs.confidence, "Errors so far"))
+    share = metric_share_line(state.summary)
+    if share:
+        console.print(share, highlight=False, soft_wrap=True)
     if state.finished:
         progress = "finished"
     elif state.driver is False:

@@ -8,6 +8,7 @@ errors (``%f`` fixed-point, six decimals, as the Freiburg metricEvaluator's ``-e
 from __future__ import annotations
 
 from dataclasses import replace
+from enum import Enum
 from pathlib import Path
 from typing import Annotated
 
@@ -20,13 +21,20 @@ from slamtrials.metric.rule import SamplingRule
 
 __all__ = ["evaluate", "register"]
 
-DEFAULT_RULE = SamplingRule()
+
+class RuleChoice(str, Enum):
+    """The named sampling rules (:attr:`SamplingRule.rule`)."""
+
+    precise = "precise"
+    paper = "paper"
 
 
 def evaluate(
     run: Annotated[
         Path | None,
-        typer.Argument(help="Simulated run folder: sample relations from its ground truth and evaluate its estimate."),
+        typer.Argument(
+            help="Simulated run folder: evaluate its estimate on the run's relation set (or on relations sampled afresh from its ground truth)."
+        ),
     ] = None,
     estimate: Annotated[
         Path | None, typer.Option("--estimate", "-e", help="Estimated trajectory: CARMEN log or TUM file.")
@@ -80,28 +88,50 @@ def evaluate(
     errors_out: Annotated[
         Path | None, typer.Option("--errors", help="Write per-relation errors here (.npz, or a text table).")
     ] = None,
-    seed: Annotated[int, typer.Option("--seed", "-s", help="Seed of the relation sampling (RUN).")] = 0,
-    pilot: Annotated[int, typer.Option("--pilot", help="Pilot pairs of the sampling (RUN).")] = DEFAULT_RULE.pilot,
+    seed: Annotated[
+        int | None,
+        typer.Option(
+            "--seed",
+            "-s",
+            help="RUN: sample relations afresh with this seed instead of scoring on the run's own relation set (relations.npz).",
+        ),
+    ] = None,
+    rule: Annotated[
+        RuleChoice | None,
+        typer.Option(
+            "--rule",
+            help="RUN: sample afresh by this rule: precise (margin relative to the error; the default) or paper (absolute margins).",
+        ),
+    ] = None,
+    pilot: Annotated[int | None, typer.Option("--pilot", help="Pilot pairs of the sampling (RUN).")] = None,
     confidence: Annotated[
-        float, typer.Option("--confidence", help="Confidence level of the margins (RUN).")
-    ] = DEFAULT_RULE.confidence,
+        float | None, typer.Option("--confidence", help="Confidence level of the margins (RUN).")
+    ] = None,
+    relative_margin: Annotated[
+        float | None,
+        typer.Option(
+            "--relative-margin", help="Margin of error as a fraction of the pilot's mean error (precise rule, RUN)."
+        ),
+    ] = None,
     margin_t: Annotated[
-        float, typer.Option("--margin-t", help="Margin of error of the mean translational error, m (RUN).")
-    ] = DEFAULT_RULE.margin_t,
+        float | None,
+        typer.Option("--margin-t", help="Margin of error of the mean translational error, m (paper rule, RUN)."),
+    ] = None,
     margin_r: Annotated[
-        float, typer.Option("--margin-r", help="Margin of error of the mean rotational error, rad (RUN).")
-    ] = DEFAULT_RULE.margin_r,
+        float | None,
+        typer.Option("--margin-r", help="Margin of error of the mean rotational error, rad (paper rule, RUN)."),
+    ] = None,
     distribution: Annotated[
-        Quantile,
+        Quantile | None,
         typer.Option(
             "--distribution",
             "--quantile",
             help="Critical value: normal or Student t with pilot-1 degrees of freedom (RUN).",
         ),
-    ] = Quantile(DEFAULT_RULE.distribution),
+    ] = None,
     sides: Annotated[
-        int, typer.Option("--sides", help="2 for a two-sided quantile, 1 for one-sided (RUN).")
-    ] = DEFAULT_RULE.sides,
+        int | None, typer.Option("--sides", help="2 for a two-sided quantile, 1 for one-sided (RUN).")
+    ] = None,
 ) -> None:
     """Localization error (Kuemmerle et al.) of an estimate: Mean, Std, Min, Max, NumMeasures in m and rad."""
     from slamtrials.evaluation import evaluate_files, evaluate_run, format_report
@@ -116,23 +146,26 @@ def evaluate(
             raise ConfigError(
                 "with a RUN folder, relations are sampled from its ground truth and its odometry is used: drop --relations and --odometry"
             )
-        if seed < 0:
+        if seed is not None and seed < 0:
             raise ConfigError(f"--seed must be a non-negative integer, got {seed}")
-        rule = sampling_rule(
-            pilot=pilot,
-            confidence=confidence,
-            margin_t=margin_t,
-            margin_r=margin_r,
-            distribution=distribution.value,
-            sides=sides,
-            squared=squared,
-        )
+        given = {
+            "rule": rule.value if rule is not None else None,
+            "pilot": pilot,
+            "confidence": confidence,
+            "relative_margin": relative_margin,
+            "margin_t": margin_t,
+            "margin_r": margin_r,
+            "distribution": distribution.value if distribution is not None else None,
+            "sides": sides,
+            "squared": squared or None,
+        }
+        given = {name: value for name, value in given.items() if value is not None}
         result = evaluate_run(
             run,
             estimate=estimate,
             estimate_pose=estimate_pose,
             seed=seed,
-            rule=rule,
+            rule=sampling_rule(**given) if given else None,
             tolerance=tolerance,
             interpolate=interpolate,
             out=out,

@@ -38,7 +38,10 @@ def trial(
     """Let the robot explore WORLD on its own, mapped online by SLAM, until the map stops changing."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from slamtrials.io.runfolder import RunFolder, write_run
+    from slamtrials.campaign.config import MetricSettings
+    from slamtrials.campaign.score import score_run
+    from slamtrials.campaign.task import write_scored_run
+    from slamtrials.io.runfolder import RunFolder
     from slamtrials.io.yamlfile import read_yaml_mapping
     from slamtrials.report.runplot import save_run_figure
     from slamtrials.trial import TrialConfig, TrialSummary, run_trial
@@ -69,7 +72,10 @@ def trial(
 
         record = run_trial(the_world, trial_config, seed, on_progress=report)
     record.metadata.update(world_source=str(world))
-    write_run(out, record)
+    metric = MetricSettings()
+    score = score_run(record, seed, metric)
+    record.metadata["evaluation"] = {**score.to_dict(), "metric": metric.model_dump(mode="json")}
+    write_scored_run(Path(out), record, score)
     save_run_figure(the_world, record, RunFolder(out).picture, title=f"{the_world.name}, seed {seed}")
     info = TrialSummary.of(record)
     assert info is not None  # run_trial always stores it
@@ -77,6 +83,14 @@ def trial(
         f"{out}: {info.termination_reason} after {info.duration_s:.0f} s simulated in {info.wall_time_s:.1f} s "
         f"({info.realtime_factor:.0f}x real time); mapped {100 * info.mapped_fraction:.1f} % of the reachable "
         f"{info.reachable_area_m2:.0f} m^2, travelled {info.distance_m:.0f} m, {info.slam_updates} SLAM updates",
+        soft_wrap=True,
+        highlight=False,
+    )
+    odometry = score.odometry
+    console.print(
+        f"error over {len(score.relation_set)} relations (relations.npz): translational {score.eps_t:.4f} "
+        f"+- {score.estimate.se_t:.4f} m, rotational {score.eps_r:.4f} +- {score.estimate.se_r:.4f} rad "
+        f"(standard errors); odometry alone {odometry.eps_t:.4f} m, {odometry.eps_r:.4f} rad",
         soft_wrap=True,
         highlight=False,
     )

@@ -34,7 +34,11 @@ class RunFolder:
     MAP = "map.yaml"
     MAP_IMAGE = "map.pgm"
     MAP_PICTURE = "map.png"
-    #: ``relations.txt``: the relations the run was scored on (Kuemmerle format); ``errors.npz``: their errors.
+    #: ``relations.npz``: the run's relation set (pairs of frames), drawn once; every estimate of the run
+    #: is scored on it (:mod:`slamtrials.campaign.relationsetfile`).
+    RELATION_SET = "relations.npz"
+    #: ``relations.txt`` (Kuemmerle format) and ``errors.npz`` (per-relation errors): what a later
+    #: evaluation writes into its ``evaluations/<name>/`` folder.
     RELATIONS = "relations.txt"
     ERRORS = "errors.npz"
     #: ``run.png``: the true and estimated paths on the floor plan.
@@ -74,6 +78,11 @@ class RunFolder:
     def map_picture(self) -> Path:
         """``map.png``."""
         return self.path / self.MAP_PICTURE
+
+    @property
+    def relation_set(self) -> Path:
+        """``relations.npz``."""
+        return self.path / self.RELATION_SET
 
     @property
     def relations(self) -> Path:

@@ -2,7 +2,8 @@
 
 ``frames.npz`` holds ``t`` float64 [T] (s), ``scans`` float32 [T, B] (m), ``odometry`` float64 [T, 3]
 (odometry frame), ``truth`` float64 [T, 3] (world frame) and ``stalled`` bool [T], and, for a run with a
-SLAM estimate, ``estimate`` float64 [T, 3] (map frame), also written as ``estimate.tum``.
+SLAM estimate, ``estimate`` float64 [T, 3] (map frame; the algorithm's final trajectory), also written
+as ``estimate.tum``, and ``online`` float64 [T, 3] (what the algorithm returned at each frame) when known.
 ``run.json`` holds the laser geometry, the run's metadata (world, seed, drawn odometry bias, outcome,
 timings, resolved config) and the versions that produced it.
 A run with a final SLAM map also has ``map.yaml`` + ``map.pgm`` (ROS map_server) and ``map.png``.
@@ -47,6 +48,8 @@ _ARRAYS: dict[str, tuple[type, int | None]] = {  # name -> (dtype, size of the l
     "truth": (np.float64, 3),
     "stalled": (np.bool_, None),
 }
+#: Optional pose arrays, float64 [T, 3] (map frame): the final and the online SLAM estimate.
+_ESTIMATES = ("estimate", "online")
 _LASER_KEYS = ("angle_min", "angle_increment", "range_min", "range_max")
 
 
@@ -83,6 +86,8 @@ def write_run(folder: str | Path, record: RunRecord) -> Path:
         write_tum(files.estimate, Trajectory(t=arrays["t"], poses=arrays["estimate"]))
     else:
         files.estimate.unlink(missing_ok=True)
+    if record.online is not None:
+        arrays["online"] = np.asarray(record.online, dtype=np.float64).reshape(len(record), 3)
     if record.map is not None:
         write_map(files.map, record.map.grid, record.map.resolution, record.map.origin)
         write_map_png(files.map_picture, record.map.grid)
@@ -135,7 +140,7 @@ def _read_frames(path: Path) -> dict[str, np.ndarray]:
         raise FormatError(path, "missing: every run folder has frames.npz")
     try:
         with np.load(path, allow_pickle=False) as npz:
-            arrays = {name: npz[name] for name in npz.files if name in _ARRAYS or name == "estimate"}
+            arrays = {name: npz[name] for name in npz.files if name in _ARRAYS or name in _ESTIMATES}
     except (zipfile.BadZipFile, zlib.error, ValueError, OSError, EOFError, io.UnsupportedOperation) as exc:
         raise FormatError(path, f"not a readable .npz archive ({exc})") from None
     for name, (dtype, last) in _ARRAYS.items():
@@ -146,11 +151,11 @@ def _read_frames(path: Path) -> dict[str, np.ndarray]:
         if last is not None and (arrays[name].ndim != 2 or arrays[name].shape[1] != last):
             raise FormatError(path, f"array '{name}' has shape {arrays[name].shape}, expected [T, {last}]")
     n = len(arrays["t"])
-    if "estimate" in arrays and (arrays["estimate"].dtype != np.float64 or arrays["estimate"].shape != (n, 3)):
-        raise FormatError(
-            path,
-            f"array 'estimate' has {arrays['estimate'].dtype} {arrays['estimate'].shape}, expected float64 [{n}, 3]",
-        )
+    for name in _ESTIMATES:
+        if name in arrays and (arrays[name].dtype != np.float64 or arrays[name].shape != (n, 3)):
+            raise FormatError(
+                path, f"array '{name}' has {arrays[name].dtype} {arrays[name].shape}, expected float64 [{n}, 3]"
+            )
     if arrays["scans"].ndim != 2 or any(len(a) != n for a in arrays.values()):
         raise FormatError(path, f"arrays disagree on the number of frames: { {k: v.shape for k, v in arrays.items()} }")
     if n > 1 and not np.all(np.diff(arrays["t"]) > 0):

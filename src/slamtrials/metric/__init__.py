@@ -9,6 +9,8 @@ Pure functions over arrays and the dataclasses of :mod:`slamtrials.record`; no f
 - :mod:`~slamtrials.metric.quantiles`: critical values of a confidence level.
 - :mod:`~slamtrials.metric.rule`: the relation-sampling rule (:class:`SamplingRule`).
 - :mod:`~slamtrials.metric.sampling`: automatic relation sampling (pilot, ``N = ceil(z^2 s^2 / d^2)``).
+- :mod:`~slamtrials.metric.relationset`: a run's one relation set, and any estimate scored on it.
+- :mod:`~slamtrials.metric.noiseshare`: standard errors, and the metric's share of the between-run variance.
 - :mod:`~slamtrials.metric.runcount`: the run-count rule of the paper's Section III-C.
 - :mod:`~slamtrials.metric.stats`: per-environment mean, population and sample std, confidence interval.
 """
@@ -26,6 +28,7 @@ from slamtrials.metric.matching import (
 )
 from slamtrials.metric.noiseshare import metric_noise_share, standard_error
 from slamtrials.metric.quantiles import critical_value
+from slamtrials.metric.relationset import RelationSet, SetScore, draw_relation_set, score_on_set
 from slamtrials.metric.relerrors import RelationErrors, evaluate_relations, relative_pose_errors
 from slamtrials.metric.rule import SamplingRule
 from slamtrials.metric.runcount import RunCount, replay_run_count, runs_needed
@@ -57,6 +60,10 @@ __all__ = [
     "EnvironmentStats",
     "environment_stats",
     "metric_noise_share",
+    "RelationSet",
+    "SetScore",
+    "draw_relation_set",
+    "score_on_set",
     "standard_error",
     "SUMMARY_HEADER",
     "ErrorSummary",

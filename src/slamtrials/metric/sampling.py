@@ -1,10 +1,12 @@
 """Automatic relation sampling from a ground-truth trajectory (Amigoni, Castelli, Luperto, IROS 2018).
 
 1. Pilot: draw ``n0`` pairs (default 500) of ground-truth poses uniformly at random, ``t1 < t2``, and take
-   the sample standard deviations ``s_t``, ``s_r`` of their translational and rotational errors.
-2. Sample size ``N = ceil(z^2 s^2 / d^2)`` for translation (margin ``d_t``, default 0.02 m) and rotation
-   (``d_r``, default 0.02 rad); the relation count is ``max(N_t, N_r)``. ``z`` is the two-sided normal
-   quantile of the confidence (default 99 %: 2.576) unless another is asked for.
+   the means and sample standard deviations ``s_t``, ``s_r`` of their translational and rotational errors.
+2. Sample size ``N = ceil(z^2 s^2 / d^2)`` for translation (margin ``d_t``) and rotation (``d_r``); the
+   relation count is ``max(N_t, N_r)`` within the rule's floor and cap. The margins are 1 % of the pilot's
+   mean errors under the default ``precise`` rule, 0.02 m and 0.02 rad under the paper's
+   (:class:`~slamtrials.metric.rule.SamplingRule`). ``z`` is the two-sided normal quantile of the
+   confidence (default 99 %: 2.576) unless another is asked for.
 3. Draw that many fresh pairs (a new sample, not the pilot extended) and compute their errors.
 
 Pairs are drawn among the ground-truth poses that the estimate covers (an estimated pose within the
@@ -69,6 +71,13 @@ def sample_size(std: float, margin: float, critical: float) -> int:
     return int(math.ceil(exact * (1.0 - 1e-9)))
 
 
+def _needed(std: float, margin: float, critical: float) -> int:
+    """:func:`sample_size`, and 0 for a zero margin of a zero spread (a relative margin of a perfect estimate)."""
+    if margin == 0.0 and std == 0.0:
+        return 0
+    return sample_size(std, margin, critical)
+
+
 def draw_pairs(n: int, count: int, rng: np.random.Generator) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """Draw ``count`` pairs of distinct indices in ``[0, n)`` uniformly, each ordered ``i < j``.
 
@@ -109,8 +118,14 @@ class SampledRelations:
         The ``count`` sampled relations (ground-truth timestamps and relative poses).
     errors:
         Their errors against the estimate (all matched).
+    first, second:
+        int64 ``[count]`` indices into ``truth`` of each relation's two poses (``first < second``).
     pilot_relations, pilot_errors:
         The pilot sample and its errors.
+    mean_t, mean_r:
+        Means of the pilot's translational and rotational errors.
+    margin_t, margin_r:
+        The margins of error used (absolute, or the relative margin times the pilot's means).
     std_t, std_r:
         Sample standard deviations (divisor ``n0 - 1``) of the pilot's translational (m) and rotational
         (rad) errors (squared units when the errors are squared).
@@ -130,8 +145,14 @@ class SampledRelations:
 
     relations: Relations
     errors: RelationErrors
+    first: NDArray[np.int64]
+    second: NDArray[np.int64]
     pilot_relations: Relations
     pilot_errors: RelationErrors
+    mean_t: float
+    mean_r: float
+    margin_t: float
+    margin_r: float
     std_t: float
     std_r: float
     critical: float
@@ -172,7 +193,7 @@ def sample_relations(
     interpolate: bool = False,
     odometry: Trajectory | None = None,
 ) -> SampledRelations:
-    """Sample relations from ``truth`` by the IROS 2018 rule and evaluate ``estimate`` on them.
+    """Sample relations from ``truth`` by ``rule`` (pilot, then N fresh pairs) and evaluate ``estimate`` on them.
 
     Parameters
     ----------
@@ -215,8 +236,11 @@ def sample_relations(
     pilot_relations, pilot_errors = _errors_for(sub_truth, estimated, corrected, i, j, squared)
     std_t = float(np.std(pilot_errors.translational, ddof=1))
     std_r = float(np.std(pilot_errors.rotational, ddof=1))
-    needed_t = sample_size(std_t, rule.margin_t, critical)
-    needed_r = sample_size(std_r, rule.margin_r, critical)
+    mean_t = float(np.mean(pilot_errors.translational))
+    mean_r = float(np.mean(pilot_errors.rotational))
+    margin_t, margin_r = rule.margins(mean_t, mean_r)
+    needed_t = _needed(std_t, margin_t, critical)
+    needed_r = _needed(std_r, margin_r, critical)
     wanted = max(needed_t, needed_r, rule.min_relations)
     count = min(wanted, rule.max_relations)
 
@@ -225,8 +249,14 @@ def sample_relations(
     return SampledRelations(
         relations=relations,
         errors=errors,
+        first=covered[i].astype(np.int64),
+        second=covered[j].astype(np.int64),
         pilot_relations=pilot_relations,
         pilot_errors=pilot_errors,
+        mean_t=mean_t,
+        mean_r=mean_r,
+        margin_t=margin_t,
+        margin_r=margin_r,
         std_t=std_t,
         std_r=std_r,
         critical=critical,

@@ -511,7 +511,7 @@ def _fig3(
     if chosen is None:
         return h.section(title, "<p>No finished run to check.</p>", id="fig-3")
     world, index = chosen
-    metric = MetricSettings.model_validate(data.config.get("metric", {}))
+    metric = MetricSettings.of_stored(data.config.get("metric", {}))
     try:
         record = _read_record(data, world, index)
         if record.estimate is None:
@@ -527,7 +527,7 @@ def _fig3(
                 repeats,
                 sequence,
                 component=component,
-                rule=metric.rule,
+                rule=metric.sampling,
                 tolerance=metric.tolerance,
                 odometry=odometry,
             )
@@ -537,6 +537,7 @@ def _fig3(
         log.warning("relation-sampling check of %s/%d: %s", world, index, exc)
         return h.section(title, h.notes([f"Run {world}/{index} could not be checked: {exc}"]), id="fig-3")
     row = done[(done["world"] == world) & (done["run"] == index)].iloc[0]
+    margins = dict(zip(METRICS, metric.sampling.margins(float(row["eps_t"]), float(row["eps_r"]))))
     fig = figs.new(11, 3.8)
     axes = fig.subplots(1, 2)
     for ax, (component, values), metric_name in zip(axes, means.items(), METRICS):
@@ -548,13 +549,12 @@ def _fig3(
         ax.set_title(f"{world} run #{index}: {SYMBOLS[metric_name]} over {repeats} samplings", fontsize=9)
     caption = (
         f"The paper's Fig. 3 for run #{index} of {world}: the distribution of the run's mean error over {repeats} "
-        f"independent samplings of relations (each by the campaign's rule: pilot {metric.pilot}, "
-        f"{_pct(metric.confidence)} confidence, margins \u00b1{metric.margin_t:g} m and "
-        f"\u00b1{metric.margin_r:g} rad), with a fitted normal; dotted: the value the campaign recorded "
+        f"independent samplings of relations (each by the campaign's {metric.sampling.describe()}), "
+        f"with a fitted normal; dotted: the value the campaign recorded "
         f"({row['eps_t']:.4f} m, {row['eps_r']:.4f} rad). Sampling seed {seed}."
     )
     spread = [
-        f"{SYMBOLS[m]}: mean {v.mean():.4g}, sd {v.std(ddof=1):.2g} over samplings (margin \u00b1{getattr(metric, 'margin_' + m[-1]):g})"
+        f"{SYMBOLS[m]}: mean {v.mean():.4g}, sd {v.std(ddof=1):.2g} over samplings (margin \u00b1{margins[m]:.2g})"
         for m, v in zip(METRICS, means.values())
     ]
     return h.section(

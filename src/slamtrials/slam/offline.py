@@ -40,6 +40,8 @@ class SlamRun:
         The run's seed (the algorithm's stream is :func:`slamtrials.seeding.slam_rng` of it).
     trajectory:
         The algorithm's :meth:`trajectory` after the last frame (map frame).
+    online:
+        float64 ``[T, 3]``: what ``process`` returned for each frame (map frame).
     occupancy:
         The final map.
     timing:
@@ -53,6 +55,7 @@ class SlamRun:
     config: BaseModel
     seed: int
     trajectory: Trajectory
+    online: NDArray[np.float64]
     occupancy: OccupancyGrid
     timing: NDArray[np.float64]
     updates: int
@@ -116,6 +119,7 @@ def run_over_recording(
     slam.reset(slam_rng(seed))
     total = len(record)
     timing = np.empty(total, dtype=np.float64)
+    online = np.empty((total, 3), dtype=np.float64)
     for k in range(total):
         frame = Frame(
             t=float(record.t[k]),
@@ -125,7 +129,7 @@ def run_over_recording(
             stalled=bool(record.stalled[k]),
         )
         started = time.perf_counter()
-        slam.process(frame)
+        online[k] = slam.process(frame)
         timing[k] = time.perf_counter() - started
         if on_frame is not None:
             on_frame(k, total)
@@ -135,6 +139,7 @@ def run_over_recording(
         config=config,
         seed=seed,
         trajectory=slam.trajectory(),
+        online=online,
         occupancy=slam.occupancy(),
         timing=timing,
         updates=int(slam.updates),

@@ -22,6 +22,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from slamtrials import stablemath
 from slamtrials.errors import ConfigError
@@ -102,7 +103,8 @@ def run_trial(
     -------
     RunRecord
         Every frame (``t``, ``scans``, ``odometry``, ``truth``, ``stalled``), ``estimate`` (the SLAM
-        trajectory, map frame, one pose per frame), ``map`` (the final SLAM map), and ``metadata``:
+        trajectory, map frame, one pose per frame), ``online`` (what SLAM returned at each frame, the
+        pose the explorer drove by), ``map`` (the final SLAM map), and ``metadata``:
         ``trial`` (termination reason, mapped and observed fractions of the free area the robot's
         footprint can reach (:meth:`World.reachable_by_disc`; mapped with the SLAM map aligned locally,
         :func:`~slamtrials.trial.coverage.local_mapped_fraction`, and, as ``mapped_fraction_global``,
@@ -135,6 +137,7 @@ def run_trial(
     max_time = config.termination.max_time
 
     frames: list[Frame] = []
+    online: list[NDArray[np.float64]] = []
     frame = sim.observe()
     next_report = 0.0
     reason = None
@@ -144,6 +147,7 @@ def run_trial(
         tick = time.perf_counter()
         estimate = slam.process(frame)
         slam_seconds += time.perf_counter() - tick
+        online.append(np.array(estimate, dtype=np.float64))
         grid = slam.occupancy()
         reason = termination.check(frame.t, grid)
         if reason is not None:
@@ -165,6 +169,7 @@ def run_trial(
             f"{len(record)} frames; trajectory() must hold one pose per processed frame"
         )
     record.estimate = trajectory.poses
+    record.online = np.stack(online)
     final_map: OccupancyGrid = slam.occupancy()
     record.map = final_map
     wall = time.perf_counter() - started

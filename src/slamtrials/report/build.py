@@ -653,16 +653,16 @@ def _fig4_panel(ax, record, label: str, row: pd.Series):
         f"{label}: run #{int(row['run'])}, {SYMBOLS['eps_t']} {row['eps_t']:.3f} m, "
         f"{SYMBOLS['eps_r']} {row['eps_r']:.4f} rad"
     )
-    if record.estimate is None:
+    estimate = None if record.estimate is None else np.asarray(record.estimate, dtype=np.float64)
+    if estimate is None or not np.isfinite(estimate).all(axis=1).any():
         if record.map is not None:
             cf.draw_map(ax, record.map, title=title)
             cf.zoom_to_known(ax, record.map)
-        ax.text(0.5, 0.5, "no estimate recorded", ha="center", va="center", transform=ax.transAxes)
+        message = "no estimate recorded" if estimate is None else "the estimate has no finite pose"
+        ax.text(0.5, 0.5, message, ha="center", va="center", transform=ax.transAxes)
         ax.set_title(title, fontsize=11)
         return None
-    fit = cf.draw_run_on_map(
-        ax, record.map, record.truth, np.asarray(record.estimate, dtype=np.float64), title=title, legend=False
-    )
+    fit = cf.draw_run_on_map(ax, record.map, record.truth, estimate, title=title, legend=False)
     ax.set_title(title, fontsize=11)
     return fit
 

@@ -229,7 +229,9 @@ def test_times_are_rounded():
         "-",
         "-",
     ]
-    assert [h.fmt_duration(v) for v in (8.64, 43.4, 59.7, 166.2, 3599.4, 3600.0, 11130.0, "x")] == [
+    assert [h.fmt_duration(v) for v in (0.01, 0.0, 8.64, 43.4, 59.7, 166.2, 3599.4, 3600.0, 11130.0, "x")] == [
+        "< 0.1 s",
+        "0.0 s",
         "8.6 s",
         "43 s",
         "1 min 00 s",

@@ -20,6 +20,7 @@ from slamtrials.campaign.store import DB_FILE
 from slamtrials.campaign.testing import FakeTrial
 from slamtrials.io.runfolder import read_run
 from slamtrials.report import campaign_figures as cf
+from slamtrials.report import html as h
 from slamtrials.report.build import build_report
 from slamtrials.report.load import load_campaign
 
@@ -181,8 +182,9 @@ def test_metric_share_per_world_and_what_it_means(campaign, drawn):
     assert office_t < 0.1 <= lab_t  # the fixture has one world on each side of 10 %
     note = html.unescape(re.search(r'<p class="explain" id="metric-share-note">(.*?)</p>', page, re.S).group(1))
     assert "mean(se\u00b2) over the variance of the run errors" in note
-    assert "Below 10%, the differences between the runs are real" in note and "n/a" in note
+    assert "Below 10 %, the differences between the runs are real" in note and "n/a" in note
     assert f"lab_small_01 (\u03b5t {100 * lab_t:.0f} %" in note and "office_small_01 (\u03b5t" not in note
+    assert note.count("lab_small_01") == 1  # one entry per world, both errors in it
 
 
 def test_the_outlier_column_is_explained_on_the_page(drawn):
@@ -199,4 +201,6 @@ def test_times_on_the_page_are_rounded(campaign, drawn):
         assert row[9] == "1.0" and re.fullmatch(r"\d+\.\d|\d+", row[10]), row  # sim s, wall s
         assert row[10] == (f"{run['wall_s']:.1f}" if run["wall_s"] < 9.95 else f"{run['wall_s']:.0f}")
     overview = html.unescape(re.search(r"<dt>run times</dt><dd>(.*?)</dd>", page).group(1))
-    assert overview.startswith("18 s simulated (mean 1.0 s per run)")
+    assert overview.startswith("18 s simulated (mean 1.0 s per run); ")
+    wall = data.done["wall_s"]
+    assert overview.endswith(f"of worker time (mean {h.fmt_duration(wall.mean())} per run)")

@@ -362,7 +362,7 @@ def _table_one(data: CampaignData, done: pd.DataFrame) -> str:
 
 def _share_note(data: CampaignData) -> str:
     """The paragraph under Table I that says what the metric-share columns are, and which worlds exceed 10 %."""
-    limit = f"{NOISE_SHARE_LIMIT:.0%}"
+    limit = _pct(NOISE_SHARE_LIMIT)
     text = (
         "Metric share: each run's error is the mean over its sampled relations, so it carries a standard error "
         "se of its own (the per-relation errors' standard deviation over \u221aN). Over a world's runs, the "
@@ -375,10 +375,13 @@ def _share_note(data: CampaignData) -> str:
     )
     high = []
     for _, w in data.worlds.iterrows():
-        for metric in METRICS:
-            share = w[f"{metric}_metric_share"]
-            if math.isfinite(share) and share >= NOISE_SHARE_LIMIT:
-                high.append(f"{w['world']} ({SYMBOLS[metric]} {100 * share:.0f} %)")
+        shares = [
+            f"{SYMBOLS[metric]} {100 * w[f'{metric}_metric_share']:.0f} %"
+            for metric in METRICS
+            if math.isfinite(w[f"{metric}_metric_share"]) and w[f"{metric}_metric_share"] >= NOISE_SHARE_LIMIT
+        ]
+        if shares:
+            high.append(f"{w['world']} ({', '.join(shares)})")
     if high:
         text += f" At or above {limit} here: " + ", ".join(high) + "."
     return f'<p class="explain" id="metric-share-note">{h.esc(text)}</p>'

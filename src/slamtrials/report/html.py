@@ -100,13 +100,16 @@ def fmt_seconds(value: Any) -> str:
 
 
 def fmt_duration(seconds: Any) -> str:
-    """A duration for text, rounded to what a reader needs: ``8.6 s``, ``43 s``, ``2 min 46 s``, ``3 h 05 min``."""
+    """A duration for text, rounded to what a reader needs: ``< 0.1 s``, ``8.6 s``, ``43 s``, ``2 min 46 s``,
+    ``3 h 05 min``."""
     try:
         number = float(seconds)
     except (TypeError, ValueError):
         return "-"
     if not math.isfinite(number):
         return "-"
+    if 0.0 < number < 0.05:
+        return "< 0.1 s"
     if number < 59.5:
         return f"{fmt_seconds(number)} s"
     whole = int(round(number))

@@ -111,7 +111,7 @@ def align_truth(truth: ArrayLike, estimate: ArrayLike) -> TruthAlignment:
     true_poses, estimated = as_poses(truth), as_poses(estimate)
     if true_poses.shape != estimated.shape or true_poses.ndim != 2:
         raise ValueError(f"truth {true_poses.shape} and estimate {estimated.shape} must both be [T, 3]")
-    used = np.isfinite(true_poses).all(axis=1) & np.isfinite(estimated).all(axis=1)
+    used: NDArray[np.bool_] = np.asarray(np.isfinite(true_poses).all(axis=1) & np.isfinite(estimated).all(axis=1))
     if not used.any():
         raise ValueError("no pose has both a finite true and a finite estimated value")
     transform = fit_rigid_2d(true_poses[used, :2], estimated[used, :2])

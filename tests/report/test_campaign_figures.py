@@ -191,6 +191,56 @@ def test_trajectories_align_the_estimate_through_its_first_pose() -> None:
     assert cf.draw_trajectories(ax, truth, late) == pytest.approx(truth.poses[50:], abs=1e-9)
 
 
+def test_run_on_map_draws_the_estimate_as_recorded_and_the_truth_fitted_onto_it() -> None:
+    truth, _ = _run_trajectories()
+    map_from_world = np.array([-4.0, 6.0, 2.2])
+    estimate = compose(map_from_world, truth.poses + np.r_[0.0, 0.03, 0.0])  # map frame, 3 cm off in y
+    grid = np.full((200, 300), -1, dtype=np.int8)
+    grid[80:120, 100:180] = 0  # the known part of the map
+    occupancy = OccupancyGrid(grid=grid, resolution=0.1, origin=np.array([-20.0, -5.0, 0.0]))
+    _fig, (ax,) = _figure()
+    fit = cf.draw_run_on_map(ax, occupancy, truth.poses, estimate, title="best")
+    drawn_estimate, drawn_truth = _line(ax, "estimate"), _line(ax, "truth")
+    assert drawn_estimate.get_xdata() == pytest.approx(estimate[:, 0])  # not moved: the map's frame
+    assert drawn_truth.get_xdata() == pytest.approx(fit.truth[:, 0]) and drawn_truth.get_ydata() == pytest.approx(
+        fit.truth[:, 1]
+    )
+    assert fit.map_from_world[2] == pytest.approx(map_from_world[2], abs=1e-9)
+    assert fit.max_distance == pytest.approx(0.0, abs=1e-9)  # shifting the whole path is rigid too: the fit takes it
+    assert _line(ax, "start").get_xdata() == pytest.approx([estimate[0, 0]])
+    assert len(ax.images) == 1 and ax.get_title() == "best"
+    # the view holds the known cells and both paths (plus the margin), not the whole unknown grid
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    known_x, known_y = (-20.0 + 10.0, -20.0 + 18.0), (-5.0 + 8.0, -5.0 + 12.0)
+    xs, ys = np.r_[estimate[:, 0], fit.truth[:, 0]], np.r_[estimate[:, 1], fit.truth[:, 1]]
+    assert x0 == pytest.approx(min(known_x[0], xs.min()) - 0.5) and x1 == pytest.approx(max(known_x[1], xs.max()) + 0.5)
+    assert y0 == pytest.approx(min(known_y[0], ys.min()) - 0.5) and y1 == pytest.approx(max(known_y[1], ys.max()) + 0.5)
+    _fig, (ax,) = _figure()
+    cf.draw_run_on_map(ax, None, truth.poses, estimate, legend=False)
+    assert not ax.images and ax.get_legend() is None and len(_line(ax, "truth").get_xdata()) == len(truth.poses)
+
+
+def test_world_order_is_the_one_given(runs: pd.DataFrame) -> None:
+    order = ["school", "office", "campus"]  # neither by name nor by mean
+    _fig, axes = _figure(3)
+    cf.draw_all_runs(axes[0], runs, "eps_t", order=order)
+    counts = cf.draw_termination(axes[1], runs, order)
+    means = cf.draw_explored(axes[2], runs, order)
+    for ax in axes:
+        assert [label.get_text() for label in ax.get_xticklabels()] == order
+    assert list(counts.index) == order and list(means.index) == order
+    assert counts.sum(axis=1).tolist() == [9, 12, 15]
+    assert means.to_numpy() == pytest.approx(runs.groupby("world")["mapped"].mean()[order].to_numpy())
+    # the box-plot means follow the same order
+    assert _line(axes[0], "means").get_ydata() == pytest.approx(runs.groupby("world")["eps_t"].mean()[order])
+    # worlds without runs are skipped; a world of runs that the order does not list is an error
+    _fig, (ax,) = _figure()
+    cf.draw_termination(ax, runs, ["nowhere", *order])
+    assert [label.get_text() for label in ax.get_xticklabels()] == order
+    with pytest.raises(ValueError, match="campus"):
+        cf.draw_explored(ax, runs, ["school", "office"])
+
+
 def test_termination_stacks_count_every_run(runs: pd.DataFrame) -> None:
     _fig, (ax,) = _figure()
     counts = cf.draw_termination(ax, runs)

@@ -126,9 +126,10 @@ def test_report_page_has_table_one_and_every_figure(campaign, report):
         assert row[1] == world["status"]
         if world["runs_done"]:
             assert row[3] == f"{world['eps_t_mean']:.3f}" and row[4] == f"{world['eps_t_std']:.3f}"
-            assert row[5] == f"{world['eps_t_half_width']:.3f}" and row[6] == f"{world['eps_r_mean']:.4f}"
+            assert row[5] == f"{world['eps_t_half_width']:.3f}" and row[7] == f"{world['eps_r_mean']:.4f}"
+            assert row[6] == row[10] == "n/a"  # no standard errors recorded: the metric's share is not known
         else:
-            assert row[3] == "-"
+            assert row[3] == "-" and row[6] == "-"
     # every image is a PNG file beside the page, every PDF link too
     assert len(page.images) >= 1 + 2 + 1 + 1 + 1 + 2 + 1  # Fig. 1 (all + 2 worlds), 5, 6, 3, 4 (2 worlds), termination
     for src in page.images:
@@ -216,6 +217,30 @@ def test_html_helpers_escape_everything():
     figure = h.figure("figures/a b.png", "caption <i>", pdf="figures/a.pdf")
     assert 'src="figures/a b.png"' in figure and "caption &lt;i&gt;" in figure and 'href="figures/a.pdf"' in figure
     assert h.notes([]) == "" and "&lt;" in h.notes(["<"])
+
+
+def test_times_are_rounded():
+    assert [h.fmt_seconds(v) for v in (0.04, 8.64, 9.96, 166.2, 1234.5, None, math.nan)] == [
+        "0.0",
+        "8.6",
+        "10",
+        "166",
+        "1234",
+        "-",
+        "-",
+    ]
+    assert [h.fmt_duration(v) for v in (0.01, 0.0, 8.64, 43.4, 59.7, 166.2, 3599.4, 3600.0, 11130.0, "x")] == [
+        "< 0.1 s",
+        "0.0 s",
+        "8.6 s",
+        "43 s",
+        "1 min 00 s",
+        "2 min 46 s",
+        "59 min 59 s",
+        "1 h 00 min",
+        "3 h 06 min",
+        "-",
+    ]
 
 
 # ------------------------------------------------------------------------------------------ comparison

@@ -7,6 +7,10 @@ translational error ``e_t`` and rotational error ``e_r``. ``e_t`` and ``e_r`` ar
 distributions (clipped at 0) with ``numpy.random.default_rng(seed)``, so their variance across runs is
 known and the expected run counts of the Section III-C rule can be computed independently.
 
+With ``map_offset`` the estimate (and the map) is expressed in a map frame other than the world frame:
+``estimate = map_offset (+) estimate_in_world``, a rigid motion that leaves every relative error, and so
+``e_t`` and ``e_r``, unchanged (the default, no offset, gives the same numbers bit for bit).
+
 Pass it as ``trial_fn`` to :func:`slamtrials.campaign.run_campaign`. It is a module-level class so that
 Dask workers can unpickle it by reference.
 """
@@ -18,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from slamtrials.geometry import compose
 from slamtrials.record import LaserGeometry, OccupancyGrid, RunRecord
 from slamtrials.trial import TrialSummary
 
@@ -38,6 +43,8 @@ class FakeTrial:
         Mean and standard deviation of the per-run rotational error ``e_r`` (rad).
     sleep:
         Wall-clock seconds to pretend to work (for crash and speed-up tests).
+    map_offset:
+        ``(x m, y m, theta rad)``: the pose of the world frame in the map frame of the estimate.
     """
 
     mean_t: float = 0.3
@@ -45,6 +52,7 @@ class FakeTrial:
     mean_r: float = 0.05
     std_r: float = 0.01
     sleep: float = 0.0
+    map_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def errors(self, seed: int) -> tuple[float, float]:
         """The ``(e_t, e_r)`` (m, rad) that the run with ``seed`` has."""
@@ -59,6 +67,8 @@ class FakeTrial:
         t = np.array([0.0, 1.0])
         truth = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
         estimate = np.array([[0.0, 0.0, 0.0], [1.0 + e_t, 0.0, e_r]])
+        if any(self.map_offset):
+            estimate = compose(np.asarray(self.map_offset, dtype=np.float64), estimate)
         record = RunRecord(
             t=t,
             scans=np.full((2, 3), 5.0, dtype=np.float32),

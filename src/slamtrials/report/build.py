@@ -6,13 +6,16 @@ the run folders), draws the paper's figures with :mod:`slamtrials.report.campaig
 ``<out>/index.html`` with every figure beside it in ``<out>/figures/`` as PNG (shown) and PDF (linked):
 
 * Table I: per world, runs, mean, standard deviation and confidence interval of ``eps_t`` (m) and
-  ``eps_r`` (rad) (``<table id="summary-table">``, one row per world), and the paper's printed layout;
+  ``eps_r`` (rad), the metric's share of the between-run variance of each, and the outlier counts, with a
+  paragraph saying what the share and the outlier column are (``<table id="summary-table">``, one row per
+  world, in the campaign's order, which every figure keeps), and the paper's printed layout;
 * Fig. 1: each world's run errors, largest first, and all worlds' sorted curves;
 * Fig. 5: all runs of all worlds, outliers (Tukey's fences) marked;
 * Fig. 6: pairs of worlds where a single run of each would rank them opposite to their means;
 * Fig. 3: the relation-sampling check of one run: the mean error over repeated samplings, with a normal fit;
-* Fig. 4: the best and the worst map of every world with their errors, and their estimated versus true
-  trajectories;
+* Fig. 4: the best and the worst map of every world (by ``eps_t``) with their errors, the estimated
+  trajectory drawn on the map (map frame) and the true one fitted onto it
+  (:func:`slamtrials.report.alignment.align_truth`);
 * termination reasons and explored fraction of the runs;
 * every run (seed, status, errors, outlier marks), and the provenance: config, root seed, versions.
 
@@ -61,7 +64,7 @@ from slamtrials.report.compare import (
     world_pair_traps,
 )
 from slamtrials.report.load import CampaignData, load_campaign
-from slamtrials.report.tables import METRICS, paper_table
+from slamtrials.report.tables import METRICS, NOISE_SHARE_LIMIT, OUTLIER_IQR, paper_table
 
 __all__ = [
     "build_report",
@@ -168,6 +171,24 @@ def _num(value: Any, digits: int = 3) -> h.Cell:
     return h.Cell(h.fmt_number(value, digits), numeric=True)
 
 
+def _seconds(value: Any) -> h.Cell:
+    """A time in seconds, rounded: one decimal below 10 s, whole seconds above."""
+    return h.Cell(h.fmt_seconds(value), numeric=True)
+
+
+def _share(value: Any) -> h.Cell:
+    """The metric's share of the between-run variance as a percentage; ``n/a`` when it is not known."""
+    if value is None or not math.isfinite(float(value)):
+        return h.Cell("n/a", numeric=True, title="no standard errors recorded for these runs, or fewer than 2 runs")
+    return h.Cell(f"{100 * float(value):.{1 if value < 0.1 else 0}f} %", numeric=True)
+
+
+def _table_order(data: CampaignData, done: pd.DataFrame) -> list[str]:
+    """The worlds that have finished runs, in the order of Table I (the campaign's order): every figure uses it."""
+    present = set(done["world"].astype(str))
+    return [str(w) for w in data.worlds["world"] if str(w) in present]
+
+
 def _versions() -> dict[str, str]:
     import matplotlib
     import scipy
@@ -239,10 +260,22 @@ def _overview(data: CampaignData, done: pd.DataFrame) -> str:
             f"first {runs.get('initial')} runs, cap {runs.get('max_runs')}, margins \u00b1{runs.get('margin_t')} m "
             f"and \u00b1{runs.get('margin_r')} rad at {_pct(runs.get('confidence'))} confidence ({runs.get('distribution')} quantile)",
         ),
+        *([("run times", _run_times(done))] if len(done) else []),
         ("root seed", str(config.get("seed"))),
         ("created", str(data.meta.get("created"))),
     ]
     return h.section("Overview", h.definition_list(items), h.notes(_notes(data, done), id="notes"), id="overview")
+
+
+def _run_times(done: pd.DataFrame) -> str:
+    """The finished runs' simulated and wall-clock time, in all and per run, rounded."""
+    simulated, wall = done["duration_s"].dropna(), done["wall_s"].dropna()
+    parts = []
+    if len(simulated):
+        parts.append(f"{h.fmt_duration(simulated.sum())} simulated (mean {h.fmt_duration(simulated.mean())} per run)")
+    if len(wall):
+        parts.append(f"{h.fmt_duration(wall.sum())} of worker time (mean {h.fmt_duration(wall.mean())} per run)")
+    return "; ".join(parts) or "-"
 
 
 def _pct(value: Any) -> str:
@@ -257,13 +290,13 @@ def _table_one(data: CampaignData, done: pd.DataFrame) -> str:
         "world",
         "status",
         "runs",
-        *(["mean", "std", "\u00b1 CI"] * 2),
+        *(["mean", "std", "\u00b1 CI", "metric share"] * 2),
         "outliers",
         "min \u2013 max " + SYMBOLS["eps_t"] + " (m)",
         "runs ended by",
         "note",
     ]
-    groups = [("", 3), (f"{SYMBOLS['eps_t']} (m)", 3), (f"{SYMBOLS['eps_r']} (rad)", 3), ("", 4)]
+    groups = [("", 3), (f"{SYMBOLS['eps_t']} (m)", 4), (f"{SYMBOLS['eps_r']} (rad)", 4), ("", 4)]
     rows, classes = [], []
     reasons = done.groupby("world")["termination"].agg(lambda s: Counter(s.fillna("unknown"))) if len(done) else {}
     for _, w in data.worlds.iterrows():
@@ -275,6 +308,7 @@ def _table_one(data: CampaignData, done: pd.DataFrame) -> str:
                 _num(w[f"{metric}_mean"], digits),
                 _num(w[f"{metric}_std"], digits),
                 _num(w[f"{metric}_half_width"], digits),
+                _share(w[f"{metric}_metric_share"]) if w["runs_done"] else h.Cell("-", numeric=True),
             ]
         cells.append(
             h.Cell(
@@ -300,7 +334,11 @@ def _table_one(data: CampaignData, done: pd.DataFrame) -> str:
         f"translational error {SYMBOLS['eps_t']} (m) and rotational error {SYMBOLS['eps_r']} (rad), and the half width "
         f"of the {_pct(confidence)} confidence interval of the mean. Runs: done (/ needed by the run-count rule when more)."
     )
-    parts = [h.table(header, rows, id="summary-table", caption=caption, row_classes=classes, groups=groups)]
+    parts = [
+        h.table(header, rows, id="summary-table", caption=caption, row_classes=classes, groups=groups),
+        _share_note(data),
+        _outlier_note(data),
+    ]
     if len(done):
         summary = data.worlds[data.worlds["runs_done"] > 0]
         for metric, unit in (("eps_t", "m"), ("eps_r", "rad")):
@@ -322,11 +360,52 @@ def _table_one(data: CampaignData, done: pd.DataFrame) -> str:
     return h.section("Table I: localization error per world", *parts, id="table-1")
 
 
+def _share_note(data: CampaignData) -> str:
+    """The paragraph under Table I that says what the metric-share columns are, and which worlds exceed 10 %."""
+    limit = _pct(NOISE_SHARE_LIMIT)
+    text = (
+        "Metric share: each run's error is the mean over its sampled relations, so it carries a standard error "
+        "se of its own (the per-relation errors' standard deviation over \u221aN). Over a world's runs, the "
+        "variance of the run errors is the variance between the runs plus, on average, se\u00b2; the metric "
+        "share is mean(se\u00b2) over the variance of the run errors (sample variance): the part of the "
+        f"run-to-run spread that is the metric's own sampling noise. Below {limit}, the differences between "
+        "the runs are real (the algorithm's, not the metric's), and so are the standard deviation, the best "
+        "and worst runs and the outliers; near 100 % the runs cannot be told apart. n/a: the runs have no "
+        "standard error recorded (scored by an earlier version of slamtrials) or there are fewer than 2."
+    )
+    high = []
+    for _, w in data.worlds.iterrows():
+        shares = [
+            f"{SYMBOLS[metric]} {100 * w[f'{metric}_metric_share']:.0f} %"
+            for metric in METRICS
+            if math.isfinite(w[f"{metric}_metric_share"]) and w[f"{metric}_metric_share"] >= NOISE_SHARE_LIMIT
+        ]
+        if shares:
+            high.append(f"{w['world']} ({', '.join(shares)})")
+    if high:
+        text += f" At or above {limit} here: " + ", ".join(high) + "."
+    return f'<p class="explain" id="metric-share-note">{h.esc(text)}</p>'
+
+
+def _outlier_note(data: CampaignData) -> str:
+    """The paragraph under Table I that says how the outlier column is counted."""
+    text = (
+        f"Outliers: how many of the world's finished runs lie beyond Tukey's fences, for {SYMBOLS['eps_t']} / "
+        f"{SYMBOLS['eps_r']}: more than {OUTLIER_IQR:g} interquartile ranges (IQR = Q3 \u2212 Q1) below the first "
+        "quartile Q1 or above the third quartile Q3 of that world's run errors (quartiles by linear "
+        "interpolation), the whiskers of Fig. 5's boxes. An outlier is a run unusual among its world's runs, not "
+        "a failed one (failed runs have no error); with few runs the quartiles are rough, so an outlier there is "
+        "a hint, and where the metric share is high it may be the metric's noise. The runs table at the end marks "
+        "each outlier run."
+    )
+    return f'<p class="explain" id="outlier-note">{h.esc(text)}</p>'
+
+
 def _fig1(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame) -> str:
     if done.empty:
         return h.section("Fig. 1: run errors per world", "<p>No finished runs.</p>", id="fig-1")
     parts = []
-    worlds = [w for w in data.worlds["world"] if (done["world"] == w).any()]
+    worlds = _table_order(data, done)
     fig = figs.new(11, 3.8)
     axes = fig.subplots(1, 2)
     for ax, metric in zip(axes, METRICS):
@@ -364,19 +443,20 @@ def _fig1(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame) -> str:
     )
 
 
-def _fig5(figs: _FigureWriter, done: pd.DataFrame) -> str:
+def _fig5(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame) -> str:
     if done.empty:
         return h.section("Fig. 5: all runs of all worlds", "<p>No finished runs.</p>", id="fig-5")
-    n = done["world"].nunique()
-    fig = figs.new(min(max(7.0, 0.45 * n + 3), 30), 7.5)
+    worlds = _table_order(data, done)
+    fig = figs.new(min(max(7.0, 0.45 * len(worlds) + 3), 30), 7.5)
     axes = fig.subplots(2, 1)
     for ax, metric in zip(axes, METRICS):
-        cf.draw_all_runs(ax, done, metric)
+        cf.draw_all_runs(ax, done, metric, order=worlds)
     count_t, count_r = int(done["outlier_t"].sum()), int(done["outlier_r"].sum())
     caption = (
         f"The paper's Fig. 5: every run of every world (points), a box per world (quartiles, whiskers at 1.5 IQR), "
-        f"the world means (orange), and outliers beyond Tukey's fences as red crosses: {count_t} in "
-        f"{SYMBOLS['eps_t']} (top), {count_r} in {SYMBOLS['eps_r']} (bottom)."
+        f"the world means (orange), and outliers beyond Tukey's fences (the outlier column of Table I) as red "
+        f"crosses: {count_t} in {SYMBOLS['eps_t']} (top), {count_r} in {SYMBOLS['eps_r']} (bottom). Worlds in the "
+        "order of Table I."
     )
     return h.section(
         "Fig. 5: all runs of all worlds, outliers marked", figs.save(fig, "fig5_all_runs", caption), id="fig-5"
@@ -566,77 +646,91 @@ def _fig3(
     )
 
 
-def _zoom_to_known(ax, occupancy, margin: float = 0.5) -> None:
-    """Limit ``ax`` to the mapped (known) cells of an unrotated map, plus ``margin`` metres."""
-    grid = np.asarray(occupancy.grid)
-    ox, oy, theta = (float(v) for v in occupancy.origin)
-    known = grid >= 0
-    if theta != 0.0 or not known.any():
-        return
-    rows, cols = np.flatnonzero(known.any(axis=1)), np.flatnonzero(known.any(axis=0))
-    res, height = float(occupancy.resolution), grid.shape[0]
-    ax.set_xlim(ox + cols[0] * res - margin, ox + (cols[-1] + 1) * res + margin)
-    ax.set_ylim(oy + (height - rows[-1] - 1) * res - margin, oy + (height - rows[0]) * res + margin)
+#: Width (inches, at 100 dpi) of a figure shown at the page's full width (its max-width is 1250 px).
+PAGE_WIDTH_IN = 12.0
 
 
-def _draw_run_panels(axes, record, label: str, row: pd.Series) -> None:
-    map_ax, path_ax = axes
-    title = f"{label}: run #{int(row['run'])}, {SYMBOLS['eps_t']} {row['eps_t']:.3f} m, {SYMBOLS['eps_r']} {row['eps_r']:.3f} rad"
-    if record.map is not None:
-        cf.draw_map(map_ax, record.map, title=title)
-        _zoom_to_known(map_ax, record.map)
-    else:
-        map_ax.text(0.5, 0.5, "no map recorded", ha="center", va="center", transform=map_ax.transAxes)
-        map_ax.set_title(title, fontsize=9)
-    if record.estimate is not None:
-        cf.draw_trajectories(
-            path_ax,
-            Trajectory(t=record.t, poses=record.truth),
-            Trajectory(t=record.t, poses=np.asarray(record.estimate, dtype=np.float64)),
-        )
-        path_ax.set_title(f"{label}: estimated vs true trajectory", fontsize=9)
-    else:
-        path_ax.text(0.5, 0.5, "no estimate recorded", ha="center", va="center", transform=path_ax.transAxes)
+def _fig4_panel(ax, record, label: str, row: pd.Series):
+    """One run of Fig. 4: its map with both trajectories (map frame); the alignment, or None without an estimate."""
+    title = (
+        f"{label}: run #{int(row['run'])}, {SYMBOLS['eps_t']} {row['eps_t']:.3f} m, "
+        f"{SYMBOLS['eps_r']} {row['eps_r']:.4f} rad"
+    )
+    estimate = None if record.estimate is None else np.asarray(record.estimate, dtype=np.float64)
+    if estimate is None or not np.isfinite(estimate).all(axis=1).any():
+        if record.map is not None:
+            cf.draw_map(ax, record.map, title=title)
+            cf.zoom_to_known(ax, record.map)
+        message = "no estimate recorded" if estimate is None else "the estimate has no finite pose"
+        ax.text(0.5, 0.5, message, ha="center", va="center", transform=ax.transAxes)
+        ax.set_title(title, fontsize=11)
+        return None
+    fit = cf.draw_run_on_map(ax, record.map, record.truth, estimate, title=title, legend=False)
+    ax.set_title(title, fontsize=11)
+    return fit
 
 
 def _fig4(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame) -> str:
     title = "Fig. 4: best and worst map of every world"
     if done.empty:
         return h.section(title, "<p>No finished runs.</p>", id="fig-4")
-    gallery, problems = [], []
-    for i, world in enumerate(data.worlds["world"]):
-        mine = done[done["world"] == world]
-        if mine.empty:
-            continue
+    pictures, problems = [], []
+    for i, world in enumerate(_table_order(data, done)):
+        mine = done[done["world"] == world]  # in run order: a tie goes to the lower run index
         best, worst = mine.loc[mine["eps_t"].idxmin()], mine.loc[mine["eps_t"].idxmax()]
         picks = [("best", best)] if best["run"] == worst["run"] else [("best", best), ("worst", worst)]
-        fig = figs.new(5.2 * len(picks), 8.4)
-        axes = np.asarray(fig.subplots(2, len(picks))).reshape(2, len(picks))
+        width = PAGE_WIDTH_IN if len(picks) == 2 else PAGE_WIDTH_IN / 2
+        fig = figs.new(width, 6.0)
+        axes = np.atleast_1d(fig.subplots(1, len(picks)))
+        fits = []
         try:
-            for k, (label, row) in enumerate(picks):
-                _draw_run_panels(axes[:, k], _read_record(data, world, int(row["run"])), label, row)
+            for ax, (label, row) in zip(axes, picks):
+                fits.append(_fig4_panel(ax, _read_record(data, world, int(row["run"])), label, row))
         except SlamtrialsError as exc:
             problems.append(f"{world}: a run folder could not be read ({exc})")
-            log.warning("gallery of %s: %s", world, exc)
+            log.warning("Fig. 4 of %s: %s", world, exc)
             continue
+        handles, labels = axes[0].get_legend_handles_labels()
+        if handles:
+            fig.legend(handles, labels, loc="outside lower center", ncols=len(handles), fontsize=10, frameon=False)
+        # the panels' height follows the maps' shape, so a wide or a tall building fills the page's width
+        x0, x1 = axes[0].get_xlim()
+        y0, y1 = axes[0].get_ylim()
+        aspect = (y1 - y0) / (x1 - x0) if x1 > x0 else 1.0
+        fig.set_size_inches(width, float(np.clip((width / len(picks) - 0.9) * aspect + 1.5, 3.5, 11.0)))
         described = " and ".join(
-            f"the {label} run #{int(row['run'])} ({row['eps_t']:.3f} m, {row['eps_r']:.3f} rad)" for label, row in picks
+            f"the {label} run #{int(row['run'])} ({SYMBOLS['eps_t']} {row['eps_t']:.3f} m"
+            + (f" over {int(row['relations']):,} relations" if pd.notna(row["relations"]) else "")
+            + f", {SYMBOLS['eps_r']} {row['eps_r']:.4f} rad)"
+            for label, row in picks
         )
-        gallery.append(
-            figs.save(
-                fig,
-                f"fig4_{i:03d}_{world}",
-                f"{world}: the final SLAM maps (top) and the estimated versus true trajectories (bottom; "
-                f"the estimate placed through its first pose) of {described}, by translational error.",
+        residuals = [f"{fit.rms:.3f} m" for fit in fits if fit is not None]
+        methods = {fit.method for fit in fits if fit is not None}
+        how = (
+            "moved into the map frame through the first poses (the truth does not move)"
+            if methods == {"first pose"}
+            else "moved into the map frame by a least-squares SE(2) fit (rotation and translation, no scale) of "
+            "the true positions onto the estimated ones"
+        )
+        caption = (
+            f"{world}: the final SLAM map of {described}, the lowest and highest {SYMBOLS['eps_t']} of its "
+            f"{len(mine)} runs. On each map, in the map frame: the SLAM estimate as recorded (red; dot: its "
+            f"start) and the ground truth (wide, blue) {how}"
+            + (
+                f"; after the fit the true positions lie {' and '.join(residuals)} (rms) from the estimate."
+                if residuals
+                else "."
             )
         )
+        pictures.append(figs.save(fig, f"fig4_{i:03d}_{world}", caption, id=f"fig-4-{_safe(world)}"))
     return h.section(
         title,
         h.notes(problems),
-        '<div class="gallery">' + "\n".join(gallery) + "</div>",
+        *pictures,
         id="fig-4",
-        intro="The metric should tell a good map from a bad one (the paper's Fig. 4): the map and the "
-        "trajectories of the run with the smallest and the largest translational error of each world.",
+        intro="The metric should tell a good map from a bad one (the paper's Fig. 4): per world, in the order of "
+        "Table I, the map and trajectories of the run with the smallest and the largest translational error "
+        f"{SYMBOLS['eps_t']} (as the catalog records it).",
     )
 
 
@@ -647,20 +741,20 @@ def _termination(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame) ->
     mapped = done[np.isfinite(done["mapped"])]
     fig = figs.new(min(max(10.0, 0.6 * done["world"].nunique() + 4), 30), 4.0)
     axes = fig.subplots(1, 2 if len(mapped) else 1, squeeze=False)[0]
-    cf.draw_termination(axes[0], done)
+    worlds = _table_order(data, done)
+    cf.draw_termination(axes[0], done, worlds)
     if len(mapped):
-        cf.draw_explored(axes[1], mapped)
+        cf.draw_explored(axes[1], mapped, worlds)
     picture = figs.save(
         fig,
         "termination",
         "Left: why the runs ended, per world (run counts). Right: the fraction of each "
-        "world's free space the robot's footprint can reach that the final map knows (free or occupied), per run, and its mean.",
+        "world's free space the robot's footprint can reach that the final map knows (free or occupied), per run, "
+        "and its mean. Worlds in the order of Table I.",
     )
     rows = []
-    for world in data.worlds["world"]:
+    for world in worlds:
         mine = done[done["world"] == world]
-        if mine.empty:
-            continue
         reasons = Counter(mine["termination"].fillna("unknown"))
         rows.append(
             [
@@ -669,8 +763,8 @@ def _termination(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame) ->
                 ", ".join(f"{k} {v}" for k, v in sorted(reasons.items())),
                 _num(mine["mapped"].mean(), 3),
                 _num(mine["mapped"].min(), 3),
-                _num(mine["duration_s"].mean(), 1),
-                _num(mine["wall_s"].mean(), 1),
+                _seconds(mine["duration_s"].mean()),
+                _seconds(mine["wall_s"].mean()),
             ]
         )
     table = h.table(
@@ -697,8 +791,8 @@ def _runs_table(data: CampaignData) -> str:
                 flag,
                 r["termination"] if isinstance(r["termination"], str) else "",
                 _num(r["mapped"], 3),
-                _num(r["duration_s"], 1),
-                _num(r["wall_s"], 1),
+                _seconds(r["duration_s"]),
+                _seconds(r["wall_s"]),
                 r["error"] if isinstance(r["error"], str) else "",
             ]
         )
@@ -721,6 +815,8 @@ def _runs_table(data: CampaignData) -> str:
         rows,
         id="runs-table",
         row_classes=classes,
+        caption="outlier in: the errors in which the run lies beyond its world's Tukey fences (see the outlier "
+        "column of Table I); sim s: simulated duration; wall s: the run's wall-clock time on its worker.",
     )
     return h.section(
         "Every run",
@@ -833,7 +929,7 @@ def build_report(
         _overview(data, done),
         _table_one(data, done),
         _fig1(figs, data, done),
-        _fig5(figs, done),
+        _fig5(figs, data, done),
         _fig6(figs, done),
         _fig3(figs, data, done, chosen, repeats, seed),
         _fig4(figs, data, done),

@@ -27,6 +27,7 @@ from slamtrials.metric.rule import SamplingRule
 from slamtrials.metric.sampling import sample_relations
 from slamtrials.metric.stats import environment_stats
 from slamtrials.record import OccupancyGrid, Trajectory
+from slamtrials.report.alignment import TruthAlignment, align_truth
 from slamtrials.report.compare import (
     A_BETTER,
     B_BETTER,
@@ -51,6 +52,8 @@ __all__ = [
     "map_picture",
     "draw_map",
     "draw_trajectories",
+    "draw_run_on_map",
+    "zoom_to_known",
     "draw_termination",
     "draw_explored",
     "draw_comparison",
@@ -159,8 +162,22 @@ def draw_sorted_errors(ax, runs: pd.DataFrame, worlds: list[str] | None = None, 
     ax.legend(fontsize=7)
 
 
-def _world_order(runs: pd.DataFrame, values: NDArray[np.float64], order: str) -> list[str]:
+def _given_order(runs: pd.DataFrame, worlds: list[str] | None) -> list[str]:
+    """``worlds`` (those with runs in ``runs``, in the given order), or every world of ``runs`` sorted by name."""
+    present = runs["world"].astype(str)
+    if worlds is None:
+        return sorted(present.unique())
+    names = [str(w) for w in worlds]
+    missing = sorted(set(present.unique()) - set(names))
+    if missing:
+        raise ValueError(f"worlds does not list {', '.join(missing)}, which runs has")
+    return [w for w in names if (present == w).any()]
+
+
+def _world_order(runs: pd.DataFrame, values: NDArray[np.float64], order: str | list[str]) -> list[str]:
     names = runs["world"].astype(str)
+    if not isinstance(order, str):
+        return _given_order(runs, list(order))
     if order == "name":
         return sorted(names.unique())
     if order == "mean":
@@ -168,7 +185,7 @@ def _world_order(runs: pd.DataFrame, values: NDArray[np.float64], order: str) ->
     raise ValueError(f"order must be 'name' or 'mean', got {order!r}")
 
 
-def draw_all_runs(ax, runs: pd.DataFrame, metric: str = "eps_t", *, order: str = "name") -> None:
+def draw_all_runs(ax, runs: pd.DataFrame, metric: str = "eps_t", *, order: str | list[str] = "name") -> None:
     """All runs of all worlds (the paper's Fig. 5): a box per world, every run as a point, outliers marked.
 
     Outliers are those of :func:`slamtrials.report.tables.world_outliers` (beyond 1.5 IQR of the world's
@@ -178,7 +195,8 @@ def draw_all_runs(ax, runs: pd.DataFrame, metric: str = "eps_t", *, order: str =
     Parameters
     ----------
     order:
-        ``"name"`` (default) or ``"mean"`` (increasing mean error) along x.
+        ``"name"`` (default), ``"mean"`` (increasing mean error) or a list of world names (e.g. the
+        report's table order; it must name every world of ``runs``) along x.
     """
     values = check_metric(runs, metric)
     outlier = world_outliers(runs, metric).to_numpy()
@@ -386,18 +404,100 @@ def draw_trajectories(ax, truth: Trajectory | ArrayLike, estimate: Trajectory | 
     return aligned
 
 
-def draw_termination(ax, runs: pd.DataFrame) -> pd.DataFrame:
-    """Termination reasons per world as stacked bars of run counts (one BarContainer per reason).
+def zoom_to_known(ax, occupancy_grid: OccupancyGrid, *, also: ArrayLike | None = None, margin: float = 0.5) -> None:
+    """Limit ``ax`` to the known (free or occupied) cells of an unrotated map, and the points ``also``
+    (``[N, 2]``, m; non-finite rows ignored), plus ``margin`` metres; a rotated or empty map keeps its limits
+    (widened to ``also``)."""
+    grid = np.asarray(occupancy_grid.grid)
+    ox, oy, theta = (float(v) for v in occupancy_grid.origin)
+    known = grid >= 0
+    if theta == 0.0 and known.any():
+        rows, cols = np.flatnonzero(known.any(axis=1)), np.flatnonzero(known.any(axis=0))
+        res, height = float(occupancy_grid.resolution), grid.shape[0]
+        x0, x1 = ox + cols[0] * res, ox + (cols[-1] + 1) * res
+        y0, y1 = oy + (height - rows[-1] - 1) * res, oy + (height - rows[0]) * res
+    else:
+        (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+        margin = 0.0 if also is None else margin
+    if also is not None:
+        points = np.asarray(also, dtype=np.float64).reshape(-1, 2)
+        points = points[np.isfinite(points).all(axis=1)]
+        if len(points):
+            x0, x1 = min(x0, float(points[:, 0].min())), max(x1, float(points[:, 0].max()))
+            y0, y1 = min(y0, float(points[:, 1].min())), max(y1, float(points[:, 1].max()))
+    ax.set_xlim(x0 - margin, x1 + margin)
+    ax.set_ylim(y0 - margin, y1 + margin)
 
-    Needs columns ``world`` and ``termination`` (missing reasons count as ``"unknown"``).
+
+def draw_run_on_map(
+    ax,
+    occupancy_grid: OccupancyGrid | None,
+    truth: ArrayLike,
+    estimate: ArrayLike,
+    *,
+    title: str | None = None,
+    legend: bool = True,
+) -> TruthAlignment:
+    """A run's final SLAM map with its estimated trajectory and its true trajectory on top, all in the map frame.
+
+    The estimate is drawn as recorded (map frame, gid ``"estimate"``); the truth (world frame) is moved
+    into the map frame by :func:`slamtrials.report.alignment.align_truth` (a least-squares rigid fit of
+    the true positions onto the estimated ones) and drawn under it, wider and paler (gid ``"truth"``).
+    The start of the estimate is a dot (gid ``"start"``). The view is the map's known cells and both paths.
+
+    Parameters
+    ----------
+    occupancy_grid:
+        The final map (map frame), or None to draw the paths alone.
+    truth, estimate:
+        ``[T, 3]`` true poses (world frame) and estimated poses (map frame) at the same timestamps.
 
     Returns
     -------
-    The counts drawn: worlds (sorted) by reasons (sorted).
+    The alignment drawn (its ``truth`` is the drawn true path, its ``rms`` the fit's residual).
+    """
+    estimated = _poses(estimate)
+    fit = align_truth(truth, estimated)
+    if occupancy_grid is not None:
+        draw_map(ax, occupancy_grid, title=title)
+    elif title:
+        ax.set_title(title, fontsize=9)
+    ax.plot(
+        fit.truth[:, 0],
+        fit.truth[:, 1],
+        color="tab:blue",
+        lw=2.6,
+        alpha=0.55,
+        label="ground truth (fitted)",
+        gid="truth",
+    )
+    ax.plot(estimated[:, 0], estimated[:, 1], color="tab:red", lw=1.0, label="SLAM estimate", gid="estimate")
+    first = int(np.argmax(fit.used))
+    ax.plot(*estimated[first, :2], "o", color="tab:red", ms=5, label="start", gid="start")
+    if occupancy_grid is not None:
+        zoom_to_known(ax, occupancy_grid, also=np.vstack([fit.truth[:, :2], estimated[:, :2]]))
+    ax.set_aspect("equal", adjustable="datalim" if occupancy_grid is None else "box")
+    ax.set_xlabel("x (m, map frame)")
+    ax.set_ylabel("y (m, map frame)")
+    if legend:
+        ax.legend(fontsize=8, loc="upper right", framealpha=0.85)
+    return fit
+
+
+def draw_termination(ax, runs: pd.DataFrame, worlds: list[str] | None = None) -> pd.DataFrame:
+    """Termination reasons per world as stacked bars of run counts (one BarContainer per reason).
+
+    Needs columns ``world`` and ``termination`` (missing reasons count as ``"unknown"``). ``worlds`` orders
+    the worlds along x (it must name every world of ``runs``); default: sorted by name.
+
+    Returns
+    -------
+    The counts drawn: worlds (in that order) by reasons (sorted).
     """
     require_columns(runs, ("world", "termination"))
+    order = _given_order(runs, worlds)
     reasons = runs["termination"].astype(object).where(runs["termination"].notna(), "unknown").astype(str)
-    counts = pd.crosstab(runs["world"].astype(str), reasons).sort_index().sort_index(axis=1)
+    counts = pd.crosstab(runs["world"].astype(str), reasons).reindex(order).sort_index(axis=1)
     x = np.arange(len(counts))
     bottom = np.zeros(len(counts))
     for reason in counts.columns:
@@ -411,22 +511,24 @@ def draw_termination(ax, runs: pd.DataFrame) -> pd.DataFrame:
     return counts
 
 
-def draw_explored(ax, runs: pd.DataFrame) -> pd.Series:
+def draw_explored(ax, runs: pd.DataFrame, worlds: list[str] | None = None) -> pd.Series:
     """The explored (mapped) fraction of every run per world: points (gid ``"runs"``) and means (gid ``"means"``).
 
-    Needs columns ``world`` and ``mapped`` (fraction 0..1; every value finite).
+    Needs columns ``world`` and ``mapped`` (fraction 0..1; every value finite). ``worlds`` orders the
+    worlds along x (it must name every world of ``runs``); default: sorted by name.
 
     Returns
     -------
-    The mean mapped fraction per world (sorted by world), as drawn.
+    The mean mapped fraction per world (in that order), as drawn.
     """
     require_columns(runs, ("world", "mapped"))
+    order = _given_order(runs, worlds)
     mapped = pd.to_numeric(runs["mapped"], errors="coerce").to_numpy(dtype=np.float64, na_value=np.nan)
     if not np.isfinite(mapped).all():
         row = runs.iloc[int(np.argmax(~np.isfinite(mapped)))]
         raise ValueError(f"runs: world {row['world']!r} has a non-finite mapped fraction ({row['mapped']!r})")
     names = runs["world"].astype(str).to_numpy()
-    means = pd.Series(mapped, index=names).groupby(level=0).mean().sort_index()
+    means = pd.Series(mapped, index=names).groupby(level=0).mean().reindex(order)
     x = np.empty(len(mapped))
     for i, w in enumerate(means.index):
         here = np.flatnonzero(names == w)

@@ -20,6 +20,8 @@ __all__ = [
     "attr",
     "Cell",
     "fmt_number",
+    "fmt_seconds",
+    "fmt_duration",
     "table",
     "figure",
     "section",
@@ -52,6 +54,7 @@ dl { display: grid; grid-template-columns: max-content auto; gap: 0.2em 1em; } d
 nav { font-size: 0.9em; } nav a { margin-right: 0.9em; }
 details summary { cursor: pointer; color: #0645ad; }
 .muted { color: #777; }
+p.explain { font-size: 0.88em; color: #333; max-width: 70em; }
 """
 
 
@@ -82,6 +85,38 @@ def fmt_number(value: Any, digits: int = 3) -> str:
     if math.isinf(number):
         return "inf" if number > 0 else "-inf"
     return f"{number:.{digits}f}"
+
+
+def fmt_seconds(value: Any) -> str:
+    """A time in seconds for a table column: one decimal below 10 s (``8.6``), whole seconds from 10 s
+    (``166``); ``-`` for None and NaN."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return "-"
+    if not math.isfinite(number):
+        return "-"
+    return f"{number:.1f}" if abs(number) < 9.95 else f"{number:.0f}"
+
+
+def fmt_duration(seconds: Any) -> str:
+    """A duration for text, rounded to what a reader needs: ``< 0.1 s``, ``8.6 s``, ``43 s``, ``2 min 46 s``,
+    ``3 h 05 min``."""
+    try:
+        number = float(seconds)
+    except (TypeError, ValueError):
+        return "-"
+    if not math.isfinite(number):
+        return "-"
+    if 0.0 < number < 0.05:
+        return "< 0.1 s"
+    if number < 59.5:
+        return f"{fmt_seconds(number)} s"
+    whole = int(round(number))
+    if whole < 3600:
+        return f"{whole // 60} min {whole % 60:02d} s"
+    minutes = int(round(number / 60.0))
+    return f"{minutes // 60} h {minutes % 60:02d} min"
 
 
 @dataclass(frozen=True)

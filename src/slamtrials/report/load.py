@@ -27,7 +27,8 @@ finished
 outlier_t,     the run is an outlier of its world (Tukey's fences, :func:`slamtrials.report.tables.outlier_mask`,
 outlier_r      among the world's done runs); False unless done
 frames, ...    the entries of the catalog's ``details`` (frames, distance_m, observed_fraction,
-               slam_updates, relation_std_t, relation_std_r, relations_capped)
+               slam_updates, relation_std_t, relation_std_r, relations_capped, and se_t, se_r: the standard
+               errors of eps_t, eps_r, from this version on)
 ============== ======================================================================================
 
 ``worlds``: one row per world in campaign order: the catalog's ``worlds`` columns (``name`` as ``world``,
@@ -37,7 +38,10 @@ frames, ...    the entries of the catalog's ``details`` (frames, distance_m, obs
 paper's Table I over the done runs (the columns of :func:`slamtrials.report.tables.world_summary`:
 ``eps_t_mean``, ``eps_t_std``, ``eps_t_std_population``, ``eps_t_ci_low``, ``eps_t_ci_high``,
 ``eps_t_half_width``, ``eps_t_min``, ``eps_t_max``, ``eps_t_outliers``, the same for ``eps_r``, and
-``confidence``), NaN for a world without done runs. The intervals use the campaign's confidence and
+``confidence``), NaN for a world without done runs; and ``eps_t_metric_share``, ``eps_r_metric_share``:
+the metric's share of the variance between the done runs (:func:`slamtrials.report.tables.metric_shares`,
+mean ``se^2`` over the variance of the run errors), NaN when a run has no standard error recorded
+(``se_t``, ``se_r``: runs of earlier versions) or for fewer than 2 runs. The intervals use the campaign's confidence and
 quantile (``runs.confidence``, ``runs.distribution``), as ``slamtrials campaign status`` prints them.
 
 :func:`export_table` writes either table as CSV or Parquet.
@@ -59,7 +63,7 @@ from slamtrials.atomicfile import atomic_write, atomic_write_text
 from slamtrials.campaign.store import DB_FILE, RUNS_DIR, STORE_FORMAT
 from slamtrials.errors import ConfigError, FormatError
 from slamtrials.metric.quantiles import Distribution
-from slamtrials.report.tables import METRICS, outlier_mask, world_summary
+from slamtrials.report.tables import METRICS, metric_shares, outlier_mask, world_summary
 
 __all__ = ["CampaignData", "load_campaign", "export_table", "RUN_COLUMNS", "WORLD_COLUMNS", "TABLES", "FORMATS"]
 
@@ -111,6 +115,7 @@ WORLD_COLUMNS = (
     "runs_pending",
     *(f"{m}_{s}" for m in METRICS for s in _STATS),
     "confidence",
+    *(f"{m}_metric_share" for m in METRICS),
 )
 #: The tables :func:`export_table` writes.
 TABLES = ("runs", "worlds")
@@ -299,6 +304,9 @@ def _worlds_frame(rows: list[tuple], runs: pd.DataFrame, config: dict[str, Any])
             else:
                 worlds[column] = worlds[column].astype("float64")
     worlds["confidence"] = confidence
+    for metric in METRICS:
+        shares = metric_shares(done, metric) if len(done) else pd.Series(dtype="float64")
+        worlds[f"{metric}_metric_share"] = worlds["world"].map(shares).astype("float64")
     return worlds[list(WORLD_COLUMNS)]
 
 

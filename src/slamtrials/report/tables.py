@@ -7,6 +7,10 @@ The outlier rule (shared with :func:`slamtrials.report.campaign_figures.draw_all
 world, a run is an outlier of a metric when its value lies beyond Tukey's fences, more than 1.5
 interquartile ranges below the first or above the third quartile, the quartiles taken by linear
 interpolation (``numpy.percentile``'s default, the same matplotlib's box plot uses for its whiskers).
+
+The metric's share of the between-run variance (:func:`metric_shares`): per world, the runs' mean squared
+standard error over the variance of their errors (:func:`slamtrials.metric.metric_noise_share`), from
+the columns ``se_t`` and ``se_r`` (the catalog's details; absent for runs of earlier versions).
 """
 
 from __future__ import annotations
@@ -17,6 +21,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
+from slamtrials.metric.noiseshare import metric_noise_share
 from slamtrials.metric.quantiles import Distribution
 from slamtrials.metric.stats import environment_stats
 
@@ -29,12 +34,19 @@ __all__ = [
     "world_outliers",
     "world_summary",
     "paper_table",
+    "metric_shares",
+    "STANDARD_ERRORS",
+    "NOISE_SHARE_LIMIT",
 ]
 
 #: The per-run error columns: translational (m) and rotational (rad).
 METRICS = ("eps_t", "eps_r")
 #: Tukey's fence factor of the outlier rule.
 OUTLIER_IQR = 1.5
+#: The column of each metric's per-run standard error (m, rad).
+STANDARD_ERRORS = {"eps_t": "se_t", "eps_r": "se_r"}
+#: Below this share of the between-run variance, the metric's own noise is small against the runs' differences.
+NOISE_SHARE_LIMIT = 0.10
 
 
 def require_columns(runs: pd.DataFrame, columns: Iterable[str], what: str = "runs") -> None:
@@ -166,3 +178,31 @@ def paper_table(summary: pd.DataFrame, metric: str = "eps_t", *, population: boo
     table.index = ["average", "std dev"]
     table.columns.name = None
     return table
+
+
+def metric_shares(runs: pd.DataFrame, metric: str = "eps_t") -> pd.Series:
+    """Per world, the metric's share of the between-run variance of ``metric``: ``mean(se^2) / var(eps)``.
+
+    Parameters
+    ----------
+    runs:
+        One row per finished run with ``world``, ``run``, ``metric`` and, when recorded, its standard error
+        column (:data:`STANDARD_ERRORS`: ``se_t`` for ``eps_t``, ``se_r`` for ``eps_r``).
+
+    Returns
+    -------
+    pandas.Series
+        float64 indexed by world (sorted by world): the share (0.05 is 5 %), NaN where a run of the world has
+        no standard error (runs of earlier versions, or a missing column), for fewer than 2 runs, or when the
+        runs' errors do not vary (:func:`slamtrials.metric.metric_noise_share`).
+    """
+    values = check_metric(runs, metric)
+    column = STANDARD_ERRORS[metric]
+    if column in runs.columns:
+        errors = pd.to_numeric(runs[column], errors="coerce").to_numpy(dtype=np.float64, na_value=np.nan)
+    else:
+        errors = np.full(len(runs), np.nan)
+    worlds = runs["world"].astype(str).to_numpy()
+    names = sorted(set(worlds.tolist()))
+    shares = [metric_noise_share(values[worlds == w], errors[worlds == w]) for w in names]
+    return pd.Series(shares, index=pd.Index(names, name="world"), dtype="float64", name=f"{metric}_metric_share")

@@ -127,7 +127,9 @@ def test_report_page_has_table_one_and_every_figure(campaign, report):
         if world["runs_done"]:
             assert row[3] == f"{world['eps_t_mean']:.3f}" and row[4] == f"{world['eps_t_std']:.3f}"
             assert row[5] == f"{world['eps_t_half_width']:.3f}" and row[7] == f"{world['eps_r_mean']:.4f}"
-            assert row[6] == row[10] == "n/a"  # no standard errors recorded: the metric's share is not known
+            # the metric's share of the between-run variance, from the runs' recorded standard errors
+            share = world["eps_t_metric_share"]
+            assert row[6] == f"{100 * share:.{1 if share < 0.1 else 0}f} %"
         else:
             assert row[3] == "-" and row[6] == "-"
     # every image is a PNG file beside the page, every PDF link too

@@ -53,6 +53,11 @@ class MetricSettings(SamplingRule):
     tolerance: float = Field(
         RUN_TOLERANCE, gt=0.0, le=10.0, description="matching tolerance of estimate to ground-truth timestamps (s)"
     )
+    estimate: Literal["final", "online"] = Field(
+        "final",
+        description="which SLAM estimate eps_t and eps_r score: final (the trajectory after the last frame) or "
+        "online (what SLAM returned at each frame, as the paper's system logged it)",
+    )
 
     @classmethod
     def of_stored(cls, doc: dict[str, Any]) -> MetricSettings:
@@ -62,7 +67,7 @@ class MetricSettings(SamplingRule):
     @property
     def sampling(self) -> SamplingRule:
         """The sampling rule alone (without the matching tolerance)."""
-        return SamplingRule(**self.model_dump(exclude={"tolerance"}))
+        return SamplingRule(**self.model_dump(exclude={"tolerance", "estimate"}))
 
 
 class RunSettings(BaseModel):

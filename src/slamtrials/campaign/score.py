@@ -38,22 +38,33 @@ class RunScore:
         The online estimate's score, when the record has one.
     odometry:
         The odometry's score (the same relations, no SLAM).
+    scored:
+        Which SLAM estimate the run's ``eps_t``, ``eps_r`` are: ``final`` or ``online`` (``metric.estimate``).
     """
 
     relation_set: RelationSet
     estimate: SetScore
     online: SetScore | None
     odometry: SetScore
+    scored: str = "final"
+
+    @property
+    def run(self) -> SetScore:
+        """The score that is the run's (the final or the online estimate's)."""
+        if self.scored == "online":
+            assert self.online is not None
+            return self.online
+        return self.estimate
 
     @property
     def eps_t(self) -> float:
         """The run's mean translational error (m)."""
-        return self.estimate.eps_t
+        return self.run.eps_t
 
     @property
     def eps_r(self) -> float:
         """The run's mean rotational error (rad)."""
-        return self.estimate.eps_r
+        return self.run.eps_r
 
     def to_dict(self) -> dict[str, Any]:
         """What run.json keeps under ``campaign``: errors, standard errors, relation count, the set's draw."""
@@ -68,8 +79,9 @@ class RunScore:
         return {
             "eps_t": self.eps_t,
             "eps_r": self.eps_r,
-            "se_t": self.estimate.se_t,
-            "se_r": self.estimate.se_r,
+            "se_t": self.run.se_t,
+            "se_r": self.run.se_r,
+            "scored_estimate": self.scored,
             "relations": len(rs),
             "relation_set": {
                 "seed": rs.seed,
@@ -123,7 +135,14 @@ def score_run(
     online = None
     if record.online is not None:
         online = score(Trajectory(t=record.t, poses=np.asarray(record.online, dtype=np.float64)), "online")
-    return RunScore(relation_set, score(estimate, "estimate"), online, score(odometry, "odometry"))
+    elif metric.estimate == "online":
+        raise MetricError(
+            "metric.estimate is online but the run has no online estimate (recorded by an earlier version)",
+            what="estimate",
+        )
+    return RunScore(
+        relation_set, score(estimate, "estimate"), online, score(odometry, "odometry"), scored=metric.estimate
+    )
 
 
 def run_relation_set(folder: str | Path, record: RunRecord, seed: int, metric: MetricSettings) -> RelationSet:

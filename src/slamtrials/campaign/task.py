@@ -115,8 +115,8 @@ def outcome(task_world: str, index: int, record: RunRecord, score: RunScore, sta
             relation_std_t=relation_set.std_t,
             relation_std_r=relation_set.std_r,
             relations_capped=bool(relation_set.capped),
-            se_t=score.estimate.se_t,
-            se_r=score.estimate.se_r,
+            se_t=score.run.se_t,
+            se_r=score.run.se_r,
         ),
     )
 

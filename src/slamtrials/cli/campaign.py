@@ -68,7 +68,7 @@ def metric_share_line(rows) -> str | None:
     for row in rows:
         if row.metric_share_t is None or row.metric_share_r is None:
             continue
-        parts.append(f"{row.world} {100 * row.metric_share_t:.1f} % / {100 * row.metric_share_r:.1f} %")
+        parts.append(f"{row.world} {100 * row.metric_share_t:.2g} % / {100 * row.metric_share_r:.2g} %")
     if not parts:
         return None
     return (

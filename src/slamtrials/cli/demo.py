@@ -35,7 +35,7 @@ def demo(
     import matplotlib
 
     from slamtrials.campaign.cluster import check_workers
-    from slamtrials.cli.campaign import EXIT_INTERRUPTED, _Progress, summary_table
+    from slamtrials.cli.campaign import EXIT_INTERRUPTED, _Progress, metric_share_line, summary_table
     from slamtrials.cli.common import quiet_dask
     from slamtrials.demo import DEMO_WORLDS, run_demo
 
@@ -62,6 +62,9 @@ def demo(
         raise typer.Exit(EXIT_INTERRUPTED) from None
     campaign = result.campaign
     console.print(summary_table(campaign.summary, result.confidence, f"Demo campaign {campaign.folder}"))
+    share = metric_share_line(campaign.summary)
+    if share:
+        console.print(share, highlight=False, soft_wrap=True)
     for note in campaign.notes:
         console.print(f"note: {note}", highlight=False, soft_wrap=True)
     console.print(

@@ -455,8 +455,15 @@ def _overall(
         verdict = "no consistent difference"
         head = f"no consistent difference in {metric}"
     unit = UNITS.get(metric, "")
+    evidence = (
+        f"{test}, {combined.worlds} worlds, Z = {combined.z:.2f}, p = {combined.p:.3g}"
+        if math.isfinite(combined.p)
+        else f"{test}: no world has a test"
+        if combined.worlds == 0
+        else f"{test}: each campaign is better without error in some world"
+    )
     statement = (
-        f"{head}: {test}, {combined.worlds} worlds, Z = {combined.z:.2f}, p = {combined.p:.3g}; "
+        f"{head}: {evidence}; "
         f"mean over worlds of {name_b} \u2212 {name_a} = {mean:.3g} {unit}; "
         f"{name_b} has the lower mean in {lower} and the higher in {higher} of {len(rows)} worlds "
         f"(check: sign test over worlds p = {sign_p:.3g}); significant per world at {alpha:g} after {correction}: "

@@ -62,6 +62,7 @@ def test_paired_test_matches_scipy(seed: int) -> None:
     assert (r.ci_low, r.ci_high) == pytest.approx((ci.low, ci.high))
     assert r.se == pytest.approx(np.std(b - a, ddof=1) / math.sqrt(len(a)))
     assert r.wilcoxon_p == pytest.approx(stats.wilcoxon(b - a).pvalue)
+    assert r.correlation == pytest.approx(stats.pearsonr(a, b).statistic)
 
 
 def test_paired_test_by_hand_and_degenerate_cases() -> None:
@@ -76,6 +77,8 @@ def test_paired_test_by_hand_and_degenerate_cases() -> None:
     assert (same.t, same.p, same.wilcoxon_p) == (0.0, 1.0, 1.0)
     shifted = paired_test([1.0, 2.0, 3.0], [1.5, 2.5, 3.5])  # a constant difference
     assert shifted.p == 0.0 and shifted.t == math.inf
+    assert shifted.correlation == pytest.approx(1.0)
+    assert math.isnan(paired_test([1.0, 1.0, 1.0], [1.0, 2.0, 3.0]).correlation)  # a constant side
     one = paired_test([1.0], [2.0])
     assert one.difference == 1.0 and math.isnan(one.p) and math.isnan(one.wilcoxon_p)
     assert signed_rank_p([0.0, 0.0]) == 1.0

@@ -153,7 +153,10 @@ def compare(
         typer.Option("--out", "-o", help="Folder of compare.html and comparison.csv (default: B/report/compare-<A>)."),
     ] = None,
     alpha: Annotated[
-        float, typer.Option("--alpha", help="Significance level; intervals have confidence 1 - alpha.")
+        float,
+        typer.Option(
+            "--alpha", help="Significance level; the intervals beside the verdicts are corrected like the p-values."
+        ),
     ] = 0.05,
     correction: Annotated[
         CorrectionChoice, typer.Option("--correction", help="Correction for multiple comparisons across worlds.")

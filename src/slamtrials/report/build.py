@@ -1059,6 +1059,7 @@ def _comparison_table(comparison: Comparison, metric: str) -> str:
             _num(r["p"], 4),
             _num(r["p_adjusted"], 4),
             *([_num(r["wilcoxon_p_adjusted"], 4)] if paired else []),
+            *([_num(r["correlation"], 2)] if paired else []),
             r["verdict"],
             h.Cell(
                 h.fmt_number(r["trap_fraction"] * 100, 0) + " %" if math.isfinite(r["trap_fraction"]) else "-",
@@ -1080,6 +1081,7 @@ def _comparison_table(comparison: Comparison, metric: str) -> str:
         f"p ({test})",
         f"p ({test}, {comparison.correction})",
         *([f"p (Wilcoxon check, {comparison.correction})"] if paired else []),
+        *(["r of the paired errors"] if paired else []),
         "verdict",
         "single-run pairs reversed",
     ]
@@ -1097,7 +1099,12 @@ def _comparison_table(comparison: Comparison, metric: str) -> str:
         caption=f"{SYMBOLS[metric]} ({unit}), lower is better; {comparison.pairing}: per world the difference of "
         f"mean errors by {how}; p-values corrected for {len(rows)} comparisons ({comparison.correction}) and the "
         f"first interval corrected alike ({level.label}); the second holds for one world alone. Verdict on the "
-        f"corrected p at \u03b1 = {comparison.alpha:g}.",
+        f"corrected p at \u03b1 = {comparison.alpha:g}."
+        + (
+            " r: the correlation of a run's errors in the two campaigns; pairing narrows the interval only where it is positive."
+            if paired
+            else ""
+        ),
     )
 
 
@@ -1120,10 +1127,12 @@ def compare_report(
     out_dir:
         Folder of ``compare.html``, ``comparison.csv`` and ``figures/``.
     alpha:
-        Significance level of the verdicts; the intervals have confidence ``1 - alpha``.
+        Significance level of the verdicts; each world's own interval has confidence ``1 - alpha``, the
+        one beside the verdicts the level that matches ``correction``.
     correction:
-        ``"holm"``, ``"bh"`` or ``"none"``: correction of the p-values for multiple comparisons (per metric,
-        across worlds).
+        ``"holm"``, ``"bh"`` or ``"none"``: correction of the p-values (and of the intervals beside them) for
+        multiple comparisons (per metric, across worlds). The runs are paired when one campaign is a replay
+        of the other or both of one source (:func:`slamtrials.report.pairing.detect_pairing`).
     labels:
         Names of A and B on the page; default the folder names.
     pdf:

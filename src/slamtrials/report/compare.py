@@ -288,7 +288,8 @@ class Comparison:
         ``test`` (``"paired t"`` or ``"Welch"``), ``n_a``, ``n_b`` (runs compared: the pairs when paired),
         ``left_out_a``, ``left_out_b`` (runs of the world without a partner in the other campaign, left
         out of a paired test; 0 for Welch), ``mean_a``, ``mean_b``, ``std_a``, ``std_b``,
-        ``std_difference`` (of the run-by-run differences; NaN for Welch), ``difference``
+        ``std_difference`` (of the run-by-run differences), ``correlation`` (of the paired errors; NaN
+        for Welch), ``difference``
         (``mean_b - mean_a``), ``se``, ``dof``, ``t``, ``p``, ``p_adjusted``, ``wilcoxon_p``,
         ``wilcoxon_p_adjusted`` (the signed-rank check, corrected like ``p``; NaN for Welch),
         ``ci_low``, ``ci_high`` (``1 - alpha``, this world alone), ``ci_adj_low``, ``ci_adj_high``,
@@ -363,7 +364,8 @@ def _world_row(
     if paired and len(a) == 0:
         nan = math.nan
         row.update({"n_a": 0, "n_b": 0, "left_out_a": left_a, "left_out_b": left_b})
-        row.update(dict.fromkeys(("mean_a", "mean_b", "std_a", "std_b", "std_difference", "difference"), nan))
+        row.update(dict.fromkeys(("mean_a", "mean_b", "std_a", "std_b", "std_difference", "correlation"), nan))
+        row["difference"] = nan
         row.update(dict.fromkeys(("se", "dof", "t", "p", "wilcoxon_p", "ci_low", "ci_high"), nan))
         row.update({"trap_fraction": nan, "trap_run_a": -1, "trap_run_b": -1})
         row.update(dict.fromkeys(("trap_value_a", "trap_value_b", "trap_difference"), nan))
@@ -371,11 +373,11 @@ def _world_row(
     if paired:
         r = paired_test(a, b, confidence=confidence)
         n_a = n_b = r.n
-        std_difference, wilcoxon_p = r.std_difference, r.wilcoxon_p
+        std_difference, correlation, wilcoxon_p = r.std_difference, r.correlation, r.wilcoxon_p
     else:
         r = welch(a, b, confidence=confidence)
         n_a, n_b = r.n_a, r.n_b
-        std_difference = wilcoxon_p = math.nan
+        std_difference = correlation = wilcoxon_p = math.nan
     row.update(
         {
             "n_a": n_a,
@@ -387,6 +389,7 @@ def _world_row(
             "std_a": r.std_a,
             "std_b": r.std_b,
             "std_difference": std_difference,
+            "correlation": correlation,
             "difference": r.difference,
             "se": r.se,
             "dof": r.dof,

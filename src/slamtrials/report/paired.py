@@ -40,6 +40,9 @@ class PairedResult:
         Sample standard deviations (divisor ``n - 1``) of the two samples.
     std_difference:
         Sample standard deviation of the differences ``b_k - a_k``.
+    correlation:
+        Pearson correlation of ``a`` and ``b`` over the pairs, ``(s_a^2 + s_b^2 - s_d^2) / (2 s_a s_b)``: the
+        pairing narrows the interval (against Welch's) only where it is positive; NaN when a side is constant.
     difference, se, dof, t, p:
         Mean difference, its standard error ``std_difference / sqrt(n)``, ``n - 1``, ``difference / se``
         (``+-inf`` when ``se == 0`` and the mean differs from 0, 0 when both are 0) and the two-sided
@@ -61,6 +64,7 @@ class PairedResult:
     std_a: float
     std_b: float
     std_difference: float
+    correlation: float
     difference: float
     se: float
     dof: float
@@ -104,8 +108,10 @@ def paired_test(a: ArrayLike, b: ArrayLike, *, confidence: float = 0.95) -> Pair
     diff = float(d.mean())
     nan = math.nan
     if n < 2:
-        return PairedResult(n, ma, mb, nan, nan, nan, diff, nan, nan, nan, nan, nan, nan, confidence, nan)
+        return PairedResult(n, ma, mb, nan, nan, nan, nan, diff, nan, nan, nan, nan, nan, nan, confidence, nan)
     sd = float(d.std(ddof=1))
+    sa, sb = float(a.std(ddof=1)), float(b.std(ddof=1))
+    correlation = (sa * sa + sb * sb - sd * sd) / (2.0 * sa * sb) if sa > 0.0 and sb > 0.0 else nan
     se = sd / math.sqrt(n)
     dof = float(n - 1)
     if se == 0.0:
@@ -119,9 +125,10 @@ def paired_test(a: ArrayLike, b: ArrayLike, *, confidence: float = 0.95) -> Pair
         n,
         ma,
         mb,
-        float(a.std(ddof=1)),
-        float(b.std(ddof=1)),
+        sa,
+        sb,
         sd,
+        min(1.0, max(-1.0, correlation)) if math.isfinite(correlation) else nan,
         diff,
         se,
         dof,

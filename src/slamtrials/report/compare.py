@@ -52,7 +52,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import stats
 
 from slamtrials.report.combine import IntervalLevel, interval_level, stouffer
-from slamtrials.report.paired import paired_test
+from slamtrials.report.paired import PairedResult, paired_test
 from slamtrials.report.tables import METRICS, check_metric
 
 __all__ = [
@@ -370,6 +370,7 @@ def _world_row(
         row.update({"trap_fraction": nan, "trap_run_a": -1, "trap_run_b": -1})
         row.update(dict.fromkeys(("trap_value_a", "trap_value_b", "trap_difference"), nan))
         return row
+    r: PairedResult | WelchResult
     if paired:
         r = paired_test(a, b, confidence=confidence)
         n_a = n_b = r.n

@@ -46,12 +46,32 @@ def fake_campaign(folder, trial):
     return folder
 
 
+def replay(source, folder):
+    from distributed import Client, LocalCluster
+
+    from slamtrials.campaign import replay_campaign
+
+    with (
+        LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster,
+        Client(cluster) as client,
+    ):
+        replay_campaign(source, folder, params={"resolution": 0.1}, scheduler=client)
+    return folder
+
+
 @pytest.fixture(scope="module")
 def campaigns(tmp_path_factory):
     root = tmp_path_factory.mktemp("cli_report")
     a = fake_campaign(root / "slow_algo", FakeTrial(mean_t=0.5, std_t=0.05))
     b = fake_campaign(root / "fast_algo", FakeTrial(mean_t=0.3, std_t=0.05))
     return a, b
+
+
+@pytest.fixture(scope="module")
+def replayed(campaigns):
+    """The odometry replay of ``slow_algo`` (FakeTrial's odometry is the truth: every replayed error is 0)."""
+    a, _ = campaigns
+    return replay(a, a.parent / "slow_replay")
 
 
 def one_line_error(result, *fragments):
@@ -79,13 +99,36 @@ def test_compare_command(campaigns, tmp_path):
     assert result.exit_code == 0, result.output
     out = b / "report" / "compare-slow_algo"
     assert (out / "compare.html").is_file() and (out / "comparison.csv").is_file()
-    assert "fast_algo better" in result.output and "99% Welch interval" in result.output and "by bh" in result.output
-    assert "overall: no consistent difference in eps_t: fast_algo has the lower mean in 2" in result.output
+    assert "fast_algo better" in result.output and "by bh" in result.output
+    assert "test: unpaired (Welch): Welch's t-test per world; p and intervals corrected by bh" in result.output
+    assert "CI: FCR-adjusted 99% (Benjamini-Yekutieli, 2 of 2 selected: 99%)" in result.output
+    # two worlds, each 0.2 m better by 4 standard deviations: Stouffer's test decides, the sign test could not
+    assert "overall: fast_algo is better overall in eps_t: Stouffer's Z over the worlds' one-sided Welch t-tests" in (
+        result.output.replace("\n", " ")
+    )
+    assert "sign test over worlds p = 0.5" in result.output
     table = pd.read_csv(out / "comparison.csv")
     assert table.loc[table["metric"] == "eps_t", "verdict"].tolist() == ["B better", "B better"]
     assert table.loc[table["metric"] == "eps_t", "difference"].to_numpy() == pytest.approx([-0.2, -0.2], abs=1e-9)
     explicit = runner.invoke(cli_app(), ["compare", str(a), str(b), "--out", str(tmp_path / "cmp"), "--no-pdf"])
     assert explicit.exit_code == 0 and (tmp_path / "cmp" / "compare.html").is_file()
+
+
+def test_compare_a_replay_is_paired(campaigns, replayed, tmp_path):
+    a, b = campaigns
+    result = runner.invoke(cli_app(), ["compare", str(a), str(replayed), "--out", str(tmp_path / "p"), "--no-pdf"])
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    assert "test: paired (slow_replay is a replay of slow_algo): paired t on the run-by-run differences" in text
+    assert "overall: slow_replay is better overall in eps_t: Stouffer's Z over the worlds' one-sided paired" in text
+    assert "CI: simultaneous 95% (Bonferroni, 2 worlds: each at 97.5%)" in text and "W adj" in text
+    table = pd.read_csv(tmp_path / "p" / "comparison.csv")
+    assert set(table["test"]) == {"paired t"} and (table["n_a"] == 8).all() and (table["left_out_a"] == 0).all()
+    swapped = runner.invoke(cli_app(), ["compare", str(replayed), str(a), "--out", str(tmp_path / "s"), "--no-pdf"])
+    assert "test: paired (slow_replay is a replay of slow_algo)" in " ".join(swapped.output.split())
+    unpaired = runner.invoke(cli_app(), ["compare", str(b), str(replayed), "--out", str(tmp_path / "u"), "--no-pdf"])
+    text = " ".join(unpaired.output.split())
+    assert "test: unpaired (Welch)" in text and "slow_replay is a replay of" in text and "not paired" in text
 
 
 @pytest.mark.parametrize("fmt", ["csv", "parquet"])

@@ -292,12 +292,49 @@ def test_compare_report_verdicts_statistics_and_trap(two_levels, tmp_path):
         WORLDS[:2]
     )  # the comparison sorts worlds by name
     assert all((result.page.parent / src).is_file() for src in page.images) and len(page.images) == 3
-    assert "Overall verdict" in " ".join(page.text)
+    text = " ".join(page.text)
+    assert "Overall verdict" in text
+    # independent campaigns (the same seeds, but neither is a replay): Welch, and the page says so
+    assert comparison.pairing == "unpaired (Welch)" and "unpaired (Welch): Welch's t-test per world" in text
+    assert "overall: Stouffer's Z over the worlds' one-sided Welch t-tests" in text
+    # both intervals, each labelled: the one corrected like the p-values, and the one of a world alone
+    assert "CI: simultaneous 95% (Bonferroni, 2 worlds: each at 97.5%)" in text
+    assert "CI: 95% this world alone (unadjusted)" in text
     back = pd.read_csv(result.table_csv)
     assert len(back) == 4 and back["verdict"].tolist()[:2] == [B_BETTER, B_BETTER]
     # swapped: A better
     swapped = compare_report(b, a, tmp_path / "swapped", pdf=False).comparison
     assert swapped.for_metric("eps_t")["verdict"].tolist() == [A_BETTER, A_BETTER]
+
+
+def test_compare_report_of_a_replay_is_paired(two_levels, tmp_path):
+    from distributed import Client, LocalCluster
+
+    from slamtrials.campaign import replay_campaign
+
+    a, _ = two_levels
+    with (
+        LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster,
+        Client(cluster) as client,
+    ):
+        replay_campaign(a, tmp_path / "algo_a_r01", params={"resolution": 0.1}, scheduler=client)
+    result = compare_report(a, tmp_path / "algo_a_r01", tmp_path / "cmp", pdf=False)
+    comparison = result.comparison
+    assert comparison.paired and comparison.pairing == "paired (algo_a_r01 is a replay of algo_a)"
+    runs_a, runs_b = load_campaign(a).done, load_campaign(tmp_path / "algo_a_r01").done
+    for _, row in comparison.table.iterrows():
+        x = runs_a[runs_a["world"] == row["world"]].sort_values("run")[row["metric"]].to_numpy()
+        y = runs_b[runs_b["world"] == row["world"]].sort_values("run")[row["metric"]].to_numpy()
+        assert row["test"] == "paired t" and row["n_a"] == len(x) == len(y) == 10
+        assert row["p"] == pytest.approx(stats.ttest_rel(y, x).pvalue, rel=1e-9)
+        assert row["wilcoxon_p"] == pytest.approx(stats.wilcoxon(y - x).pvalue, rel=1e-9)
+    text = " ".join(Page(result.page.read_text(encoding="utf-8")).text)
+    assert (
+        "paired (algo_a_r01 is a replay of algo_a): paired t-test per world (Wilcoxon signed-rank as a check)" in text
+    )
+    assert "overall: Stouffer's Z over the worlds' one-sided paired t-tests" in text
+    assert "p (Wilcoxon check, holm)" in text and "pairs" in text
+    assert any(note.startswith("Paired (algo_a_r01 is a replay of algo_a): run i of a world") for note in result.notes)
 
 
 def test_compare_problems_are_config_errors(two_levels, tmp_path):
@@ -379,11 +416,13 @@ def test_compare_a_real_campaign_with_its_replay(real_campaign, tmp_path):
     assert sorted(set(table["world"])) == ["rooms_5m", "rooms_6m"] and len(table) == 4
     a, b = load_campaign(gmapping).done, load_campaign(odometry).done
     for _, row in table.iterrows():
-        x = a.loc[a["world"] == row["world"], row["metric"]].to_numpy()
-        y = b.loc[b["world"] == row["world"], row["metric"]].to_numpy()
-        assert row["p"] == pytest.approx(stats.ttest_ind(y, x, equal_var=False).pvalue, rel=1e-9)
+        x = a[a["world"] == row["world"]].sort_values("run")[row["metric"]].to_numpy()
+        y = b[b["world"] == row["world"]].sort_values("run")[row["metric"]].to_numpy()
+        # the replay is paired run by run with its source
+        assert row["p"] == pytest.approx(stats.ttest_rel(y, x).pvalue, rel=1e-9)
         expected = NO_DIFFERENCE if row["p_adjusted"] > 0.05 else (B_BETTER if row["difference"] < 0 else A_BETTER)
         assert row["verdict"] == expected
-    assert any("replay of the other campaign" in note for note in result.notes)
+    assert result.comparison.pairing == "paired (odometry is a replay of gmapping)"
+    assert any(note.startswith("Paired (odometry is a replay of gmapping)") for note in result.notes)
     page = (tmp_path / "cmp" / "compare.html").read_text(encoding="utf-8")
     assert "settings that differ (A -&gt; B)" in page and "slam.algorithm: gmapping -&gt; odometry" in page

@@ -3,11 +3,12 @@
 * ``report CAMPAIGN [--out DIR] [--run WORLD/IDX] [--repeats N] [--seed S] [--no-pdf]``: write the HTML
   report (``CAMPAIGN/report/index.html``, figures beside it) and print Table I and the page's path.
 * ``compare A B [--out DIR] [--alpha 0.05] [--correction holm|bh|none]``: compare two campaigns on their
-  common worlds; print every setting that differs between them (``slam.preset: paper -> null``), then per
-  world and metric the difference B - A with its Welch interval, the corrected
-  p-value, the verdict and the share of single-run pairs that reverse it (the paper's Fig. 6 trap), then
-  the overall verdicts; write ``compare.html`` and ``comparison.csv`` (default folder
-  ``B/report/compare-<A>``).
+  common worlds; print every setting that differs between them (``slam.preset: paper -> null``), which
+  test (``paired (B is a replay of A)``: paired t per world with a Wilcoxon check; or ``unpaired
+  (Welch)``), then per world and metric the difference B - A with its interval corrected like the
+  p-values (Bonferroni's simultaneous one for Holm), the corrected p-value, the verdict and the share of
+  single-run pairs that reverse it (the paper's Fig. 6 trap), then the overall verdicts (Stouffer's
+  combined test); write ``compare.html`` and ``comparison.csv`` (default folder ``B/report/compare-<A>``).
 * ``export-table CAMPAIGN --format csv|parquet [--table runs|worlds] [--out FILE]``: the runs (or worlds)
   as a file for pandas, R or a spreadsheet.
 """
@@ -100,21 +101,27 @@ def comparison_table(comparison, metric: str):
     name_a, name_b = comparison.labels
     unit = "m" if metric == "eps_t" else "rad"
     digits = 3 if metric == "eps_t" else 4
+    paired = comparison.paired
+    test = "paired t" if paired else "Welch"
     table = Table(
         title=f"{metric} ({unit}): {name_b} vs {name_a}, difference of mean errors B \u2212 A (lower is better)",
-        caption=f"{1 - comparison.alpha:.0%} Welch interval; p adjusted by {comparison.correction}; trap: share of "
-        "single-run pairs that reverse the means (paper Fig. 6)",
+        caption=f"{comparison.pairing}; CI: {comparison.intervals[metric].label}; p ({test}) adjusted by "
+        f"{comparison.correction}"
+        + (f"; W: Wilcoxon signed-rank check, adjusted by {comparison.correction}" if paired else "")
+        + "; trap: share of single-run pairs that reverse the means (paper Fig. 6)",
     )
-    for column, justify in (
+    columns = [
         ("world", "left"),
-        ("runs A/B", "right"),
+        ("pairs" if paired else "runs A/B", "right"),
         ("mean A", "right"),
         ("mean B", "right"),
         ("B \u2212 A [CI]", "right"),
         ("p adj", "right"),
+        *([("W adj", "right")] if paired else []),
         ("verdict", "left"),
         ("trap", "right"),
-    ):
+    ]
+    for column, justify in columns:
         table.add_column(column, justify=justify, no_wrap=column not in ("world", "verdict"))
     short = {
         "A better": f"{name_a} better",
@@ -123,13 +130,15 @@ def comparison_table(comparison, metric: str):
     }
     for _, r in comparison.for_metric(metric).iterrows():
         trap = "-" if r["trap_fraction"] != r["trap_fraction"] else f"{r['trap_fraction']:.0%}"
+        interval = f"[{fmt_number(r['ci_adj_low'], digits)}, {fmt_number(r['ci_adj_high'], digits)}]"
         table.add_row(
             str(r["world"]),
-            f"{r['n_a']}/{r['n_b']}",
+            f"{r['n_a']}" if paired else f"{r['n_a']}/{r['n_b']}",
             fmt_number(r["mean_a"], digits),
             fmt_number(r["mean_b"], digits),
-            f"{fmt_number(r['difference'], digits)} [{fmt_number(r['ci_low'], digits)}, {fmt_number(r['ci_high'], digits)}]",
+            f"{fmt_number(r['difference'], digits)} {interval}",
             fmt_number(r["p_adjusted"], 4),
+            *([fmt_number(r["wilcoxon_p_adjusted"], 4)] if paired else []),
             short.get(r["verdict"], r["verdict"]),
             trap,
         )
@@ -144,14 +153,18 @@ def compare(
         typer.Option("--out", "-o", help="Folder of compare.html and comparison.csv (default: B/report/compare-<A>)."),
     ] = None,
     alpha: Annotated[
-        float, typer.Option("--alpha", help="Significance level; intervals have confidence 1 - alpha.")
+        float,
+        typer.Option(
+            "--alpha", help="Significance level; the intervals beside the verdicts are corrected like the p-values."
+        ),
     ] = 0.05,
     correction: Annotated[
         CorrectionChoice, typer.Option("--correction", help="Correction for multiple comparisons across worlds.")
     ] = CorrectionChoice.holm,
     pdf: Annotated[bool, typer.Option("--pdf/--no-pdf", help="Also save every figure as PDF.")] = True,
 ) -> None:
-    """Compare two campaigns on the same worlds: Welch intervals, corrected p-values, verdicts, the Fig. 6 trap."""
+    """Compare two campaigns on the same worlds: paired tests for a replay (Welch's otherwise), corrected p-values
+    and intervals, verdicts, Stouffer's overall test, the Fig. 6 trap."""
     from slamtrials.campaign.differences import campaign_differences
     from slamtrials.cli.campaign import print_differences
     from slamtrials.errors import ConfigError
@@ -164,6 +177,19 @@ def compare(
     result = compare_report(campaign_a, campaign_b, folder, alpha=alpha, correction=correction.value, pdf=pdf)
     console = make_console()
     print_differences(console, campaign_differences(campaign_a, campaign_b), str(campaign_a), str(campaign_b))
+    comparison = result.comparison
+    what = (
+        "paired t on the run-by-run differences per world, Wilcoxon signed-rank as a check"
+        if comparison.paired
+        else "Welch's t-test per world"
+    )
+    overall_test = next(iter(comparison.overall.values())).test if comparison.overall else "-"
+    console.print(
+        f"test: {comparison.pairing}: {what}; p and intervals corrected by {comparison.correction}; "
+        f"overall: {overall_test}",
+        highlight=False,
+        soft_wrap=True,
+    )
     for metric in result.comparison.overall:
         console.print(comparison_table(result.comparison, metric))
     for note in result.notes:

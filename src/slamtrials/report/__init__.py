@@ -4,9 +4,10 @@
   (:class:`CampaignData`); :func:`export_table` writes them as CSV or Parquet.
 * :func:`build_report` writes ``<campaign>/report/index.html`` with the paper's Table I and Figs. 1, 3, 4,
   5, 6, trajectories, termination reasons, explored fraction and provenance.
-* :func:`compare_report` compares two campaigns world by world (Welch intervals, corrected p-values, an
-  overall verdict, the Fig. 6 trap) and writes ``compare.html``; :func:`compare_campaigns` is the
-  statistics alone.
+* :func:`compare_report` compares two campaigns world by world (paired tests for a replay and its source,
+  Welch's otherwise; corrected p-values and intervals; Stouffer's overall verdict; the Fig. 6 trap) and
+  writes ``compare.html``; :func:`compare_campaigns` is the statistics alone, :func:`detect_pairing` says
+  whether two campaigns share their recorded data.
 * :func:`world_summary` is Table I as a DataFrame; the ``draw_*`` functions of
   :mod:`slamtrials.report.campaign_figures` draw on a given matplotlib Axes.
 
@@ -28,6 +29,7 @@ _PUBLIC = {
     "compare_campaigns": "slamtrials.report.compare",
     "Comparison": "slamtrials.report.compare",
     "world_pair_traps": "slamtrials.report.compare",
+    "detect_pairing": "slamtrials.report.pairing",
     "world_summary": "slamtrials.report.tables",
     "paper_table": "slamtrials.report.tables",
     "save_figure": "slamtrials.report.campaign_figures",

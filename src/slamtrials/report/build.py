@@ -24,8 +24,9 @@ with notes saying what is missing. Every file is written atomically; figures of 
 are not drawn again are removed.
 
 :func:`compare_report` compares two campaigns on their common worlds
-(:func:`slamtrials.report.compare.compare_campaigns`: Welch intervals, corrected p-values, verdicts, the
-Fig. 6 trap) and writes ``compare.html``, ``comparison.csv`` and its figures.
+(:func:`slamtrials.report.compare.compare_campaigns`: paired tests when one is a replay of the other,
+Welch's otherwise; corrected p-values with intervals corrected alike, verdicts, Stouffer's overall test,
+the Fig. 6 trap) and writes ``compare.html``, ``comparison.csv`` and its figures.
 """
 
 from __future__ import annotations
@@ -61,9 +62,11 @@ from slamtrials.report.compare import (
     Comparison,
     Correction,
     compare_campaigns,
+    comparison_notes,
     world_pair_traps,
 )
 from slamtrials.report.load import CampaignData, load_campaign
+from slamtrials.report.pairing import detect_pairing
 from slamtrials.report.tables import METRICS, NOISE_SHARE_LIMIT, OUTLIER_IQR, paper_table
 
 __all__ = [
@@ -985,19 +988,23 @@ def _labels(a: CampaignData, b: CampaignData) -> tuple[str, str]:
     return names if names[0] != names[1] else ("A", "B")
 
 
-def _compare_notes(a: CampaignData, b: CampaignData, comparison: Comparison) -> list[str]:
+def _compare_notes(a: CampaignData, b: CampaignData, comparison: Comparison, unpaired_because: str = "") -> list[str]:
     notes = []
     name_a, name_b = comparison.labels
     if comparison.only_a:
         notes.append(f"Worlds only in {name_a}, not compared: {', '.join(comparison.only_a)}.")
     if comparison.only_b:
         notes.append(f"Worlds only in {name_b}, not compared: {', '.join(comparison.only_b)}.")
-    for data, other, name in ((b, a, name_b), (a, b, name_a)):
-        if data.kind == "replay" and Path(str(data.config.get("replay_of"))) == other.folder:
-            notes.append(
-                f"{name} is a replay of the other campaign: its runs use the same recorded data, so they are paired; "
-                "Welch's test ignores the pairing (it is conservative). " + REPLAY_NOTE + "."
-            )
+    if comparison.paired:
+        notes.append(
+            f"{comparison.pairing[0].upper()}{comparison.pairing[1:]}: run i of a world comes from the same recorded "
+            "data in both campaigns, so each world is tested on the run-by-run differences (paired t-test, with "
+            "the Wilcoxon signed-rank test as a check). "
+            + (REPLAY_NOTE + "." if "replay" in comparison.pairing else "")
+        )
+    elif unpaired_because:
+        notes.append(f"Unpaired: {unpaired_because}.")
+    notes.extend(comparison_notes(comparison))
     for data, name in ((a, name_a), (b, name_b)):
         unfinished = data.worlds[~data.worlds["status"].isin(["done", "capped", "short"])]
         if len(unfinished):
@@ -1029,53 +1036,75 @@ def trap_sentences(comparison: Comparison, metric: str = "eps_t") -> list[str]:
     return out
 
 
+def _interval(low: float, high: float, digits: int) -> h.Cell:
+    return h.Cell(f"[{h.fmt_number(low, digits)}, {h.fmt_number(high, digits)}]", numeric=True)
+
+
 def _comparison_table(comparison: Comparison, metric: str) -> str:
     rows, classes = [], []
     unit = UNITS[metric]
     digits = 3 if metric == "eps_t" else 4
+    paired = comparison.paired
+    level = comparison.intervals[metric]
     for _, r in comparison.for_metric(metric).iterrows():
-        ci = f"[{h.fmt_number(r['ci_low'], digits)}, {h.fmt_number(r['ci_high'], digits)}]"
-        rows.append(
-            [
-                r["world"],
-                h.Cell(str(r["n_a"]), numeric=True),
-                h.Cell(str(r["n_b"]), numeric=True),
-                _num(r["mean_a"], digits),
-                _num(r["mean_b"], digits),
-                _num(r["difference"], digits),
-                h.Cell(ci, numeric=True),
-                _num(r["p"], 4),
-                _num(r["p_adjusted"], 4),
-                r["verdict"],
-                h.Cell(
-                    h.fmt_number(r["trap_fraction"] * 100, 0) + " %" if math.isfinite(r["trap_fraction"]) else "-",
-                    numeric=True,
-                ),
-            ]
-        )
+        cells = [
+            r["world"],
+            *([h.Cell(str(r["n_a"]), numeric=True)] if paired else []),
+            *([] if paired else [h.Cell(str(r["n_a"]), numeric=True), h.Cell(str(r["n_b"]), numeric=True)]),
+            _num(r["mean_a"], digits),
+            _num(r["mean_b"], digits),
+            _num(r["difference"], digits),
+            _interval(r["ci_adj_low"], r["ci_adj_high"], digits),
+            _interval(r["ci_low"], r["ci_high"], digits),
+            _num(r["p"], 4),
+            _num(r["p_adjusted"], 4),
+            *([_num(r["wilcoxon_p_adjusted"], 4)] if paired else []),
+            *([_num(r["correlation"], 2)] if paired else []),
+            r["verdict"],
+            h.Cell(
+                h.fmt_number(r["trap_fraction"] * 100, 0) + " %" if math.isfinite(r["trap_fraction"]) else "-",
+                numeric=True,
+            ),
+        ]
+        rows.append(cells)
         classes.append("good" if r["verdict"] == B_BETTER else ("bad" if r["verdict"] == A_BETTER else None))
     name_a, name_b = comparison.labels
+    test = "paired t" if paired else "Welch"
     header = [
         "world",
-        f"n {name_a}",
-        f"n {name_b}",
+        *(["pairs"] if paired else [f"n {name_a}", f"n {name_b}"]),
         f"mean {name_a}",
         f"mean {name_b}",
         f"{name_b} \u2212 {name_a}",
-        f"{1 - comparison.alpha:.0%} CI (Welch)",
-        "p",
-        f"p ({comparison.correction})",
+        f"CI: {level.label}",
+        f"CI: {1 - comparison.alpha:.0%} this world alone (unadjusted)",
+        f"p ({test})",
+        f"p ({test}, {comparison.correction})",
+        *([f"p (Wilcoxon check, {comparison.correction})"] if paired else []),
+        *(["r of the paired errors"] if paired else []),
         "verdict",
         "single-run pairs reversed",
     ]
+    how = (
+        "the paired t-test on the run-by-run differences (runs paired by world and index), with the Wilcoxon "
+        "signed-rank test of the same differences as a check"
+        if paired
+        else "Welch's t-test (the runs of the two campaigns are independent)"
+    )
     return h.table(
         header,
         rows,
         id=f"comparison-table-{metric}",
         row_classes=classes,
-        caption=f"{SYMBOLS[metric]} ({unit}), lower is better: per world the difference of mean errors with its "
-        f"Welch confidence interval, the Welch p-value and the p-value corrected for {len(rows)} comparisons "
-        f"({comparison.correction}); verdict at \u03b1 = {comparison.alpha:g}.",
+        caption=f"{SYMBOLS[metric]} ({unit}), lower is better; {comparison.pairing}: per world the difference of "
+        f"mean errors by {how}; p-values corrected for {len(rows)} comparisons ({comparison.correction}) and the "
+        f"first interval corrected alike ({level.label}); the second holds for one world alone. Verdict on the "
+        f"corrected p at \u03b1 = {comparison.alpha:g}."
+        + (
+            " r: the correlation of a run's errors in the two campaigns; pairing narrows the interval only where it is positive."
+            if paired
+            else ""
+        ),
     )
 
 
@@ -1098,10 +1127,12 @@ def compare_report(
     out_dir:
         Folder of ``compare.html``, ``comparison.csv`` and ``figures/``.
     alpha:
-        Significance level of the verdicts; the intervals have confidence ``1 - alpha``.
+        Significance level of the verdicts; each world's own interval has confidence ``1 - alpha``, the
+        one beside the verdicts the level that matches ``correction``.
     correction:
-        ``"holm"``, ``"bh"`` or ``"none"``: correction of the p-values for multiple comparisons (per metric,
-        across worlds).
+        ``"holm"``, ``"bh"`` or ``"none"``: correction of the p-values (and of the intervals beside them) for
+        multiple comparisons (per metric, across worlds). The runs are paired when one campaign is a replay
+        of the other or both of one source (:func:`slamtrials.report.pairing.detect_pairing`).
     labels:
         Names of A and B on the page; default the folder names.
     pdf:
@@ -1120,15 +1151,18 @@ def compare_report(
         if done.empty:
             raise ConfigError(f"{data.folder}: campaign {name} has no finished run to compare")
     names = labels or _labels(data_a, data_b)
+    pairing = detect_pairing(data_a, data_b, names)
     try:
-        comparison = compare_campaigns(done_a, done_b, alpha=alpha, correction=correction, labels=names)
+        comparison = compare_campaigns(
+            done_a, done_b, alpha=alpha, correction=correction, labels=names, paired_by=pairing.paired_by
+        )
     except ValueError as exc:
         raise ConfigError(f"cannot compare {data_a.folder} with {data_b.folder}: {exc}") from None
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     figs = _FigureWriter(out, "compare_", pdf)
     name_a, name_b = comparison.labels
-    notes = _compare_notes(data_a, data_b, comparison)
+    notes = _compare_notes(data_a, data_b, comparison, pairing.note)
 
     forest = []
     for metric in METRICS:
@@ -1139,9 +1173,10 @@ def compare_report(
             figs.save(
                 fig,
                 f"forest_{metric}",
-                f"{name_b} \u2212 {name_a} in mean {SYMBOLS[metric]} per world with {1 - alpha:.0%} Welch intervals, "
-                f"coloured by verdict ({correction} correction); diamonds: the most misleading single-run pair "
-                "where it contradicts the means; right margin: share of run pairs that reverse the means.",
+                f"{name_b} \u2212 {name_a} in mean {SYMBOLS[metric]} per world ({comparison.pairing}) with "
+                f"{comparison.intervals[metric].label} intervals, coloured by verdict ({correction} correction); "
+                "diamonds: the most misleading single-run pair where it contradicts the means; right margin: share "
+                "of run pairs that reverse the means.",
             )
         )
     trap_rows = comparison.for_metric("eps_t")
@@ -1159,6 +1194,8 @@ def compare_report(
         for ax, (_, r) in zip(axes, trap_rows.iterrows()):
             a = done_a[done_a["world"] == r["world"]]
             b = done_b[done_b["world"] == r["world"]]
+            if comparison.paired:  # the runs the paired test compared
+                a, b = a[a["run"].isin(b["run"])], b[b["run"].isin(a["run"])]
             ia = int(np.flatnonzero(a["run"].to_numpy() == r["trap_run_a"])[0])
             ib = int(np.flatnonzero(b["run"].to_numpy() == r["trap_run_b"])[0])
             va, vb = a["eps_t"].to_numpy(), b["eps_t"].to_numpy()
@@ -1201,8 +1238,21 @@ def compare_report(
                     ("compared worlds", ", ".join(comparison.for_metric(METRICS[0])["world"])),
                     (
                         "test",
-                        f"Welch's t-test per world, {correction} correction across worlds, "
-                        f"\u03b1 = {alpha:g}; overall: sign test over worlds",
+                        f"{comparison.pairing}: "
+                        + (
+                            "paired t-test per world (Wilcoxon signed-rank as a check)"
+                            if comparison.paired
+                            else "Welch's t-test per world"
+                        )
+                        + f", {correction} correction across worlds, \u03b1 = {alpha:g}; intervals: "
+                        + "; ".join(
+                            f"{SYMBOLS[m]} {comparison.intervals[m].label}"
+                            for m in METRICS
+                            if m in comparison.intervals
+                        )
+                        + "; overall: "
+                        + (comparison.overall[METRICS[0]].test if METRICS[0] in comparison.overall else "-")
+                        + " (sign test over worlds as a check)",
                     ),
                 ]
             ),

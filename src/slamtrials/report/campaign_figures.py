@@ -549,7 +549,10 @@ def draw_explored(ax, runs: pd.DataFrame, worlds: list[str] | None = None) -> pd
 
 
 def draw_comparison(ax, comparison: Comparison, metric: str = "eps_t") -> None:
-    """Forest plot of a comparison: per world, ``mean_B - mean_A`` with its Welch interval, coloured by verdict.
+    """Forest plot of a comparison: per world, ``mean_B - mean_A`` with its interval, coloured by verdict.
+
+    The intervals are those corrected like the p-values (``ci_adj_low``, ``ci_adj_high``; their level is
+    ``comparison.intervals[metric]``), so an interval that excludes 0 goes with a significant verdict.
 
     Worlds run top to bottom in the table's order. Each verdict is one errorbar (gid ``"verdict:<v>"``):
     B better green, A better red, no significant difference grey. The Fig. 6 trap: a hollow black diamond
@@ -563,7 +566,7 @@ def draw_comparison(ax, comparison: Comparison, metric: str = "eps_t") -> None:
     name_a, name_b = comparison.labels
     y = np.arange(len(rows))[::-1].astype(float)
     diff = rows["difference"].to_numpy(dtype=float)
-    low, high = rows["ci_low"].to_numpy(dtype=float), rows["ci_high"].to_numpy(dtype=float)
+    low, high = rows["ci_adj_low"].to_numpy(dtype=float), rows["ci_adj_high"].to_numpy(dtype=float)
     xerr = np.nan_to_num(np.vstack([diff - low, high - diff]), nan=0.0)
     verdicts = rows["verdict"].to_numpy()
     for verdict, color in VERDICT_COLORS.items():
@@ -603,11 +606,11 @@ def draw_comparison(ax, comparison: Comparison, metric: str = "eps_t") -> None:
     ax.set_ylim(-0.7, len(rows) - 0.3)
     ax.set_xlabel(f"{name_b} \u2212 {name_a}: difference of mean {METRIC_LABELS[metric]}")
     overall = comparison.overall.get(metric)
-    conf = 1.0 - comparison.alpha
+    level = comparison.intervals[metric]
     ax.set_title(
-        f"{name_b} vs {name_a}"
+        f"{name_b} vs {name_a}, {comparison.pairing}"
         + (f": {overall.verdict}" if overall else "")
-        + f"\n({conf:.0%} Welch intervals, {comparison.correction} correction; right: share of run pairs"
+        + f"\n({level.label} intervals, {comparison.correction} correction;\nright: share of run pairs"
         " that reverse the means)",
         fontsize=8,
     )

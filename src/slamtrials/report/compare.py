@@ -1,32 +1,42 @@
 """Statistical comparison of two campaigns (A and B, e.g. two SLAM algorithms on the same worlds).
 
-Per world and metric (``eps_t`` in m, ``eps_r`` in rad; lower is better):
+Per world and metric (``eps_t`` in m, ``eps_r`` in rad; lower is better), the difference of the mean
+errors ``B - A`` and its test, by one of two tests:
 
-- the difference of the mean errors ``B - A`` with a Welch confidence interval (standard error
-  ``sqrt(s_A^2/n_A + s_B^2/n_B)``, Welch-Satterthwaite degrees of freedom, Student-t quantile);
-- the two-sided Welch t-test p-value (equal to ``scipy.stats.ttest_ind(b, a, equal_var=False)``);
-- the p-values adjusted for multiple comparisons across the worlds of one metric (each metric is its own
-  family): Holm-Bonferroni by default (controls the family-wise error rate), Benjamini-Hochberg on request
-  (controls the false discovery rate), or none;
-- a verdict at level ``alpha`` on the adjusted p-value: ``"A better"``, ``"B better"``,
-  ``"no significant difference"``, or ``"too few runs"`` when either side has fewer than 2 runs.
-  The intervals are per world at level ``1 - alpha`` and are not adjusted, so a world whose interval
-  excludes 0 may still be "no significant difference" after the correction.
+- **paired** when the two campaigns share their recorded data (B a replay of A, A of B, or both replays
+  of one source: run ``i`` of world ``w`` comes from the same recorded laser and odometry in both).
+  Runs are paired by ``(world, run)`` present in both (the others are left out and counted); the test is
+  the paired t-test on the run-by-run differences (:func:`slamtrials.report.paired.paired_test`, equal
+  to ``scipy.stats.ttest_rel``), with the Wilcoxon signed-rank test of the same differences as a check
+  (its p-value corrected the same way, shown beside);
+- **unpaired (Welch)** otherwise: Welch's unequal-variance t-test (standard error
+  ``sqrt(s_A^2/n_A + s_B^2/n_B)``, Welch-Satterthwaite degrees of freedom; equal to
+  ``scipy.stats.ttest_ind(b, a, equal_var=False)``).
 
-Overall, per metric: the counts of verdicts, and an exact two-sided **sign test** over worlds on the sign of
-the per-world difference of means (worlds with equal means are dropped). Each world counts once, as the
-paper's unit of evaluation is the environment; the test asks whether one campaign has the lower mean in
-more worlds than chance would give, makes no assumption of normality or of a common effect size across
-worlds (which a fixed-effects pooling would), and is not dominated by the worlds with many runs. It needs
-at least 6 worlds to reach p < 0.05.
+The p-values are adjusted for multiple comparisons across the worlds of one metric (each metric is its
+own family): Holm-Bonferroni by default (family-wise error rate), Benjamini-Hochberg on request (false
+discovery rate), or none. The verdict at level ``alpha`` is taken on the adjusted p-value: ``"A
+better"``, ``"B better"``, ``"no significant difference"``, or ``"too few runs"`` (fewer than 2 runs on a
+side, or 2 pairs). Two intervals per world: ``ci_low, ci_high`` at ``1 - alpha`` for that world alone
+(unadjusted), and ``ci_adj_low, ci_adj_high`` at the level that matches the correction
+(:func:`slamtrials.report.combine.interval_level`: Bonferroni's simultaneous intervals for Holm,
+Benjamini-Yekutieli's for BH), the one shown beside the verdicts.
+
+Overall, per metric: **Stouffer's combination** of the worlds' one-sided tests
+(:func:`slamtrials.report.combine.stouffer`): each world's t statistic (paired or Welch) becomes a signed
+normal score, the scores add up over the worlds (each world once), and ``Z < 0`` at two-sided
+``p <= alpha`` says B is better overall. Worlds that disagree cancel, so the verdict means a consistent
+difference; three worlds with a clear effect reach it, where the former **sign test** over worlds (kept
+as a labelled check: the worlds where B's mean is lower against those where it is higher) cannot go below
+p = 0.25 with 3 worlds and needs 6 to reach p < 0.05.
 
 The trap of the paper's Fig. 6, made visible: comparing single runs can give the opposite verdict from
 comparing means. For two samples ``x`` (lower mean) and ``y`` (higher mean) the *reversal fraction* is
 the fraction of the pairs ``(x_i, y_j)`` with ``x_i > y_j`` (ties count as not reversed), and the *most
 misleading pair* is ``(argmax x, argmin y)``, whose reversed difference ``max x - min y`` is the largest.
-:func:`compare_campaigns` reports it for A vs B in every world; :func:`world_pair_traps` for every pair
-of worlds of one campaign (the paper's case: a bad run of the easier world beats a good run of the
-harder one).
+:func:`compare_campaigns` reports it for A vs B in every world (over the paired runs when paired);
+:func:`world_pair_traps` for every pair of worlds of one campaign (the paper's case: a bad run of the
+easier world beats a good run of the harder one).
 """
 
 from __future__ import annotations
@@ -41,6 +51,8 @@ import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 from scipy import stats
 
+from slamtrials.report.combine import IntervalLevel, interval_level, stouffer
+from slamtrials.report.paired import PairedResult, paired_test
 from slamtrials.report.tables import METRICS, check_metric
 
 __all__ = [
@@ -57,7 +69,9 @@ __all__ = [
     "reversal",
     "OverallVerdict",
     "Comparison",
+    "UNITS",
     "compare_campaigns",
+    "comparison_notes",
     "world_pair_traps",
     "sign_test",
 ]
@@ -225,12 +239,20 @@ class OverallVerdict:
         Worlds with each per-world verdict (after correction).
     b_lower, b_higher, ties:
         Worlds where B's mean is lower than, higher than, equal to A's.
+    test:
+        The overall test, in words (``"Stouffer's Z over the worlds' one-sided paired t-tests"``).
+    z, p:
+        Stouffer's combined score (negative: B better) and its two-sided p-value; NaN when no world has a
+        test.
+    worlds_tested:
+        Worlds that entered Stouffer's test (those with a per-world test).
+    mean_difference, median_difference:
+        Mean and median over worlds of ``mean_B - mean_A`` (units of the metric).
     sign_test_p:
-        Exact two-sided sign test over ``b_lower`` vs ``b_higher``.
-    median_difference:
-        Median over worlds of ``mean_B - mean_A`` (units of the metric).
+        The check: exact two-sided sign test over worlds of ``b_lower`` vs ``b_higher``.
     verdict:
-        ``"A better"``, ``"B better"`` (sign test significant at ``alpha``) or ``"no consistent difference"``.
+        ``"A better"``, ``"B better"`` (Stouffer's test significant at ``alpha``) or
+        ``"no consistent difference"``.
     statement:
         One sentence that says the above.
     """
@@ -244,8 +266,13 @@ class OverallVerdict:
     b_lower: int
     b_higher: int
     ties: int
-    sign_test_p: float
+    test: str
+    z: float
+    p: float
+    worlds_tested: int
+    mean_difference: float
     median_difference: float
+    sign_test_p: float
     verdict: str
     statement: str
 
@@ -257,64 +284,132 @@ class Comparison:
     Attributes
     ----------
     table:
-        One row per (world, metric), sorted by metric then world. Columns: ``world``, ``metric``, ``n_a``,
-        ``n_b``, ``mean_a``, ``mean_b``, ``std_a``, ``std_b``, ``difference`` (``mean_b - mean_a``), ``se``,
-        ``dof``, ``t``, ``p``, ``p_adjusted``, ``ci_low``, ``ci_high``, ``verdict``; and the Fig. 6 trap:
-        ``trap_fraction`` (fraction of (run of A, run of B) pairs whose comparison contradicts the sign of
-        the difference of means), ``trap_run_a``, ``trap_run_b`` (``run`` indexes of the most misleading
-        pair), ``trap_value_a``, ``trap_value_b`` (their errors), ``trap_difference`` (``value_b - value_a``,
-        of the opposite sign to ``difference`` when the pair is reversed).
+        One row per (world, metric), sorted by metric then world. Columns: ``world``, ``metric``,
+        ``test`` (``"paired t"`` or ``"Welch"``), ``n_a``, ``n_b`` (runs compared: the pairs when paired),
+        ``left_out_a``, ``left_out_b`` (runs of the world without a partner in the other campaign, left
+        out of a paired test; 0 for Welch), ``mean_a``, ``mean_b``, ``std_a``, ``std_b``,
+        ``std_difference`` (of the run-by-run differences), ``correlation`` (of the paired errors; NaN
+        for Welch), ``difference``
+        (``mean_b - mean_a``), ``se``, ``dof``, ``t``, ``p``, ``p_adjusted``, ``wilcoxon_p``,
+        ``wilcoxon_p_adjusted`` (the signed-rank check, corrected like ``p``; NaN for Welch),
+        ``ci_low``, ``ci_high`` (``1 - alpha``, this world alone), ``ci_adj_low``, ``ci_adj_high``,
+        ``ci_adj_level`` (the interval adjusted like the p-values, and its level), ``verdict``; and the
+        Fig. 6 trap: ``trap_fraction`` (fraction of (run of A, run of B) pairs whose comparison
+        contradicts the sign of the difference of means), ``trap_run_a``, ``trap_run_b`` (``run``
+        indexes of the most misleading pair), ``trap_value_a``, ``trap_value_b`` (their errors),
+        ``trap_difference`` (``value_b - value_a``, of the opposite sign to ``difference`` when the pair
+        is reversed).
     overall:
         ``{metric: OverallVerdict}``.
+    intervals:
+        ``{metric: IntervalLevel}``: level and label of ``ci_adj_*``.
     alpha, correction, labels:
         The settings; ``labels`` name A and B in statements and plots.
+    pairing:
+        ``"paired (<what the campaigns share>)"`` or ``"unpaired (Welch)"``.
     only_a, only_b:
         Worlds present in one campaign only (not compared).
     """
 
     table: pd.DataFrame
     overall: dict[str, OverallVerdict]
+    intervals: dict[str, IntervalLevel]
     alpha: float
     correction: str
     labels: tuple[str, str]
+    pairing: str
     only_a: tuple[str, ...]
     only_b: tuple[str, ...]
+
+    @property
+    def paired(self) -> bool:
+        """Whether the per-world tests are paired."""
+        return self.pairing.startswith("paired")
 
     def for_metric(self, metric: str) -> pd.DataFrame:
         """The rows of ``table`` of one metric, indexed from 0."""
         return self.table[self.table["metric"] == metric].reset_index(drop=True)
 
 
+UNITS = {"eps_t": "m", "eps_r": "rad"}
+
+
+def _pairs(
+    world: str, a: NDArray, runs_a: NDArray, b: NDArray, runs_b: NDArray
+) -> tuple[NDArray, NDArray, NDArray, int, int]:
+    """The runs of one world present in both campaigns, by run index: ``(a [n], b [n], runs [n], left_a, left_b)``."""
+    for runs, name in ((runs_a, "A"), (runs_b, "B")):
+        unique, counts = np.unique(runs, return_counts=True)
+        if (counts > 1).any():
+            raise ValueError(f"campaign {name}: world {world!r} has run {int(unique[counts > 1][0])} twice")
+    common, ia, ib = np.intersect1d(runs_a, runs_b, assume_unique=True, return_indices=True)
+    return a[ia], b[ib], common, len(runs_a) - len(common), len(runs_b) - len(common)
+
+
 def _world_row(
-    world: str, metric: str, a: NDArray, runs_a: NDArray, b: NDArray, runs_b: NDArray, confidence: float
+    world: str,
+    metric: str,
+    a: NDArray,
+    runs_a: NDArray,
+    b: NDArray,
+    runs_b: NDArray,
+    confidence: float,
+    paired: bool,
 ) -> dict:
-    w = welch(a, b, confidence=confidence)
-    row = {
-        "world": world,
-        "metric": metric,
-        "n_a": w.n_a,
-        "n_b": w.n_b,
-        "mean_a": w.mean_a,
-        "mean_b": w.mean_b,
-        "std_a": w.std_a,
-        "std_b": w.std_b,
-        "difference": w.difference,
-        "se": w.se,
-        "dof": w.dof,
-        "t": w.t,
-        "p": w.p,
-        "ci_low": w.ci_low,
-        "ci_high": w.ci_high,
-    }
-    if w.difference > 0:  # A has the lower mean: a B run below an A run contradicts it
-        r = reversal(a, b)
-        ia, ib = r.i_low, r.i_high
+    left_a = left_b = 0
+    if paired:
+        a, b, runs, left_a, left_b = _pairs(world, a, runs_a, b, runs_b)
+        runs_a = runs_b = runs
+    row: dict = {"world": world, "metric": metric, "test": "paired t" if paired else "Welch"}
+    if paired and len(a) == 0:
+        nan = math.nan
+        row.update({"n_a": 0, "n_b": 0, "left_out_a": left_a, "left_out_b": left_b})
+        row.update(dict.fromkeys(("mean_a", "mean_b", "std_a", "std_b", "std_difference", "correlation"), nan))
+        row["difference"] = nan
+        row.update(dict.fromkeys(("se", "dof", "t", "p", "wilcoxon_p", "ci_low", "ci_high"), nan))
+        row.update({"trap_fraction": nan, "trap_run_a": -1, "trap_run_b": -1})
+        row.update(dict.fromkeys(("trap_value_a", "trap_value_b", "trap_difference"), nan))
+        return row
+    r: PairedResult | WelchResult
+    if paired:
+        r = paired_test(a, b, confidence=confidence)
+        n_a = n_b = r.n
+        std_difference, correlation, wilcoxon_p = r.std_difference, r.correlation, r.wilcoxon_p
     else:
-        r = reversal(b, a)
-        ib, ia = r.i_low, r.i_high
+        r = welch(a, b, confidence=confidence)
+        n_a, n_b = r.n_a, r.n_b
+        std_difference = correlation = wilcoxon_p = math.nan
     row.update(
         {
-            "trap_fraction": r.fraction,
+            "n_a": n_a,
+            "n_b": n_b,
+            "left_out_a": left_a,
+            "left_out_b": left_b,
+            "mean_a": r.mean_a,
+            "mean_b": r.mean_b,
+            "std_a": r.std_a,
+            "std_b": r.std_b,
+            "std_difference": std_difference,
+            "correlation": correlation,
+            "difference": r.difference,
+            "se": r.se,
+            "dof": r.dof,
+            "t": r.t,
+            "p": r.p,
+            "wilcoxon_p": wilcoxon_p,
+            "ci_low": r.ci_low,
+            "ci_high": r.ci_high,
+        }
+    )
+    if r.difference > 0:  # A has the lower mean: a B run below an A run contradicts it
+        rev = reversal(a, b)
+        ia, ib = rev.i_low, rev.i_high
+    else:
+        rev = reversal(b, a)
+        ib, ia = rev.i_low, rev.i_high
+    row.update(
+        {
+            "trap_fraction": rev.fraction,
             "trap_run_a": int(runs_a[ia]),
             "trap_run_b": int(runs_b[ib]),
             "trap_value_a": float(a[ia]),
@@ -325,6 +420,15 @@ def _world_row(
     return row
 
 
+def _adjusted_intervals(table: pd.DataFrame, level: IntervalLevel) -> tuple[NDArray, NDArray]:
+    """``difference -+ q se`` with ``q`` the t quantile of ``level`` (NaN where the world has no test)."""
+    diff, se, dof = (table[c].to_numpy(dtype=np.float64) for c in ("difference", "se", "dof"))
+    half = np.full(len(table), np.nan)
+    ok = np.isfinite(se) & np.isfinite(dof)
+    half[ok] = stats.t.ppf(0.5 + level.confidence / 2.0, dof[ok]) * se[ok]
+    return diff - half, diff + half
+
+
 def _verdict(row: pd.Series, alpha: float) -> str:
     if not np.isfinite(row["p_adjusted"]):
         return TOO_FEW
@@ -333,39 +437,61 @@ def _verdict(row: pd.Series, alpha: float) -> str:
     return B_BETTER if row["difference"] < 0 else A_BETTER
 
 
-def _overall(metric: str, rows: pd.DataFrame, alpha: float, labels: tuple[str, str]) -> OverallVerdict:
+def _overall(
+    metric: str, rows: pd.DataFrame, alpha: float, correction: str, labels: tuple[str, str], paired: bool
+) -> OverallVerdict:
     counts = rows["verdict"].value_counts()
-    lower, higher = int((rows["difference"] < 0).sum()), int((rows["difference"] > 0).sum())
-    ties = len(rows) - lower - higher
-    p = sign_test(lower, higher)
-    median = float(rows["difference"].median()) if len(rows) else math.nan
+    tested = rows[np.isfinite(rows["t"].to_numpy(dtype=np.float64))]
+    combined = stouffer(tested["t"].to_numpy(dtype=np.float64), tested["dof"].to_numpy(dtype=np.float64))
+    differences = rows["difference"].to_numpy(dtype=np.float64)
+    differences = differences[np.isfinite(differences)]
+    lower, higher = int((differences < 0).sum()), int((differences > 0).sum())
+    ties = len(differences) - lower - higher
+    sign_p = sign_test(lower, higher)
+    mean = float(np.mean(np.sort(differences, kind="stable"))) if len(differences) else math.nan
+    median = float(np.median(differences)) if len(differences) else math.nan
     name_a, name_b = labels
-    if p <= alpha and lower != higher:
-        verdict = B_BETTER if lower > higher else A_BETTER
-        winner = name_b if lower > higher else name_a
-        head = f"{winner} is better overall in {metric}"
+    test = f"Stouffer's Z over the worlds' one-sided {'paired' if paired else 'Welch'} t-tests"
+    if combined.p <= alpha and combined.z != 0:
+        verdict = B_BETTER if combined.z < 0 else A_BETTER
+        head = f"{name_b if combined.z < 0 else name_a} is better overall in {metric}"
     else:
         verdict = "no consistent difference"
         head = f"no consistent difference in {metric}"
+    unit = UNITS.get(metric, "")
+    evidence = (
+        f"{test}, {combined.worlds} worlds, Z = {combined.z:.2f}, p = {combined.p:.3g}"
+        if math.isfinite(combined.p)
+        else f"{test}: no world has a test"
+        if combined.worlds == 0
+        else f"{test}: each campaign is better without error in some world"
+    )
     statement = (
-        f"{head}: {name_b} has the lower mean in {lower} and the higher in {higher} of {len(rows)} worlds "
-        f"(sign test p = {p:.3g}); significant at {alpha:g} after correction: {name_a} better in "
-        f"{int(counts.get(A_BETTER, 0))}, {name_b} better in {int(counts.get(B_BETTER, 0))}."
+        f"{head}: {evidence}; "
+        f"mean over worlds of {name_b} \u2212 {name_a} = {mean:.3g} {unit}; "
+        f"{name_b} has the lower mean in {lower} and the higher in {higher} of {len(rows)} worlds "
+        f"(check: sign test over worlds p = {sign_p:.3g}); significant per world at {alpha:g} after {correction}: "
+        f"{name_a} better in {int(counts.get(A_BETTER, 0))}, {name_b} better in {int(counts.get(B_BETTER, 0))}."
     )
     return OverallVerdict(
-        metric,
-        len(rows),
-        int(counts.get(A_BETTER, 0)),
-        int(counts.get(B_BETTER, 0)),
-        int(counts.get(NO_DIFFERENCE, 0)),
-        int(counts.get(TOO_FEW, 0)),
-        lower,
-        higher,
-        ties,
-        p,
-        median,
-        verdict,
-        statement,
+        metric=metric,
+        worlds=len(rows),
+        a_better=int(counts.get(A_BETTER, 0)),
+        b_better=int(counts.get(B_BETTER, 0)),
+        no_difference=int(counts.get(NO_DIFFERENCE, 0)),
+        too_few=int(counts.get(TOO_FEW, 0)),
+        b_lower=lower,
+        b_higher=higher,
+        ties=ties,
+        test=test,
+        z=combined.z,
+        p=combined.p,
+        worlds_tested=combined.worlds,
+        mean_difference=mean,
+        median_difference=median,
+        sign_test_p=sign_p,
+        verdict=verdict,
+        statement=statement,
     )
 
 
@@ -377,6 +503,7 @@ def compare_campaigns(
     alpha: float = 0.05,
     correction: Correction = "holm",
     labels: tuple[str, str] = ("A", "B"),
+    paired_by: str | None = None,
 ) -> Comparison:
     """Compare campaign B with campaign A world by world (see the module docstring for the method).
 
@@ -387,11 +514,15 @@ def compare_campaigns(
     metrics:
         Which of ``"eps_t"`` (m), ``"eps_r"`` (rad) to compare.
     alpha:
-        Significance level of the verdicts; the intervals have confidence ``1 - alpha``.
+        Significance level of the verdicts; the per-world intervals have confidence ``1 - alpha``, the
+        adjusted ones the level that matches ``correction``.
     correction:
         ``"holm"`` (default), ``"bh"`` (Benjamini-Hochberg) or ``"none"``, across the worlds of each metric.
     labels:
         Names of A and B for statements and plots.
+    paired_by:
+        None: the campaigns are independent (Welch). Otherwise what makes run ``(world, i)`` of A and of
+        B a pair, in words (``"replay of /data/c1"``): the tests are paired on the runs present in both.
 
     Returns
     -------
@@ -400,40 +531,63 @@ def compare_campaigns(
     Raises
     ------
     ValueError
-        A missing column, a non-finite error, a bad ``alpha`` or ``correction``, or no world in common.
+        A missing column, a non-finite error, a run index twice in one world of a paired comparison, a bad
+        ``alpha`` or ``correction``, or no world in common.
     """
     if not (0.0 < alpha < 1.0):
         raise ValueError(f"alpha must be strictly between 0 and 1, got {alpha}")
     if correction not in ("holm", "bh", "none"):
         raise ValueError(f"unknown correction {correction!r}; use 'holm', 'bh' or 'none'")
+    paired = paired_by is not None
     values_a = {m: check_metric(a, m, "campaign A") for m in metrics}
     values_b = {m: check_metric(b, m, "campaign B") for m in metrics}
     worlds_a, worlds_b = a["world"].astype(str).to_numpy(), b["world"].astype(str).to_numpy()
     common = sorted(set(worlds_a) & set(worlds_b))
     if not common:
         raise ValueError("campaigns A and B have no world in common")
-    runs_a, runs_b = a["run"].to_numpy(), b["run"].to_numpy()
-    tables, overall = [], {}
+    runs_a, runs_b = a["run"].to_numpy(dtype=np.int64), b["run"].to_numpy(dtype=np.int64)
+    tables, overall, intervals = [], {}, {}
     for metric in metrics:
         rows = []
         for world in common:
             ia, ib = worlds_a == world, worlds_b == world
             rows.append(
                 _world_row(
-                    world, metric, values_a[metric][ia], runs_a[ia], values_b[metric][ib], runs_b[ib], 1.0 - alpha
+                    world,
+                    metric,
+                    values_a[metric][ia],
+                    runs_a[ia],
+                    values_b[metric][ib],
+                    runs_b[ib],
+                    1.0 - alpha,
+                    paired,
                 )
             )
         table = pd.DataFrame(rows)
         table.insert(table.columns.get_loc("p") + 1, "p_adjusted", adjust_pvalues(table["p"].to_numpy(), correction))
-        table.insert(table.columns.get_loc("ci_high") + 1, "verdict", [_verdict(r, alpha) for _, r in table.iterrows()])
-        overall[metric] = _overall(metric, table, alpha, labels)
+        table.insert(
+            table.columns.get_loc("wilcoxon_p") + 1,
+            "wilcoxon_p_adjusted",
+            adjust_pvalues(table["wilcoxon_p"].to_numpy(), correction),
+        )
+        level = interval_level(alpha, correction, table["p_adjusted"].to_numpy())
+        low, high = _adjusted_intervals(table, level)
+        at = table.columns.get_loc("ci_high") + 1
+        table.insert(at, "ci_adj_low", low)
+        table.insert(at + 1, "ci_adj_high", high)
+        table.insert(at + 2, "ci_adj_level", level.confidence)
+        table.insert(at + 3, "verdict", [_verdict(r, alpha) for _, r in table.iterrows()])
+        overall[metric] = _overall(metric, table, alpha, correction, labels, paired)
+        intervals[metric] = level
         tables.append(table)
     return Comparison(
         table=pd.concat(tables, ignore_index=True),
         overall=overall,
+        intervals=intervals,
         alpha=alpha,
         correction=correction,
         labels=(str(labels[0]), str(labels[1])),
+        pairing=f"paired ({paired_by})" if paired else "unpaired (Welch)",
         only_a=tuple(sorted(set(worlds_a) - set(common))),
         only_b=tuple(sorted(set(worlds_b) - set(common))),
     )
@@ -507,3 +661,50 @@ def world_pair_traps(runs: pd.DataFrame, metric: str = "eps_t", *, alpha: float 
     ]
     table = pd.DataFrame(rows, columns=columns)
     return table.sort_values("reversed_by", ascending=False, kind="stable").reset_index(drop=True)
+
+
+def comparison_notes(comparison: Comparison) -> list[str]:
+    """What a reader of a comparison should know beyond its table, one sentence each.
+
+    Runs left out of the paired tests (no partner in the other campaign); worlds where the Wilcoxon
+    check disagrees with the paired t-test at ``alpha`` (both corrected); worlds that Holm's step-down
+    calls significant although their simultaneous (Bonferroni) interval reaches 0.
+    """
+    notes = []
+    alpha = comparison.alpha
+    first = comparison.for_metric(comparison.table["metric"].iloc[0]) if len(comparison.table) else None
+    if comparison.paired and first is not None:
+        left = first[(first["left_out_a"] > 0) | (first["left_out_b"] > 0)]
+        if len(left):
+            name_a, name_b = comparison.labels
+            parts = [
+                f"{r['world']} {r['left_out_a']} of {name_a}, {r['left_out_b']} of {name_b}" for _, r in left.iterrows()
+            ]
+            notes.append(
+                f"Runs without a partner in the other campaign, left out of the paired tests: {'; '.join(parts)}."
+            )
+    for metric in dict.fromkeys(comparison.table["metric"]):
+        rows = comparison.for_metric(metric)
+        for _, r in rows.iterrows():
+            if comparison.paired and np.isfinite(r["p_adjusted"]) and np.isfinite(r["wilcoxon_p_adjusted"]):
+                t_says, w_says = r["p_adjusted"] <= alpha, r["wilcoxon_p_adjusted"] <= alpha
+                if t_says != w_says:
+                    floor = 2.0 / 2.0 ** int(r["n_a"])
+                    notes.append(
+                        f"{r['world']}, {metric}: the paired t-test says {r['verdict']} (p adj = {r['p_adjusted']:.3g}) "
+                        f"but the Wilcoxon signed-rank check {'does' if w_says else 'does not'} "
+                        f"(p adj = {r['wilcoxon_p_adjusted']:.3g}"
+                        + (f"; with {int(r['n_a'])} pairs it cannot go below {floor:.3g}" if floor > alpha else "")
+                        + ")."
+                    )
+            if (
+                comparison.correction == "holm"
+                and r["verdict"] in (A_BETTER, B_BETTER)
+                and r["ci_adj_low"] <= 0.0 <= r["ci_adj_high"]
+            ):
+                notes.append(
+                    f"{r['world']}, {metric}: significant by Holm's step-down (p adj = {r['p_adjusted']:.3g}) although its "
+                    "simultaneous interval reaches 0: Holm's later steps test at alpha/(m-1), ..., alpha, the "
+                    "intervals at alpha/m."
+                )
+    return notes

@@ -88,9 +88,9 @@ def trial(
     )
     odometry = score.odometry
     console.print(
-        f"error over {len(score.relation_set)} relations (relations.npz): translational {score.eps_t:.4f} "
-        f"+- {score.estimate.se_t:.4f} m, rotational {score.eps_r:.4f} +- {score.estimate.se_r:.4f} rad "
-        f"(standard errors); odometry alone {odometry.eps_t:.4f} m, {odometry.eps_r:.4f} rad",
+        f"error over {len(score.relation_set)} relations (relations.npz): translational {score.eps_t:.4f} m "
+        f"(standard error {score.estimate.se_t:.2g}), rotational {score.eps_r:.4f} rad (standard error "
+        f"{score.estimate.se_r:.2g}); odometry alone {odometry.eps_t:.4f} m, {odometry.eps_r:.4f} rad",
         soft_wrap=True,
         highlight=False,
     )

@@ -19,7 +19,37 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 from slamtrials.errors import ConfigError, validation_problems
 from slamtrials.record import LaserGeometry
 
-__all__ = ["RobotConfig", "LaserConfig", "OdometryConfig", "SimConfig"]
+__all__ = [
+    "RobotConfig",
+    "LaserConfig",
+    "OdometryConfig",
+    "SimConfig",
+    "ErrorProfile",
+    "LASER_ERROR_FIELDS",
+    "ODOMETRY_ERROR_FIELDS",
+]
+
+#: The laser's error-model fields: what an error profile sets (:mod:`slamtrials.sim.profiles`).
+LASER_ERROR_FIELDS = (
+    "range_noise_std",
+    "range_noise_per_m",
+    "short_rate",
+    "dropout_rate",
+    "dropout_per_m",
+    "dropout_grazing",
+)
+#: The odometry's error-model fields: what an error profile sets.
+ODOMETRY_ERROR_FIELDS = (
+    "bias_linear_range",
+    "bias_angular_range",
+    "noise_linear_per_m",
+    "noise_angular_per_rad",
+    "noise_linear_per_rad",
+    "noise_angular_per_m",
+    "slip_per_m",
+    "slip_linear_std",
+    "slip_angular_std",
+)
 
 _MODEL_CONFIG = ConfigDict(extra="forbid", frozen=True)
 
@@ -102,8 +132,21 @@ class LaserConfig(BaseModel):
     mount:
         Pose (x, y, theta) of the laser in the robot base frame (m, m, rad). Default (0, 0, 0).
     range_noise_std:
-        Standard deviation (m) of zero-mean Gaussian noise added to every reading that hit something.
-        Max-range readings (no return) stay exactly ``max_range``. Default 0, as Stage's laser.
+        Constant part (m) of the standard deviation of the zero-mean Gaussian noise added to every reading
+        that hit something. Max-range readings (no return) stay exactly ``max_range``. Default 0, as
+        Stage's laser.
+    range_noise_per_m:
+        Range-proportional part (m/m): the noise's standard deviation is
+        ``range_noise_std + range_noise_per_m * range``. Default 0.
+    short_rate:
+        Probability per beam that something not in the map (a person, a chair leg, glass) returns the beam
+        early: the reading is drawn uniformly between ``min_range`` and the true range. Default 0.
+    dropout_rate, dropout_per_m, dropout_grazing:
+        Probability per beam of no return (the reading is ``max_range``):
+        ``dropout_rate + dropout_per_m * range + dropout_grazing * (1 - |cos(incidence)|)``, capped at 1,
+        where the incidence is the angle between the beam and the normal of the wall it hits. Default 0.
+
+    See :mod:`slamtrials.sim.laser_errors` for the order of the draws.
     """
 
     model_config = _MODEL_CONFIG
@@ -115,7 +158,23 @@ class LaserConfig(BaseModel):
     max_range: float = Field(30.0, gt=0.0, le=1000.0, description="largest range (m)")
     min_range: float = Field(0.0, ge=0.0, le=1000.0, description="smallest range (m)")
     mount: tuple[float, float, float] = Field((0.0, 0.0, 0.0), description="laser pose (x, y, theta) in the base frame")
-    range_noise_std: float = Field(0.0, ge=0.0, le=10.0, description="Gaussian range noise std (m)")
+    range_noise_std: float = Field(0.0, ge=0.0, le=10.0, description="Gaussian range noise std, constant part (m)")
+    range_noise_per_m: float = Field(
+        0.0, ge=0.0, le=1.0, description="Gaussian range noise std, part proportional to the range (m/m)"
+    )
+    short_rate: float = Field(0.0, ge=0.0, le=1.0, description="probability per beam of a short reading")
+    dropout_rate: float = Field(0.0, ge=0.0, le=1.0, description="probability per beam of no return")
+    dropout_per_m: float = Field(
+        0.0, ge=0.0, le=1.0, description="added probability of no return per metre of range (1/m)"
+    )
+    dropout_grazing: float = Field(
+        0.0, ge=0.0, le=1.0, description="added probability of no return times (1 - |cos incidence|)"
+    )
+
+    @property
+    def has_errors(self) -> bool:
+        """Whether any reading error is on (the noise-free Stage laser otherwise)."""
+        return any(getattr(self, name) > 0.0 for name in LASER_ERROR_FIELDS)
 
     @field_validator("mount")
     @classmethod
@@ -193,6 +252,17 @@ class OdometryConfig(BaseModel):
         Arc-length noise std per metre of the step's arc length (m/m). Default 0.
     noise_angular_per_rad:
         Heading noise std per radian of the step's heading change (rad/rad). Default 0.
+    noise_linear_per_rad:
+        Arc-length noise std per radian of the step's heading change (m/rad): the cross term. With it the
+        arc-length std is ``sqrt((noise_linear_per_m L)^2 + (noise_linear_per_rad phi)^2)``. Default 0.
+    noise_angular_per_m:
+        Heading noise std per metre of the step's arc length (rad/m): the other cross term. Default 0.
+    slip_per_m:
+        Expected wheel-slip events per metre travelled (1/m). A step of arc length ``L`` slips with
+        probability ``min(1, slip_per_m * L)``; a slip adds ``N(0, slip_linear_std)`` to its measured arc
+        length and ``N(0, slip_angular_std)`` to its measured heading change. Default 0.
+    slip_linear_std, slip_angular_std:
+        Size of a slip's errors (m, rad).
     """
 
     model_config = _MODEL_CONFIG
@@ -205,6 +275,13 @@ class OdometryConfig(BaseModel):
     bias_angular: float | None = Field(None, gt=-0.5, lt=0.5, description="fixed e_ang (rad/rad), overrides the draw")
     noise_linear_per_m: float = Field(0.0, ge=0.0, le=1.0, description="arc-length noise std per metre (m/m)")
     noise_angular_per_rad: float = Field(0.0, ge=0.0, le=1.0, description="heading noise std per radian (rad/rad)")
+    noise_linear_per_rad: float = Field(
+        0.0, ge=0.0, le=1.0, description="arc-length noise std per radian of turning (m/rad)"
+    )
+    noise_angular_per_m: float = Field(0.0, ge=0.0, le=1.0, description="heading noise std per metre travelled (rad/m)")
+    slip_per_m: float = Field(0.0, ge=0.0, le=10.0, description="expected wheel-slip events per metre (1/m)")
+    slip_linear_std: float = Field(0.0, ge=0.0, le=10.0, description="arc-length error std of a slip (m)")
+    slip_angular_std: float = Field(0.0, ge=0.0, le=math.pi, description="heading error std of a slip (rad)")
 
     @field_validator("bias_linear_range", "bias_angular_range")
     @classmethod
@@ -218,6 +295,72 @@ class OdometryConfig(BaseModel):
         return value
 
 
+class ErrorProfile(BaseModel):
+    """A named set of error-model values.
+
+    Attributes
+    ----------
+    name:
+        The profile's name (letters, digits, ``_ . -``).
+    description:
+        Where its values come from.
+    laser:
+        Values of laser error fields (``range_noise_std`` m, ``range_noise_per_m`` m/m, ``short_rate``,
+        ``dropout_rate``, ``dropout_per_m`` 1/m, ``dropout_grazing``); a field not given is 0.
+    odometry:
+        Values of odometry error fields (``bias_linear_range`` m/m, ``bias_angular_range`` rad/rad, the
+        ``noise_*`` stds, ``slip_*``); a field not given keeps the odometry config's default.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    name: str = Field(..., pattern=r"^[A-Za-z0-9_.\-]+$", max_length=100, description="profile name")
+    description: str = Field("", max_length=2000, description="where the values come from")
+    laser: dict[str, float] = Field(default_factory=dict, description="laser error-model values")
+    odometry: dict[str, Any] = Field(default_factory=dict, description="odometry error-model values")
+
+    @field_validator("laser")
+    @classmethod
+    def _laser_fields(cls, values: dict[str, float]) -> dict[str, float]:
+        _known("laser", values, LASER_ERROR_FIELDS)
+        LaserConfig.model_validate(values)  # the fields' own ranges
+        return dict(sorted(values.items()))
+
+    @field_validator("odometry")
+    @classmethod
+    def _odometry_fields(cls, values: dict[str, Any]) -> dict[str, Any]:
+        _known("odometry", values, ODOMETRY_ERROR_FIELDS)
+        checked = OdometryConfig.model_validate(values)
+        return {name: getattr(checked, name) for name in sorted(values)}
+
+    def laser_values(self) -> dict[str, float]:
+        """Every laser error field's value (0 where the profile gives none)."""
+        return {name: float(self.laser.get(name, 0.0)) for name in LASER_ERROR_FIELDS}
+
+    def odometry_values(self) -> dict[str, Any]:
+        """Every odometry error field's value (the odometry config's default where the profile gives none)."""
+        defaults = OdometryConfig()
+        return {name: self.odometry.get(name, getattr(defaults, name)) for name in ODOMETRY_ERROR_FIELDS}
+
+
+def _known(section: str, values: dict[str, Any], fields: tuple[str, ...]) -> None:
+    unknown = sorted(set(values) - set(fields))
+    if unknown:
+        raise ValueError(f"unknown {section} error field {unknown[0]!r}; known: {', '.join(fields)}")
+
+
+def _under(profile_values: dict[str, Any], given: Any, model: type[BaseModel]) -> Any:
+    """``given`` (a mapping, a model instance or None) with ``profile_values`` for the fields it does not set."""
+    if given is None:
+        return dict(profile_values)
+    if isinstance(given, model):
+        explicit = given.model_dump(include=given.model_fields_set)
+        return {**given.model_dump(), **profile_values, **explicit}
+    if isinstance(given, dict):
+        return {**profile_values, **given}
+    return given  # not a mapping: the field's own validation names it
+
+
 class SimConfig(BaseModel):
     """Everything the :class:`~slamtrials.sim.Simulator` needs besides the world and the random stream.
 
@@ -228,6 +371,10 @@ class SimConfig(BaseModel):
         Default 0.1 s (10 Hz), as the paper.
     robot, laser, odometry:
         The sub-configurations.
+    profile:
+        The error profile (:mod:`slamtrials.sim.profiles`): a bundled name (``paper``, the default) or an
+        inline :class:`~slamtrials.sim.profiles.ErrorProfile`. It gives the laser's and the odometry's
+        error-model fields their values; a value written in ``laser`` or ``odometry`` overrides it.
     """
 
     model_config = _MODEL_CONFIG
@@ -236,6 +383,32 @@ class SimConfig(BaseModel):
     robot: RobotConfig = Field(default_factory=RobotConfig)
     laser: LaserConfig = Field(default_factory=LaserConfig)
     odometry: OdometryConfig = Field(default_factory=OdometryConfig)
+    profile: str | ErrorProfile = Field(
+        "paper", description="error profile: a bundled name (paper) or inline {name, laser, odometry}"
+    )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _profile_fills_the_error_models(cls, data: Any) -> Any:
+        if not isinstance(data, dict):
+            return data
+        from slamtrials.sim.profiles import BUNDLED_PROFILES, resolve_profile
+
+        try:
+            profile = resolve_profile(data.get("profile", "paper"))
+        except ValidationError as exc:
+            raise ValueError(f"profile: {validation_problems(exc)}") from None
+        data = dict(data)
+        data["laser"] = _under(profile.laser_values(), data.get("laser"), LaserConfig)
+        data["odometry"] = _under(profile.odometry_values(), data.get("odometry"), OdometryConfig)
+        bundled = BUNDLED_PROFILES.get(profile.name) == profile
+        data["profile"] = profile.name if bundled else profile
+        return data
+
+    @property
+    def profile_name(self) -> str:
+        """The error profile's name."""
+        return self.profile if isinstance(self.profile, str) else self.profile.name
 
     @classmethod
     def paper(cls) -> SimConfig:

@@ -75,14 +75,22 @@ def measured_increment(
     dx, dy, phi = (float(v) for v in np.asarray(delta, dtype=np.float64))
     phi_m = (1.0 + bias_angular) * phi + noise_angular
     chord = math.hypot(dx, dy)
-    if chord == 0.0:
-        return np.array([0.0, 0.0, phi_m])
+    if chord == 0.0:  # a turn in place: an arc-length error moves along the mean heading of the step
+        if noise_linear == 0.0:
+            return np.array([0.0, 0.0, phi_m])
+        half = 0.5 * phi_m
+        return np.array([noise_linear * math.cos(half), noise_linear * math.sin(half), phi_m])
     length = chord / sinc(0.5 * phi)  # arc length, >= 0 (the direction sits in the chord)
     length_m = (1.0 + bias_linear) * length + noise_linear
     scale = length_m * sinc(0.5 * phi_m) / chord
     turn = 0.5 * (phi_m - phi)
     c, s = math.cos(turn), math.sin(turn)
     return np.array([scale * (c * dx - s * dy), scale * (s * dx + c * dy), phi_m])
+
+
+def _std(main: float, cross: float) -> float:
+    """``sqrt(main^2 + cross^2)``, and ``main`` itself, untouched, without a cross term."""
+    return main if cross == 0.0 else math.hypot(main, cross)
 
 
 class Odometry:
@@ -112,18 +120,29 @@ class Odometry:
     def update(self, delta: ArrayLike) -> NDArray[np.float64]:
         """Add the measurement of the true step ``delta`` (``[3]``, robot frame) and return the new pose.
 
-        With ``noise_linear_per_m > 0`` one normal deviate with standard deviation
-        ``noise_linear_per_m * |arc length|`` is drawn, then (with ``noise_angular_per_rad > 0``) one
-        with standard deviation ``noise_angular_per_rad * |phi|``.
+        Draws, in this order and only for the models that are on: one normal deviate for the arc length
+        (``noise_linear_per_m`` or ``noise_linear_per_rad`` > 0; std ``noise_linear_per_m * L``, or
+        ``sqrt((noise_linear_per_m L)^2 + (noise_linear_per_rad phi)^2)`` with the cross term), one for
+        the heading change (``noise_angular_per_rad`` or ``noise_angular_per_m`` > 0, alike), then, with
+        ``slip_per_m > 0``, one uniform (does the step slip?) and two normals (the slip's arc-length and
+        heading errors), drawn whether or not it slips.
         """
         delta = np.asarray(delta, dtype=np.float64)
         cfg = self.config
         n_lin = n_ang = 0.0
-        if cfg.noise_linear_per_m > 0.0:
-            length = math.hypot(delta[0], delta[1]) / sinc(0.5 * float(delta[2]))
-            n_lin = float(self.rng.normal(0.0, cfg.noise_linear_per_m * length))
-        if cfg.noise_angular_per_rad > 0.0:
-            n_ang = float(self.rng.normal(0.0, cfg.noise_angular_per_rad * abs(float(delta[2]))))
+        phi = abs(float(delta[2]))
+        length = math.hypot(delta[0], delta[1]) / sinc(0.5 * float(delta[2]))
+        if cfg.noise_linear_per_m > 0.0 or cfg.noise_linear_per_rad > 0.0:
+            n_lin = float(self.rng.normal(0.0, _std(cfg.noise_linear_per_m * length, cfg.noise_linear_per_rad * phi)))
+        if cfg.noise_angular_per_rad > 0.0 or cfg.noise_angular_per_m > 0.0:
+            n_ang = float(self.rng.normal(0.0, _std(cfg.noise_angular_per_rad * phi, cfg.noise_angular_per_m * length)))
+        if cfg.slip_per_m > 0.0:
+            slips = float(self.rng.random()) < cfg.slip_per_m * length
+            slip_lin = float(self.rng.normal(0.0, cfg.slip_linear_std))
+            slip_ang = float(self.rng.normal(0.0, cfg.slip_angular_std))
+            if slips:
+                n_lin += slip_lin
+                n_ang += slip_ang
         inc = measured_increment(delta, self.bias["linear"], self.bias["angular"], n_lin, n_ang)
         self.pose = compose1(self.pose, inc)
         return self.pose

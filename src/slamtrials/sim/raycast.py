@@ -288,19 +288,25 @@ class LaserModel:
     def scan(self, pose: Pose1Like, rng: np.random.Generator) -> NDArray[np.float32]:
         """A laser reading float32 ``[B]`` (m) from robot base pose ``pose`` (world frame).
 
-        With ``range_noise_std > 0``, B normal deviates are drawn from ``rng`` (always B, so the stream
-        does not depend on what the beams hit) and added to the readings that hit something; those are
-        clipped to ``[min_range, max_range]``. Max-range readings (no return) are left exact. Readings
-        below ``min_range`` are raised to it. With no noise, ``rng`` is not used.
+        With any error model on (range noise, dropouts, short readings), the true ranges go through
+        :func:`slamtrials.sim.laser_errors.apply_laser_errors`, which draws a fixed number of deviates
+        per scan from ``rng``. Otherwise the readings are the true ranges, raised to ``min_range``, and
+        ``rng`` is not used.
         """
-        ranges = self.true_ranges(pose)
+        from slamtrials.sim.laser_errors import apply_laser_errors, incidence_cosines
+
         cfg = self.config
-        if cfg.range_noise_std > 0.0:
-            noise = rng.normal(0.0, cfg.range_noise_std, size=ranges.shape[0])
-            hit = ranges < np.float32(cfg.max_range)
-            noisy = np.clip(ranges.astype(np.float64) + noise, cfg.min_range, cfg.max_range)
-            ranges = np.where(hit, noisy, ranges).astype(np.float32)
-        elif cfg.min_range > 0.0:
+        lp = self.laser_pose(pose)
+        uv = world_to_map(self.world, lp[:2])
+        theta = float(lp[2] - self.world.origin[2])
+        ranges = cast_scan(self.map.dist, uv, theta, self.angles, cfg.max_range, self.map.resolution)
+        if cfg.has_errors:
+            incidence = None
+            if cfg.dropout_grazing > 0.0:
+                cells = ranges.astype(np.float64) / self.map.resolution
+                incidence = incidence_cosines((float(uv[0]), float(uv[1])), theta, self.angles, cells)
+            return apply_laser_errors(ranges, cfg, rng, incidence)
+        if cfg.min_range > 0.0:
             np.maximum(ranges, np.float32(cfg.min_range), out=ranges)
         return ranges
 

@@ -260,7 +260,8 @@ class CampaignConfig(BaseModel):
         A relative ``worlds`` entry that names a file or folder next to the config file is taken
         relative to the config file's folder (and stored as an absolute path), so a config and its
         floor plans can move together; other entries (catalog names, paths relative to the working
-        directory) are kept as written.
+        directory) are kept as written. A ``sim.profile`` that is a YAML file's path (relative to the
+        config's folder) is read and held inline (:mod:`slamtrials.campaign.profilefile`).
 
         Raises
         ------
@@ -274,8 +275,11 @@ class CampaignConfig(BaseModel):
         path = Path(path)
         if path.is_dir():
             raise FormatError(path, "is a folder; give a campaign config YAML file")
+        from slamtrials.campaign.profilefile import inline_profile_file
+
         data = read_yaml_mapping(path)
         worlds = data.get("worlds")
         if isinstance(worlds, list):
             data["worlds"] = [_beside(path.parent, entry) for entry in worlds]
+        data = inline_profile_file(data, path.parent)
         return cls.from_dict(data, source=str(path))

@@ -54,10 +54,13 @@ def simulate(
         raise ConfigError(f"--max-time must be positive seconds, got {max_time}")
     if RunFolder(out).is_complete() and not overwrite:
         raise ConfigError(f"{out}: already holds a run; choose another --out or pass --overwrite")
+    from slamtrials.campaign.profilefile import inline_profile_file
+
     sim_config = SimConfig.paper()
     if config is not None:
         try:
-            sim_config = SimConfig.from_dict(read_yaml_mapping(config))
+            data = inline_profile_file({"sim": read_yaml_mapping(config)}, config.parent)["sim"]
+            sim_config = SimConfig.from_dict(data)
         except ConfigError as exc:
             raise ConfigError(f"{config}: {exc}") from None
     options = {} if resolution is None else {"resolution": resolution}

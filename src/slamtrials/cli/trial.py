@@ -39,6 +39,7 @@ def trial(
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from slamtrials.campaign.config import MetricSettings
+    from slamtrials.campaign.profilefile import inline_profile_file
     from slamtrials.campaign.score import score_run
     from slamtrials.campaign.task import write_scored_run
     from slamtrials.io.runfolder import RunFolder
@@ -54,7 +55,7 @@ def trial(
     trial_config = TrialConfig()
     if config is not None:
         try:
-            trial_config = TrialConfig.from_dict(read_yaml_mapping(config))
+            trial_config = TrialConfig.from_dict(inline_profile_file(read_yaml_mapping(config), config.parent))
         except ConfigError as exc:
             raise ConfigError(f"{config}: {exc}") from None
     the_world = load_world(world, **({} if resolution is None else {"resolution": resolution}))

@@ -252,6 +252,8 @@ def _overview(data: CampaignData, done: pd.DataFrame) -> str:
         ("campaign folder", str(data.folder)),
         ("kind", data.kind + (f" of {config.get('replay_of')}" if config.get("replay_of") else "")),
         ("SLAM algorithm", f"{slam.get('algorithm')} (preset {slam.get('preset')}, params {slam.get('params') or {}})"),
+        ("simulated sensors", _profile_text(config.get("sim", {}))),
+        ("relations per run", _relations_text(config.get("metric", {}))),
         (
             "worlds",
             f"{len(data.worlds)}: "
@@ -268,6 +270,22 @@ def _overview(data: CampaignData, done: pd.DataFrame) -> str:
         ("created", str(data.meta.get("created"))),
     ]
     return h.section("Overview", h.definition_list(items), h.notes(_notes(data, done), id="notes"), id="overview")
+
+
+def _profile_text(sim: dict[str, Any]) -> str:
+    """The error profile the runs were simulated with (``paper`` for configs that name none)."""
+    profile = sim.get("profile", "paper")
+    name = profile.get("name", "?") if isinstance(profile, dict) else str(profile)
+    if name == "paper":
+        return "error profile paper: the IROS 2018 Stage set-up (noise-free laser, per-run odometry scale bias)"
+    return f"error profile {name}" + (f": {profile.get('description')}" if isinstance(profile, dict) else "")
+
+
+def _relations_text(metric: dict[str, Any]) -> str:
+    """The relation rule and which SLAM estimate the run errors score."""
+    settings = MetricSettings.of_stored(metric)
+    which = "the final SLAM estimate" if settings.estimate == "final" else "the online SLAM estimate"
+    return f"{settings.sampling.describe()}; the run errors score {which}"
 
 
 def _run_times(done: pd.DataFrame) -> str:

@@ -117,14 +117,57 @@ def time_scans(laser: LaserModel, poses: np.ndarray, plain: bool = False) -> tup
     return len(poses) / best, total / len(poses)
 
 
-def time_steps(world: World, n_steps: int, seed: int = 0) -> tuple[float, int]:
+#: Every error model on, at the magnitudes of a real log (docs/realism.md; MIT CSAIL's laser scatters by
+#: about 7.6 cm, a quarter of its beams are short, 3.6 % drop out): what the simulator's speed is checked
+#: with (issue 21: at least 2,000 scans of 541 beams per second on one core).
+EVERY_ERROR = SimConfig.model_validate(
+    {
+        "profile": {
+            "name": "every-error",
+            "laser": {
+                "range_noise_std": 0.03,
+                "range_noise_per_m": 0.01,
+                "short_rate": 0.2,
+                "dropout_rate": 0.03,
+                "dropout_per_m": 0.002,
+                "dropout_grazing": 0.1,
+            },
+            "odometry": {
+                "noise_linear_per_m": 0.05,
+                "noise_angular_per_rad": 0.1,
+                "noise_linear_per_rad": 0.01,
+                "noise_angular_per_m": 0.02,
+                "slip_per_m": 0.01,
+                "slip_linear_std": 0.05,
+                "slip_angular_std": 0.05,
+            },
+        }
+    }
+)
+
+
+def time_laser_model(world: World, config: SimConfig, poses: np.ndarray) -> float:
+    """Scans per second of ``LaserModel.scan`` (raycast plus the config's error models); best of 3."""
+    laser = LaserModel(world, config.laser)
+    rng = np.random.default_rng(0)
+    laser.scan(poses[0], rng)  # compile / warm up
+    best = math.inf
+    for _ in range(3):
+        start = time.perf_counter()
+        for pose in poses:
+            laser.scan(pose, rng)
+        best = min(best, time.perf_counter() - start)
+    return len(poses) / best
+
+
+def time_steps(world: World, n_steps: int, seed: int = 0, config: SimConfig | None = None) -> tuple[float, int]:
     """(simulator steps per second, stalled steps): wander between random free goals with the waypoint controller."""
     rng = np.random.default_rng(seed)
     goals = free_poses(world, 200, rng, clearance=0.5)[:, :2]
     best = math.inf
     stalls = 0
     for _ in range(3):
-        sim = Simulator(world, SimConfig(), np.random.default_rng(seed))
+        sim = Simulator(world, config or SimConfig(), np.random.default_rng(seed))
         sim.observe()
         robot = sim.config.robot
         goal_idx = 0
@@ -182,6 +225,19 @@ def main() -> None:
         start = free_poses(world, 1, np.random.default_rng(7), clearance=0.6)[0]
         rate, stalls = time_steps(world.with_start(start), 3000)
         print(f"| {name} | {rate:,.0f} | {stalls} / 3000 | {rate / 10:,.0f} |")
+    print()
+    print("Error models (docs/realism.md): the paper profile against every error model on (EVERY_ERROR)")
+    print()
+    print("| world | scans/s, paper | scans/s, every error | steps/s, paper | steps/s, every error |")
+    print("|---|---:|---:|---:|---:|")
+    for name, world in step_worlds:
+        poses = free_poses(world, 2000, np.random.default_rng(3))
+        scans_paper = time_laser_model(world, SimConfig(), poses)
+        scans_every = time_laser_model(world, EVERY_ERROR, poses)
+        start = free_poses(world, 1, np.random.default_rng(7), clearance=0.6)[0]
+        steps_paper, _ = time_steps(world.with_start(start), 3000)
+        steps_every, _ = time_steps(world.with_start(start), 3000, config=EVERY_ERROR)
+        print(f"| {name} | {scans_paper:,.0f} | {scans_every:,.0f} | {steps_paper:,.0f} | {steps_every:,.0f} |")
 
 
 if __name__ == "__main__":

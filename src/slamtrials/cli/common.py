@@ -69,11 +69,15 @@ def make_app(**kwargs) -> typer.Typer:
 
 
 def make_console():
-    """A rich Console for command output; pipes and logs get 110 columns instead of rich's default 80."""
+    """A rich Console for command output; pipes and logs get 110 columns instead of rich's default 80.
+
+    Markup is off: the output holds paths, values and messages that may contain ``[...]`` (a config's
+    ``[0.1, 0.2]``, a folder named ``runs[2]``), which rich would otherwise take for style tags and drop.
+    """
     from rich.console import Console
 
-    console = Console()
-    return console if console.is_terminal else Console(width=110)
+    console = Console(markup=False)
+    return console if console.is_terminal else Console(width=110, markup=False)
 
 
 def fmt_number(value: float | None, digits: int = 3) -> str:

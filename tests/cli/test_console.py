@@ -1,0 +1,10 @@
+"""The CLI's console prints text as given: brackets in paths and values are not taken for style tags."""
+
+from slamtrials.cli.common import make_console
+
+
+def test_brackets_survive(capsys):
+    console = make_console()
+    console.print("folder /tmp/runs[2]/x, range [0.1, 0.2], [bold]tag[/bold]")
+    out = capsys.readouterr().out
+    assert "runs[2]/x" in out and "[0.1, 0.2]" in out and "[bold]tag[/bold]" in out

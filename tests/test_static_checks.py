@@ -1,4 +1,4 @@
-"""Static checks of the source tree: mypy over the computing layers and ruff (lint, format) over src, tests and bench find nothing.
+"""Static checks of the source tree: mypy over the computing layers and campaign and ruff (lint, format) over src, tests and bench find nothing.
 
 The files and settings are pyproject.toml's ``[tool.mypy]`` section (the computing layers, pydantic
 plugin); mypy runs in this process through its API, from the repository root.

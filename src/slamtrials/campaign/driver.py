@@ -60,8 +60,8 @@ class Planner(Protocol):
         """The plan of ``world`` given its done runs ``{index: (eps_t, eps_r)}``."""
         ...
 
-    def task(self, world: WorldInfo, index: int) -> tuple[Callable[[Any], dict], Any, int]:
-        """``(function, argument, seed)`` of run ``index`` of ``world``; the function returns a result dict."""
+    def task(self, world: WorldInfo, index: int) -> tuple[Callable[[Any], RunResult], Any, int]:
+        """``(function, argument, seed)`` of run ``index`` of ``world``; the function returns the run's result."""
         ...
 
 

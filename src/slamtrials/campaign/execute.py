@@ -34,6 +34,7 @@ from slamtrials.campaign.folder import (
     prepare_resume,
 )
 from slamtrials.campaign.loop import next_step
+from slamtrials.campaign.results import RunResult
 from slamtrials.campaign.seeds import run_seed
 from slamtrials.campaign.store import CampaignStore, WorldInfo, is_campaign
 from slamtrials.campaign.summary import summarize_store, write_summary_csv
@@ -59,7 +60,7 @@ class CampaignPlanner:
             return Plan(step.target, (), "capped" if step.capped else "done", step.decision)
         return Plan(step.target, step.missing, None, step.decision)
 
-    def task(self, world: WorldInfo, index: int) -> tuple[Callable[[Any], dict], RunTask, int]:
+    def task(self, world: WorldInfo, index: int) -> tuple[Callable[[Any], RunResult], RunTask, int]:
         seed = run_seed(self.config.seed, world.name, index)
         task = RunTask(
             str(self.folder),

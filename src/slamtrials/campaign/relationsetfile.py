@@ -43,12 +43,10 @@ def write_relation_set(path: str | Path, relation_set: RelationSet) -> Path:
         "needed_r": relation_set.needed_r,
         "capped": relation_set.capped,
     }
-    arrays = {
-        "first": relation_set.first.astype(np.uint32),
-        "second": relation_set.second.astype(np.uint32),
-        "info": np.array(json.dumps(info, sort_keys=True)),
-    }
-    return atomic_write(path, lambda handle: np.savez_compressed(handle, **arrays))
+    first = relation_set.first.astype(np.uint32)
+    second = relation_set.second.astype(np.uint32)
+    text = np.array(json.dumps(info, sort_keys=True))
+    return atomic_write(path, lambda handle: np.savez_compressed(handle, first=first, second=second, info=text))
 
 
 def read_relation_set(path: str | Path) -> RelationSet:

@@ -244,7 +244,7 @@ class ReplayPlanner:
         )
         return Plan(step.target, (), "short", step.decision, note)
 
-    def task(self, world: WorldInfo, index: int) -> tuple[Callable[[Any], dict], ReplayTask, int]:
+    def task(self, world: WorldInfo, index: int) -> tuple[Callable[[Any], RunResult], ReplayTask, int]:
         seed, folder = self.recorded[world.name][index]
         task = ReplayTask(
             str(self.folder),

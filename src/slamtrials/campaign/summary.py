@@ -109,10 +109,14 @@ def summarize_store(store: CampaignStore) -> list[WorldSummary]:
         stats_t = stats_r = None
         if done:
             stats_t = environment_stats(
-                [r.eps_t for r in done], confidence=settings.confidence, distribution=settings.distribution
+                [float(r.eps_t) for r in done if r.eps_t is not None],
+                confidence=settings.confidence,
+                distribution=settings.distribution,
             )
             stats_r = environment_stats(
-                [r.eps_r for r in done], confidence=settings.confidence, distribution=settings.distribution
+                [float(r.eps_r) for r in done if r.eps_r is not None],
+                confidence=settings.confidence,
+                distribution=settings.distribution,
             )
         reasons = Counter(r.termination or "unknown" for r in done)
         share_t, share_r = _metric_shares(done)
@@ -144,7 +148,7 @@ def _metric_shares(done: list[RunRow]) -> tuple[float | None, float | None]:
         if len(done) < 2 or any(value is None for value in se):
             shares.append(None)
             continue
-        share = metric_noise_share([getattr(r, f"eps_{metric}") for r in done], se)
+        share = metric_noise_share([float(getattr(r, f"eps_{metric}")) for r in done], se)
         shares.append(None if math.isnan(share) else share)
     return shares[0], shares[1]
 

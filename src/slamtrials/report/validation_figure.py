@@ -78,8 +78,11 @@ def draw_real_vs_simulated(ax, groups: Sequence[ErrorBars], *, unit: str, title:
             )
     every = np.concatenate([real, mean, *[np.asarray(g.values, dtype=np.float64) for g in groups]])
     every = every[np.isfinite(every)]
-    if len(every) and every.min() > 0:
+    if len(every) and every.min() > 0:  # room above the bars for the legend
         ax.set_yscale("log")
+        ax.set_ylim(every.min() / 2.0, every.max() * 12.0)
+    elif len(every):
+        ax.set_ylim(0.0, every.max() * 1.6)
     ax.set_xticks(x)
     ax.set_xticklabels([g.label for g in groups])
     ax.set_ylabel(f"mean error ({unit})")

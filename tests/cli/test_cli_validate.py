@@ -98,3 +98,18 @@ def test_a_bad_profile_is_one_line_and_nothing_is_written(inputs, tmp_path, prof
     lines = result.output.strip().splitlines()
     assert len(lines) == 1 and expected in lines[0]
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.slow
+def test_replicas_on_dask_give_the_sequential_numbers(inputs, tmp_path):
+    base, _, _ = inputs
+    docs = []
+    for name, extra in (("seq", []), ("dask", ["--workers", "2"])):
+        out = tmp_path / f"{name}.json"
+        result = runner.invoke(app, _args(base, "--runs", "2", "--json", str(out), *extra))
+        assert result.exit_code == 0, result.output
+        doc = json.loads(out.read_text())
+        for replica in doc["replicas"]:
+            replica.pop("seconds")
+        docs.append(doc)
+    assert docs[0] == docs[1]

@@ -21,6 +21,8 @@ ALLOWED = {
     "slam": {"geometry", "record"},
     "explore": {"geometry", "record"},
     "trial": {"geometry", "record", "worlds", "sim", "slam", "explore"},
+    # validation composes sim, slam and metric like a trial (DESIGN.md, "Realism"); it computes only
+    "validation": {"geometry", "record", "worlds", "sim", "slam", "metric"},
     "metric": {"geometry", "record"},
     "io": {"geometry", "record", "worlds"},
     "campaign": {"geometry", "record", "worlds", "sim", "slam", "explore", "trial", "metric", "io"},
@@ -30,7 +32,7 @@ ALLOWED = {
 COMPOSERS = {"demo", "evaluation", "slamrun", "repeat", "cli", "__init__"}
 
 #: Layers that must not do I/O, print or plot (DESIGN.md).
-COMPUTING = {"geometry", "record", "sim", "slam", "explore", "trial", "metric"}
+COMPUTING = {"geometry", "record", "sim", "slam", "explore", "trial", "metric", "validation"}
 
 #: numpy functions whose float64 results depend on the machine: numpy's own SIMD code for these on
 #: AVX-512 CPUs differs from the C library's by a few ulp, and BLAS picks its kernels by CPU.

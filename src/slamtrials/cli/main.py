@@ -57,7 +57,19 @@ def root(
 
 
 def _register_commands() -> None:
-    from slamtrials.cli import campaign, config, demo, evaluate, report, simulate, slam, transfer, trial, worlds
+    from slamtrials.cli import (
+        campaign,
+        config,
+        demo,
+        evaluate,
+        report,
+        simulate,
+        slam,
+        transfer,
+        trial,
+        validate,
+        worlds,
+    )
 
     app.add_typer(worlds.app, name="worlds", help="List, show, load and generate floor plans.")
     simulate.register(app)
@@ -69,6 +81,7 @@ def _register_commands() -> None:
     campaign.register(app)
     config.register(app)
     report.register(app)
+    validate.register(app)
 
 
 _register_commands()

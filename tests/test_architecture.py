@@ -29,7 +29,7 @@ ALLOWED = {
     "report": {"geometry", "record", "worlds", "metric", "io", "campaign"},
 }
 #: Top-level modules that compose layers like the CLI does (no layer may import them).
-COMPOSERS = {"demo", "evaluation", "slamrun", "repeat", "cli", "__init__"}
+COMPOSERS = {"demo", "evaluation", "slamrun", "repeat", "cli", "__init__", "__main__"}
 
 #: Layers that must not do I/O, print or plot (DESIGN.md).
 COMPUTING = {"geometry", "record", "sim", "slam", "explore", "trial", "metric", "validation"}

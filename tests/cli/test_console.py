@@ -8,3 +8,11 @@ def test_brackets_survive(capsys):
     console.print("folder /tmp/runs[2]/x, range [0.1, 0.2], [bold]tag[/bold]")
     out = capsys.readouterr().out
     assert "runs[2]/x" in out and "[0.1, 0.2]" in out and "[bold]tag[/bold]" in out
+
+
+def test_python_dash_m_runs_the_command():
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-m", "slamtrials", "--help"], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and "Usage" in done.stdout and "campaign" in done.stdout

@@ -27,7 +27,9 @@ import numpy as np  # noqa: E402
 
 import slamtrials.slam.gmapping.filter as gmapping_filter  # noqa: E402
 from bench_real_logs import datasets, shared_data  # noqa: E402
+from fr079_study import repaired_odometry  # noqa: E402
 from slamtrials.cli.slam import parse_settings  # noqa: E402
+from slamtrials.io.carmen_read import read_carmen  # noqa: E402
 from slamtrials.io.relations import read_relations  # noqa: E402
 from slamtrials.metric.matching import match_relations  # noqa: E402
 from slamtrials.record import Relations, Trajectory  # noqa: E402
@@ -92,6 +94,7 @@ def main() -> int:
     parser.add_argument("--seeds", type=int, nargs="*", default=[0, 1, 2])
     parser.add_argument("--set", dest="settings", action="append", default=[])
     parser.add_argument("--top", type=int, default=8, help="local relations with the largest error shown per seed")
+    parser.add_argument("--repair", action="store_true", help="re-sign the odometry where it reverses (fr079_study.py)")
     args = parser.parse_args()
     found = datasets(shared_data(), [args.log])
     if not found:
@@ -99,13 +102,17 @@ def main() -> int:
         return 2
     _, log, relations_path = found[0]
     record = load_recording(log)
+    if args.repair:
+        odom = read_carmen(log, ranges=False).odom
+        record = repaired_odometry(record, odom.t, odom.tv)
     relations = read_relations(relations_path)
     local = np.flatnonzero(np.abs(relations.t2 - relations.t1) < LOCAL)
     local = local[np.argsort(relations.t1[local], kind="stable")]
     odometry = Trajectory(t=record.t, poses=record.odometry)
     _, odo_rot = signed_errors(odometry, relations)
     overrides = parse_settings(args.settings)
-    print(f"# {args.log}: {len(local)} local relations (< {LOCAL:g} s), settings {overrides or 'defaults'}")
+    repaired = " (odometry re-signed where it reverses)" if args.repair else ""
+    print(f"# {args.log}: {len(local)} local relations (< {LOCAL:g} s), settings {overrides or 'defaults'}{repaired}")
     marks = np.arange(record.t[0] + 50.0, record.t[-1] + 50.0, 50.0)
 
     def drift(rot: np.ndarray) -> list[str]:

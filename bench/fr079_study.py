@@ -62,7 +62,8 @@ CASES = [
     Case("temporal-0.5", {"temporalUpdate": 0.5}, why="also match every 0.5 s"),
     Case("temporal-0.25", {"temporalUpdate": 0.25}, why="also match every 0.25 s (about every reading)"),
     Case("linear-0.25", {"linearUpdate": 0.25}, why="match every 0.25 m of odometry"),
-    Case("linear-0.1", {"linearUpdate": 0.1, "angularUpdate": 0.1}, why="match every 0.1 m / 0.1 rad"),
+    Case("linear-0.2", {"linearUpdate": 0.2}, why="match every 0.2 m of odometry"),
+    Case("linear-0.1", {"linearUpdate": 0.1}, why="match every 0.1 m of odometry"),
     Case("every", {"linearUpdate": 0.0}, why="match every reading"),
     Case(
         "every-wide",
@@ -80,6 +81,7 @@ CASES = [
         why="session 10's combination",
     ),
     Case("repair-100", {"particles": 100}, repair=True, why="repaired odometry, 100 particles"),
+    Case("repair-linear-0.25", {"linearUpdate": 0.25}, repair=True, why="repaired odometry, every 0.25 m"),
     Case("repair-temporal-0.5", {"temporalUpdate": 0.5}, repair=True, why="repaired odometry, every 0.5 s"),
 ]
 
@@ -114,7 +116,8 @@ def repaired_odometry(record: RunRecord, odom_t: NDArray[np.float64], tv: NDArra
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seeds", type=int, default=5)
+    parser.add_argument("--seeds", type=int, default=5, help="runs per case")
+    parser.add_argument("--first-seed", type=int, default=0, help="seeds FIRST .. FIRST + SEEDS - 1")
     parser.add_argument("--case", dest="cases", action="append", default=None, help="case name (default: all)")
     parser.add_argument("--list", action="store_true", help="list the cases and exit")
     args = parser.parse_args()
@@ -136,14 +139,15 @@ def main() -> int:
     relations = read_relations(relations_path)
     odom = read_carmen(log, ranges=False).odom
     repaired = repaired_odometry(record, odom.t, odom.tv)
-    print(f"# fr079: GMapping, seeds 0..{args.seeds - 1}, one run at a time on one core\n")
+    last = args.first_seed + args.seeds - 1
+    print(f"# fr079: GMapping, seeds {args.first_seed}..{last}, one run at a time on one core\n")
     print(
         "| case | settings | eps_t per seed (m) | runs <= 0.10 m | mean eps_t (m) | mean eps_r (rad) | updates | s per run |"
     )
     print("|---|---|---|---|---|---|---|---|")
     for case in chosen:
         eps_t, eps_r, seconds, updates = [], [], [], 0
-        for seed in range(args.seeds):
+        for seed in range(args.first_seed, args.first_seed + args.seeds):
             started = time.perf_counter()
             run = run_over_recording(
                 repaired if case.repair else record, "gmapping", overrides=case.overrides, seed=seed

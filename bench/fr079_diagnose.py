@@ -1,17 +1,19 @@
 """Where and why GMapping goes wrong on a real log: the error along the chain of local relations.
 
 Run: ``SLAMTRIALS_SHARED=<shared> NUMBA_NUM_THREADS=1 .venv/bin/python bench/fr079_diagnose.py [--log fr079]
-[--seeds 0 1 2] [--set key=value ...]``.
+[--seeds 0 1 2] [--set key=value ...] [--repair]``.
 
 The Freiburg relations of a log are of two kinds: local ones between consecutive reference scans (fr079:
 987 of them, under 7 s apart, chained end to start over the whole log but for one 1 s gap) and long ones
 that close loops. A run's error on each local relation is the error it made over those few seconds, so
 the signed rotational error along the chain, summed, is the run's heading drift against the reference
-over time, and a jump in it is one place where the run went wrong. For each seed this prints the
-summed heading drift of the run and of the raw odometry every 50 s, the local relations with the largest
-rotational error, and per filter update what the scan matcher did there (how many particles' matches
-were taken, the best score, Neff), so one can tell whether all seeds fail at one place (one event) or
-drift everywhere, and whether the matcher or the motion model is to blame. Nothing is written.
+over time, and a jump in it is one place where the run went wrong. It first prints what the log's ODOM
+lines say about reversing (fr079: the logged pose advances forward while the velocity is negative). For
+each seed it then prints the summed heading drift of the run and of the raw odometry every 50 s, the
+local relations with the largest rotational error, and per filter update what the scan matcher did there
+(how many particles' matches were taken and the best score), so one can tell whether all seeds fail at
+one place (one event) or drift everywhere, and whether the matcher or the motion model is to blame.
+Nothing is written.
 """
 
 from __future__ import annotations
@@ -88,6 +90,33 @@ def signed_errors(estimate: Trajectory, relations: Relations) -> tuple[np.ndarra
     return np.hypot(d[:, 0], d[:, 1]), rot
 
 
+def reversals(t: np.ndarray, pose: np.ndarray, tv: np.ndarray, gap: float = 2.0) -> list[str]:
+    """What the log's ODOM lines say about driving backwards: lines with ``tv < 0``, the distance the pose
+    moved during them, whether the pose then advanced forward or backward along its heading (steps with
+    ``tv < -0.1 m/s``), and the bursts (lines less than ``gap`` s apart) longer than 0.5 m."""
+    step = np.diff(pose[:, :2], axis=0)
+    heading = pose[:-1, 2]
+    along = step[:, 0] * np.cos(heading) + step[:, 1] * np.sin(heading)
+    moved = np.hypot(step[:, 0], step[:, 1])
+    back = tv[1:] < 0.0
+    fast = tv[1:] < -0.1
+    lines = [
+        f"ODOM lines with tv < 0: {int(np.sum(tv < 0.0))} of {len(tv)}; the pose moved {moved[back].sum():.1f} m "
+        f"during them ({moved.sum():.0f} m in all); of the {int(fast.sum())} steps with tv < -0.1 m/s the pose "
+        f"advanced forward along its heading in {int(np.sum(fast & (along > 0.0)))}, backward in "
+        f"{int(np.sum(fast & (along < 0.0)))}"
+    ]
+    index = np.flatnonzero(back) + 1
+    for burst in np.split(index, np.flatnonzero(np.diff(t[index]) > gap) + 1) if len(index) else []:
+        distance = float(moved[burst - 1].sum())
+        if distance > 0.5:
+            lines.append(
+                f"  {t[burst[0]]:.1f}-{t[burst[-1]]:.1f} s: {distance:.2f} m backwards logged as forward "
+                f"(odometry off by {2.0 * distance:.1f} m)"
+            )
+    return lines
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--log", default="fr079")
@@ -102,8 +131,10 @@ def main() -> int:
         return 2
     _, log, relations_path = found[0]
     record = load_recording(log)
+    odom = read_carmen(log, ranges=False).odom
+    if len(odom):
+        print("\n".join(reversals(odom.t, odom.pose, odom.tv)))
     if args.repair:
-        odom = read_carmen(log, ranges=False).odom
         record = repaired_odometry(record, odom.t, odom.tv)
     relations = read_relations(relations_path)
     local = np.flatnonzero(np.abs(relations.t2 - relations.t1) < LOCAL)

@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from slamtrials import stablemath
 from slamtrials.errors import FormatError
 from slamtrials.io.carmen_grid import common_grid
 from slamtrials.io.carmen_lines import (
@@ -76,8 +77,14 @@ TOLERATED = {
     "laser_range_raised": "{kind} lines with a shorter maximum range: their no-return readings raised to the common one",
     "odom_nonfinite": "ODOM lines with a non-finite pose, velocity or timestamp skipped",
     "odom_reordered": "ODOM lines with a timestamp earlier than a line before them: ODOM lines ordered by timestamp (stable)",
+    "odom_against_velocity": "ODOM lines move the pose forward while their velocity tv is below "
+    f"-{0.05:g} m/s (a reversing robot logged as driving forward?): the odometry's translation has the "
+    "wrong sign there; SLAM that trusts it can fail (docs/real-datasets.md, fr079)",
     "truncated_last_line": "the last line is cut short (no newline at the end of the file): skipped",
 }
+#: ``tv`` (m/s) below which an ODOM step counts as reversing, and the forward motion (m) that contradicts it.
+_REVERSING_TV = -0.05
+_FORWARD_STEP = 0.005
 
 
 class _Tally:
@@ -344,6 +351,14 @@ def _laser(
     )
 
 
+def _forward_while_reversing(values: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """``[N - 1]``: ODOM step k -> k + 1 moves forward along the heading at k while line k + 1's tv says reversing."""
+    poses = values[:, :3]
+    step = poses[1:, :2] - poses[:-1, :2]
+    forward = step[:, 0] * stablemath.cos(poses[:-1, 2]) + step[:, 1] * stablemath.sin(poses[:-1, 2])
+    return (values[1:, 3] < _REVERSING_TV) & (forward > _FORWARD_STEP)
+
+
 def _odometry(
     path: Path, rows: list[list[float]], numbers_list: list[int], hosts: list[str], tally: _Tally
 ) -> CarmenOdometry:
@@ -358,6 +373,7 @@ def _odometry(
         return CarmenOdometry.empty()
     order = keep[_order(values[keep, 6], numbers[keep], tally, "odom", unique=False)]
     values = values[order]
+    tally.add("odom_against_velocity", numbers[order][1:][_forward_while_reversing(values)])
     return CarmenOdometry(
         t=values[:, 6].copy(),
         logger_t=values[:, 7].copy(),

@@ -19,7 +19,10 @@ simulated figures, and the raw odometry's errors on the same relations.
 profile. That field is the simulator's named error profiles (issue 21, item 1: ``paper``,
 ``realistic``, ...); a version of slamtrials without it refuses the config in one line (exit 2).
 Without ``--profile`` the configs run as written, which is the paper's Stage-like set-up (noise-free
-laser, constant per-run odometry bias); the table calls that ``(config)``.
+laser, constant per-run odometry bias); the table calls that ``(config)``. ``--set FIELD=VALUE``
+(repeatable, VALUE read as YAML) changes a field of every config for a side measurement, e.g.
+``--set sim.laser.fov=4.71238898038469`` or ``--set "sim.odometry.bias_linear_range=[-0.005, 0.005]"``
+(use another ``--out``: the CSV does not record the change).
 
 Every trial appends one row to ``DIR/trials.csv`` (default ``results/paper_validation``, which git
 ignores) as soon as it ends, so ``--resume`` continues an interrupted run; the Markdown table is
@@ -55,6 +58,7 @@ FIELDS = (
     "seed",
     "reason",
     "mapped",
+    "observed",
     "duration_s",
     "wall_s",
     "eps_t",
@@ -114,6 +118,7 @@ class Summary:
     odometry_r: tuple[float, float]
     reasons: str
     mapped_min: float
+    observed_min: float
     wall_mean: float
 
 
@@ -152,6 +157,7 @@ def summarize(rows: list[dict]) -> list[Summary]:
                 odometry_r=_mean_std(column("odometry_eps_r")),
                 reasons=", ".join(sorted({str(r["reason"]) for r in group})),
                 mapped_min=min((float(r["mapped"]) for r in ok), default=math.nan),
+                observed_min=min((float(r["observed"]) for r in ok), default=math.nan),
                 wall_mean=_mean_std(column("wall_s"))[0],
             )
         )
@@ -170,8 +176,8 @@ def markdown_table(summaries: list[Summary]) -> str:
     """The comparison table: per (world, profile) the measured errors, then the paper's real and simulated ones."""
     lines = [
         "| Table | world | profile | runs | eps_t m | eps_r rad | paper real eps_t | paper real eps_r "
-        "| paper sim eps_t | paper sim eps_r | odometry eps_t m | odometry eps_r rad | end | mapped (min) | wall s |",
-        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|",
+        "| paper sim eps_t | paper sim eps_r | odometry eps_t m | odometry eps_r rad | end | observed (min) | mapped (min) | wall s |",
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|",
     ]
     for s in summaries:
         paper = PAPER.get(s.world)
@@ -186,17 +192,30 @@ def markdown_table(summaries: list[Summary]) -> str:
                 _pm(paper.sim_r, paper.sim_sr),
             ]
         mapped = "-" if math.isnan(s.mapped_min) else f"{s.mapped_min:.3f}"
+        observed = "-" if math.isnan(s.observed_min) else f"{s.observed_min:.3f}"
         wall = "-" if math.isnan(s.wall_mean) else f"{s.wall_mean:.1f}"
         lines.append(
             f"| {paper.table if paper else '-'} | {s.world} | {s.profile} | {runs} | {_pm(*s.eps_t)} | {_pm(*s.eps_r)} | "
             + " | ".join(theirs)
-            + f" | {_pm(*s.odometry_t)} | {_pm(*s.odometry_r)} | {s.reasons} | {mapped} | {wall} |"
+            + f" | {_pm(*s.odometry_t)} | {_pm(*s.odometry_r)} | {s.reasons} | {observed} | {mapped} | {wall} |"
         )
     return "\n".join(lines)
 
 
-def load_config(path: Path, profile: str | None):
-    """The campaign config of ``path``, with ``sim.profile`` set when ``profile`` is given.
+def _set(data: dict, dotted: str, value: object) -> None:
+    """Set ``data[a][b][c] = value`` for ``dotted = "a.b.c"``, making the sections that are missing."""
+    *sections, key = dotted.split(".")
+    for name in sections:
+        section = data.get(name)
+        if not isinstance(section, dict):
+            section = data[name] = {}
+        data = section
+    data[key] = value
+
+
+def load_config(path: Path, profile: str | None, overrides: tuple[tuple[str, object], ...] = ()):
+    """The campaign config of ``path``, with ``sim.profile`` set when ``profile`` is given and the
+    ``(dotted.field, value)`` overrides applied.
 
     Raises
     ------
@@ -208,21 +227,35 @@ def load_config(path: Path, profile: str | None):
 
     data = read_yaml_mapping(path)
     if profile is not None:
-        sim = data.setdefault("sim", {})
-        if not isinstance(sim, dict):
-            sim = data["sim"] = {}
-        sim["profile"] = profile
+        _set(data, "sim.profile", profile)
+    for dotted, value in overrides:
+        _set(data, dotted, value)
     return CampaignConfig.from_dict(data, source=str(path))
 
 
-def one_trial(config_path: str, world_name: str, profile: str | None, seed: int) -> dict:
+def parse_override(text: str) -> tuple[str, object]:
+    """``FIELD=VALUE`` (VALUE read as YAML) as ``(FIELD, value)``; argparse reports a malformed one."""
+    import yaml
+
+    field, sep, value = text.partition("=")
+    if not sep or not field.strip():
+        raise argparse.ArgumentTypeError(f"expected FIELD=VALUE (e.g. sim.laser.fov=4.712), got {text!r}")
+    try:
+        return field.strip(), yaml.safe_load(value)
+    except yaml.YAMLError:
+        raise argparse.ArgumentTypeError(f"{text!r}: the value is not YAML") from None
+
+
+def one_trial(
+    config_path: str, world_name: str, profile: str | None, seed: int, overrides: tuple[tuple[str, object], ...] = ()
+) -> dict:
     """Run and score one trial (in this or a worker process); a trial that fails is a row with its error."""
     from slamtrials.campaign.score import score_run
     from slamtrials.errors import SlamtrialsError
     from slamtrials.trial import run_trial
     from slamtrials.worlds import load_world
 
-    config = load_config(Path(config_path), profile)
+    config = load_config(Path(config_path), profile, overrides)
     row: dict = {
         "config": Path(config_path).name,
         "world": world_name,
@@ -240,6 +273,7 @@ def one_trial(config_path: str, world_name: str, profile: str | None, seed: int)
         **row,
         "reason": info["termination_reason"],
         "mapped": round(info["mapped_fraction"], 4),
+        "observed": round(info["observed_fraction"], 4),
         "duration_s": round(info["duration_s"], 1),
         "wall_s": round(time.perf_counter() - started, 2),
         "eps_t": f"{score.eps_t:.6f}",
@@ -266,6 +300,15 @@ def main() -> None:
         default=None,
         help="set sim.profile (needs the simulator's named error profiles); repeat for several",
     )
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        type=parse_override,
+        default=[],
+        metavar="FIELD=VALUE",
+        help="change a config field in every config, e.g. sim.laser.fov=4.712 (VALUE is YAML); repeatable",
+    )
     parser.add_argument("--jobs", type=int, default=1, help="worker processes (default 1: one core)")
     parser.add_argument("--out", type=Path, default=HERE.parent / "results" / "paper_validation")
     parser.add_argument("--resume", action="store_true", help="keep the rows already in DIR/trials.csv")
@@ -279,16 +322,19 @@ def main() -> None:
     from slamtrials.errors import SlamtrialsError
 
     profiles: list[str | None] = list(args.profile) if args.profile else [None]
+    overrides = tuple(args.overrides)
     jobs = []
     for path in args.configs:
         for profile in profiles:
             try:
-                config = load_config(path, profile)
+                config = load_config(path, profile, overrides)
             except SlamtrialsError as exc:
                 hint = " (sim.profile needs the simulator's named error profiles)" if profile else ""
                 print(f"error: {exc}{hint}", file=sys.stderr)
                 sys.exit(2)
-            jobs += [(str(path), world, profile, seed) for world in config.worlds for seed in range(args.seeds)]
+            jobs += [
+                (str(path), world, profile, seed, overrides) for world in config.worlds for seed in range(args.seeds)
+            ]
 
     args.out.mkdir(parents=True, exist_ok=True)
     rows = _read_rows(csv_path) if args.resume and csv_path.is_file() else []
@@ -297,6 +343,8 @@ def main() -> None:
     if not rows:
         with csv_path.open("w", newline="") as handle:
             csv.DictWriter(handle, FIELDS).writeheader()
+    if overrides:
+        print("settings changed: " + ", ".join(f"{k}={v!r}" for k, v in overrides))
     print(f"CPU: {cpu_model()}; {len(jobs)} trials to run ({len(rows)} done), {args.jobs} at a time", flush=True)
     started = time.perf_counter()
 

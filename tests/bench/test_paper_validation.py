@@ -86,6 +86,7 @@ def _row(world, seed, eps_t, eps_r, profile="(config)", **extra):
         "seed": str(seed),
         "reason": "no_frontiers",
         "mapped": "0.99",
+        "observed": "0.995",
         "duration_s": "50.0",
         "wall_s": "2.0",
         "eps_t": str(eps_t),
@@ -126,3 +127,15 @@ def test_one_trial_runs_and_scores_a_replica():
     assert row["error"] == "" and row["profile"] == "(config)"
     assert row["reason"] in ("map_converged", "no_frontiers") and row["mapped"] > 0.9
     assert 0.0 < float(row["eps_t"]) < 1.0 and 0.0 < float(row["eps_r"]) < 0.5
+
+
+def test_set_option_changes_a_field_of_every_config():
+    field, value = bench.parse_override("sim.odometry.bias_linear_range=[-0.005, 0.005]")
+    assert (field, value) == ("sim.odometry.bias_linear_range", [-0.005, 0.005])
+    config = bench.load_config(HALL, None, ((field, value), ("sim.laser.fov", 4.71238898038469)))
+    assert config.sim.odometry.bias_linear_range == (-0.005, 0.005)
+    assert config.sim.laser.num_beams == 271
+    with pytest.raises(bench.argparse.ArgumentTypeError, match="FIELD=VALUE"):
+        bench.parse_override("sim.laser.fov")
+    with pytest.raises(ConfigError, match="fov"):
+        bench.load_config(HALL, None, (("sim.laser.fov", -1.0),))

@@ -11,7 +11,6 @@ import pytest
 
 from slamtrials.campaign.config import CampaignConfig
 from slamtrials.errors import ConfigError
-from slamtrials.sim import SimConfig
 from slamtrials.worlds.catalog import catalog_entry
 
 BENCH = Path(__file__).resolve().parents[2] / "bench"
@@ -69,13 +68,17 @@ def test_every_configured_world_is_bundled_and_has_the_paper_s_figures():
     assert bench.PAPER["paper_hall_empty"].real_t == 0.189 and bench.PAPER["paper_lab"].sim_sr == 0.004
 
 
-def test_profile_option_sets_sim_profile_or_says_the_field_is_missing():
-    if "profile" in SimConfig.model_fields:
-        assert bench.load_config(HALL, "paper").sim.profile == "paper"
-    else:
-        with pytest.raises(ConfigError, match=r"sim\.profile"):
-            bench.load_config(HALL, "realistic")
-    assert bench.load_config(HALL, None) == CampaignConfig.from_yaml(HALL)
+def test_profile_option_sets_sim_profile_and_the_configs_keep_their_bias_ranges():
+    as_written = bench.load_config(HALL, None)
+    assert as_written == CampaignConfig.from_yaml(HALL) and as_written.sim.profile_name == "paper"
+    assert bench.load_config(HALL, "paper") == as_written  # paper is what a config without a profile gets
+    inline = {"name": "noisy", "laser": {"range_noise_std": 0.02}, "odometry": {"bias_linear_range": [-0.2, 0.2]}}
+    noisy = bench.load_config(HALL, inline).sim
+    assert noisy.profile_name == "noisy" and noisy.laser.range_noise_std == 0.02
+    assert noisy.odometry.bias_linear_range == (-0.01, 0.01)  # the setting's own bound wins over the profile's
+    assert noisy.laser.num_beams == 81
+    with pytest.raises(ConfigError, match="profile"):
+        bench.load_config(HALL, "no_such_profile")
 
 
 def _row(world, seed, eps_t, eps_r, profile="(config)", **extra):

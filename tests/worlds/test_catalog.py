@@ -12,8 +12,9 @@ from scipy import ndimage
 from slamtrials.errors import WorldError
 from slamtrials.worlds import load_world
 from slamtrials.worlds.catalog import catalog_entries, catalog_entry, catalog_names, load_catalog_world
-from slamtrials.worlds.catalog_build import CATALOG, CATALOG_FILE, build_entry
+from slamtrials.worlds.catalog_build import CATALOG, CATALOG_FILE, REPLICAS, build_entry
 from slamtrials.worlds.generate import GENERATOR_VERSION
+from slamtrials.worlds.replicas import REPLICA_VERSION, build_replica
 
 DATA = resources.files("slamtrials.worlds").joinpath("data")
 NAMES = catalog_names()
@@ -21,13 +22,17 @@ LARGE = {e.name for e in CATALOG if e.area > 2500}
 
 
 def test_catalog_lists_the_entries_of_the_build_script():
-    assert NAMES == [e.name for e in CATALOG]
-    assert len(NAMES) == len(set(NAMES)) >= 20
+    assert NAMES == [e.name for e in CATALOG] + [r.name for r in REPLICAS]
+    assert len(NAMES) == len(set(NAMES)) >= 23
     records = {r["name"]: r for r in catalog_entries()}
     for entry in CATALOG:
         record = records[entry.name]
         assert (record["kind"], record["area_m2"], record["seed"]) == (entry.kind, entry.area, entry.seed)
         assert record["description"]
+    for replica in REPLICAS:
+        record = records[replica.name]
+        assert (record["kind"], record["shape"], record["seed"]) == ("replica", replica.shape, None)
+        assert record["source"] == replica.source and "guess" in record["layout"]
 
 
 def test_catalog_spans_small_medium_and_large_buildings():
@@ -43,6 +48,7 @@ def test_catalog_spans_small_medium_and_large_buildings():
 def test_catalog_file_records_the_generator_version():
     doc = yaml.safe_load(DATA.joinpath(CATALOG_FILE).read_text())
     assert doc["generator_version"] == GENERATOR_VERSION
+    assert doc["replica_version"] == REPLICA_VERSION
 
 
 def test_catalog_data_stays_small():
@@ -81,6 +87,16 @@ def test_catalog_world_is_regenerated_bit_for_bit(entry):
     assert np.array_equal(fresh.occupied, stored.occupied)
     assert np.allclose(fresh.start, stored.start, atol=1e-6)
     assert np.allclose(fresh.origin, stored.origin)
+
+
+@pytest.mark.parametrize("replica", REPLICAS, ids=lambda r: r.name)
+def test_catalog_replica_is_redrawn_bit_for_bit(replica):
+    stored = load_catalog_world(replica.name)
+    fresh = build_replica(replica.name)
+    assert np.array_equal(fresh.occupied, stored.occupied)
+    assert np.allclose(fresh.start, stored.start, atol=1e-6)
+    assert np.allclose(fresh.origin, stored.origin)
+    assert fresh.metadata.items() <= stored.metadata.items()  # the loader adds the file format
 
 
 def test_unknown_name_suggests_close_names():

@@ -1,10 +1,12 @@
-"""Build the bundled catalog of generated worlds (run once by ``bench/make_catalog.py``).
+"""Build the bundled catalog of worlds (run once by ``bench/make_catalog.py``).
 
-Each entry is regenerated from its (kind, area, seed) by :func:`slamtrials.worlds.generate.generate_world`
-and written as a ROS map (``<name>.png`` + ``<name>.yaml``) into the data folder, with ``catalog.yaml``
-listing every world. The test suite regenerates every entry and checks the stored image bit for bit,
-so a change to the generator that changes a bundled world must rebuild the catalog (and bump
-``GENERATOR_VERSION``).
+Each generated entry is regenerated from its (kind, area, seed) by
+:func:`slamtrials.worlds.generate.generate_world`, and each replica of the paper's validation settings is
+drawn by :func:`slamtrials.worlds.replicas.build_replica`; both are written as ROS maps (``<name>.png`` +
+``<name>.yaml``) into the data folder, with ``catalog.yaml`` listing every world (generated ones first).
+The test suite regenerates every entry and checks the stored image bit for bit, so a change to the
+generator or to a replica's drawing must rebuild the catalog (and bump ``GENERATOR_VERSION`` or
+``REPLICA_VERSION``).
 """
 
 from __future__ import annotations
@@ -17,9 +19,19 @@ import yaml
 from slamtrials.atomicfile import atomic_write_text
 from slamtrials.worlds.formats.rosmap_save import save_rosmap
 from slamtrials.worlds.generate import GENERATOR_VERSION, KINDS, generate_world
+from slamtrials.worlds.replicas import REPLICA_VERSION, REPLICAS, ReplicaSpec, build_replica
 from slamtrials.worlds.world import World
 
-__all__ = ["CatalogEntry", "CATALOG", "CATALOG_FILE", "RESOLUTION", "build_catalog", "build_entry", "describe"]
+__all__ = [
+    "CatalogEntry",
+    "CATALOG",
+    "CATALOG_FILE",
+    "RESOLUTION",
+    "REPLICAS",
+    "build_catalog",
+    "build_entry",
+    "describe",
+]
 
 #: Name of the index file in the data folder.
 CATALOG_FILE = "catalog.yaml"
@@ -76,8 +88,36 @@ def describe(world: World) -> str:
     )
 
 
-def build_catalog(out_dir: str | Path, entries: tuple[CatalogEntry, ...] = CATALOG) -> list[dict]:
-    """Generate every entry into ``out_dir`` (``<name>.png``, ``<name>.yaml``) and write ``catalog.yaml``.
+def _save(world: World, out_dir: Path) -> None:
+    save_rosmap(world, out_dir / f"{world.name}.yaml")
+    for suffix in (".yaml", ".png"):  # readable by everyone once installed
+        (out_dir / f"{world.name}{suffix}").chmod(0o644)
+
+
+def replica_record(spec: ReplicaSpec, world: World) -> dict:
+    """The catalog record of a replica: ``area_m2`` is its floor area (before furniture), ``seed`` null."""
+    width, height = world.size_m
+    return {
+        "name": spec.name,
+        "kind": "replica",
+        "shape": spec.shape,
+        "area_m2": float(world.metadata["floor_area_m2"]),
+        "free_area_m2": round(world.free_area, 1),
+        "seed": None,
+        "width_m": round(width, 2),
+        "height_m": round(height, 2),
+        "rooms": 1,
+        "description": spec.description,
+        "source": spec.source,
+        "layout": spec.layout,
+    }
+
+
+def build_catalog(
+    out_dir: str | Path, entries: tuple[CatalogEntry, ...] = CATALOG, replicas: tuple[ReplicaSpec, ...] = REPLICAS
+) -> list[dict]:
+    """Generate every entry and draw every replica into ``out_dir`` (``<name>.png``, ``<name>.yaml``) and
+    write ``catalog.yaml``.
 
     Returns the catalog records (also the content of ``catalog.yaml``'s ``worlds`` list).
     """
@@ -85,9 +125,7 @@ def build_catalog(out_dir: str | Path, entries: tuple[CatalogEntry, ...] = CATAL
     records = []
     for entry in entries:
         world = build_entry(entry)
-        save_rosmap(world, out_dir / f"{entry.name}.yaml")
-        for suffix in (".yaml", ".png"):  # readable by everyone once installed
-            (out_dir / f"{entry.name}{suffix}").chmod(0o644)
+        _save(world, out_dir)
         width, height = world.size_m
         records.append(
             {
@@ -103,10 +141,16 @@ def build_catalog(out_dir: str | Path, entries: tuple[CatalogEntry, ...] = CATAL
                 "description": describe(world),
             }
         )
+    for spec in replicas:
+        world = build_replica(spec.name, resolution=RESOLUTION)
+        _save(world, out_dir)
+        records.append(replica_record(spec, world))
     doc = {
         "generator_version": GENERATOR_VERSION,
+        "replica_version": REPLICA_VERSION,
         "resolution": RESOLUTION,
-        "note": "area_m2 is the requested free area; regenerate with generate_world(kind, area_m2, seed=seed)",
+        "note": "area_m2 is the requested free area; regenerate with generate_world(kind, area_m2, seed=seed); "
+        "kind replica: the paper's validation settings drawn by slamtrials.worlds.replicas (area_m2 = floor area)",
         "worlds": records,
     }
     atomic_write_text(out_dir / CATALOG_FILE, yaml.safe_dump(doc, sort_keys=False, width=120))

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from slamtrials.geometry import compose
@@ -255,6 +255,10 @@ world_params = st.tuples(
     cell=st.integers(0, 10**9),
     theta=headings,
     max_t=st.floats(0.5, 200.0),
+)
+# found by hypothesis: a subnormal heading (1 / sin overflows) from a point on a cell boundary gave NaN
+@example(
+    params=(1080, 58, 0, 0.1), fx=0.0, fy=0.9999999999999998, cell=513566, theta=-2.225073858507203e-309, max_t=1.0
 )
 def test_accelerated_equals_plain_traversal_bitwise(params, fx, fy, cell, theta, max_t):
     world = random_world(*params)

@@ -44,6 +44,8 @@ __all__ = ["RaycastMap", "LaserModel", "cast_scan", "cast_scan_dda", "SAFETY_CEL
 #: Margin (cells) subtracted from the distance field before a jump: sqrt(2) (a point anywhere in the
 #: current cell, an occupied square anywhere around its centre) plus slack for float32 storage.
 SAFETY_CELLS = 1.5
+#: Direction components at or below this magnitude count as 0 (their inverse would overflow).
+_TINY = 1e-300
 #: Smallest jump (cells) worth taking; below it the exact traversal steps cell by cell.
 _MIN_JUMP = 1.0
 
@@ -57,11 +59,13 @@ def _trace_beam(dist, ox, oy, dx, dy, max_t, accelerate):  # pragma: no cover - 
     height, width = dist.shape
     ix = int(math.floor(ox))
     iy = int(math.floor(oy))
-    if dx > 0.0:
+    # A direction component so small that its inverse overflows (a subnormal) is taken as 0: such a ray
+    # runs along the axis and never reaches the next boundary within any range (0 * inf would be NaN).
+    if dx > _TINY:
         step_x = 1
         off_x = 1.0
         inv_dx = 1.0 / dx
-    elif dx < 0.0:
+    elif dx < -_TINY:
         step_x = -1
         off_x = 0.0
         inv_dx = 1.0 / dx
@@ -69,11 +73,11 @@ def _trace_beam(dist, ox, oy, dx, dy, max_t, accelerate):  # pragma: no cover - 
         step_x = 0
         off_x = 0.0
         inv_dx = 0.0
-    if dy > 0.0:
+    if dy > _TINY:
         step_y = 1
         off_y = 1.0
         inv_dy = 1.0 / dy
-    elif dy < 0.0:
+    elif dy < -_TINY:
         step_y = -1
         off_y = 0.0
         inv_dy = 1.0 / dy

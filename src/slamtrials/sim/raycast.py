@@ -44,10 +44,15 @@ __all__ = ["RaycastMap", "LaserModel", "cast_scan", "cast_scan_dda", "SAFETY_CEL
 #: Margin (cells) subtracted from the distance field before a jump: sqrt(2) (a point anywhere in the
 #: current cell, an occupied square anywhere around its centre) plus slack for float32 storage.
 SAFETY_CELLS = 1.5
-#: Direction components at or below this magnitude count as 0 (their inverse would overflow).
-_TINY = 1e-300
 #: Smallest jump (cells) worth taking; below it the exact traversal steps cell by cell.
 _MIN_JUMP = 1.0
+
+
+@njit(cache=True, fastmath=False, nogil=True)
+def _crossing(gap, inverse):  # pragma: no cover - compiled
+    """Ray parameter ``gap * inverse`` of the next boundary; 0 when the ray starts on it (``gap == 0``), also
+    when the direction component is subnormal and its inverse overflowed to infinity (0 * inf is NaN)."""
+    return 0.0 if gap == 0.0 else gap * inverse
 
 
 @njit(cache=True, fastmath=False, nogil=True)
@@ -59,13 +64,11 @@ def _trace_beam(dist, ox, oy, dx, dy, max_t, accelerate):  # pragma: no cover - 
     height, width = dist.shape
     ix = int(math.floor(ox))
     iy = int(math.floor(oy))
-    # A direction component so small that its inverse overflows (a subnormal) is taken as 0: such a ray
-    # runs along the axis and never reaches the next boundary within any range (0 * inf would be NaN).
-    if dx > _TINY:
+    if dx > 0.0:
         step_x = 1
         off_x = 1.0
         inv_dx = 1.0 / dx
-    elif dx < -_TINY:
+    elif dx < 0.0:
         step_x = -1
         off_x = 0.0
         inv_dx = 1.0 / dx
@@ -73,11 +76,11 @@ def _trace_beam(dist, ox, oy, dx, dy, max_t, accelerate):  # pragma: no cover - 
         step_x = 0
         off_x = 0.0
         inv_dx = 0.0
-    if dy > _TINY:
+    if dy > 0.0:
         step_y = 1
         off_y = 1.0
         inv_dy = 1.0 / dy
-    elif dy < -_TINY:
+    elif dy < 0.0:
         step_y = -1
         off_y = 0.0
         inv_dy = 1.0 / dy
@@ -105,8 +108,8 @@ def _trace_beam(dist, ox, oy, dx, dy, max_t, accelerate):  # pragma: no cover - 
                     return t
                 jump = dist[iy, ix] - SAFETY_CELLS
         # One exact traversal step: cross the nearer of the two next cell boundaries.
-        tx = (ix + off_x - ox) * inv_dx if step_x != 0 else np.inf
-        ty = (iy + off_y - oy) * inv_dy if step_y != 0 else np.inf
+        tx = _crossing(ix + off_x - ox, inv_dx) if step_x != 0 else np.inf
+        ty = _crossing(iy + off_y - oy, inv_dy) if step_y != 0 else np.inf
         if tx < ty:
             ix += step_x
             t = tx

@@ -4,10 +4,11 @@ Per frame (:meth:`Karto.process`):
 
 1. the frame's base pose is predicted from the last node: its corrected pose composed with the
    odometry motion since it (Karto's "corrected pose" of a new scan);
-2. the frame becomes a node when it is the first, or at least ``minimum_time_interval`` seconds passed
-   since the last node and the laser moved ``minimum_travel_distance`` or turned
-   ``minimum_travel_heading`` by odometry since it (slam_toolbox's throttle and Karto's
-   HasMovedEnough);
+2. the frame becomes a node when it is the first, or it passes slam_toolbox's gate (at least
+   ``minimum_time_interval`` seconds since the last node and a base travel of ``sqrt(0.8)
+   minimum_travel_distance`` by odometry; not the 2nd to 4th frame) and then Karto's HasMovedEnough
+   (the time interval passed, or the laser turned ``minimum_travel_heading`` or moved
+   ``minimum_travel_distance``); without the gate (``scan_throttle`` False) Karto's rule alone;
 3. a node's laser pose is corrected by matching its scan against the running buffer of recent nodes
    (:mod:`.scanmatch`); it is linked to the previous node and to the buffer's node nearest to it,
    matched against the near chains of earlier passes that the graph already connects to it (linked

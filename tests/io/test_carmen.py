@@ -275,9 +275,9 @@ def test_other_line_types_are_skipped_and_counted(tmp_path):
     [
         ("", -math.pi / 2, math.pi / 4, 7.5),  # CARMEN's default: 180 degrees over the beams; largest range
         ("PARAM laser_front_laser_fov 100 1.0 h 1.0\n", -math.radians(50), math.radians(25), 7.5),
-        (
+        (  # CARMEN's reader starts every old-format laser at -90 degrees
             "PARAM laser_front_laser_resolution 1.0\nPARAM robot_front_laser_max 50.0 1.0 h 1.0\n",
-            -math.radians(2),
+            -math.pi / 2,
             math.radians(1),
             50.0,
         ),
@@ -290,6 +290,17 @@ def test_flaser_geometry_comes_from_params(tmp_path, params, angle_min, incremen
     assert laser.angle_min == pytest.approx(angle_min, rel=1e-14)
     assert laser.angle_increment == pytest.approx(increment, rel=1e-14)
     assert laser.range_max == range_max
+
+
+def test_a_360_beam_flaser_laser_starts_at_minus_90_degrees_as_carmen_reads_it(tmp_path):
+    # fr079: 360 readings and laser_front_laser_resolution 0.5; CARMEN's reader (start_angle -pi/2,
+    # "179.5 degrees, last beam ignored") and GMapping's put beam 0 at -90, not at -89.75 degrees
+    path = tmp_path / "log.clf"
+    path.write_text("PARAM laser_front_laser_resolution 0.5\n" + _flaser(360, 101.0))
+    laser = read_carmen(path).laser
+    assert laser.angle_min == -math.pi / 2
+    assert laser.angle_increment == pytest.approx(math.radians(0.5), rel=1e-15)
+    assert laser.angle_min + 359 * laser.angle_increment == pytest.approx(math.radians(89.5), rel=1e-14)
 
 
 def test_param_values_with_and_without_stamps(tmp_path):

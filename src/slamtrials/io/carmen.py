@@ -7,7 +7,8 @@ logger's timestamp the seconds since logging started. slamtrials reads and write
 ``FLASER num_readings r_1..r_n x y theta odom_x odom_y odom_theta ipc_timestamp ipc_hostname logger_timestamp``
     the old front-laser line (e.g. the Freiburg benchmark logs). Its geometry is not on the line: it
     comes from the PARAMs ``laser_front_laser_resolution`` and ``laser_front_laser_fov`` (degrees) and
-    ``robot_front_laser_max`` (m), by default 180 degrees spread over the beams, centred on the heading.
+    ``robot_front_laser_max`` (m), by default 180 degrees spread over the beams; the first beam at -90
+    degrees, as CARMEN's reader puts it, unless ``laser_front_laser_fov`` centres the field of view.
 ``ROBOTLASER1 laser_type start_angle field_of_view angular_resolution maximum_range accuracy remission_mode num_readings r_1..r_n num_remissions e_1..e_m laser_pose(x y theta) robot_pose(x y theta) laser_tv laser_rv forward_safety_dist side_safty_dist turn_axis ipc_timestamp ipc_hostname logger_timestamp``
     the current front-laser line, geometry included (radians, metres). slamtrials drops the
     remissions when reading and writes none.

@@ -111,8 +111,13 @@ class _Tally:
 
 
 def _flaser_geometry(path: Path, params: dict[str, str], where: dict[str, int], beams: int) -> tuple[float, float]:
-    """angle_min and angle_increment (rad) of an old-format laser of ``beams`` beams, from PARAMs or
-    CARMEN's default (180 degrees spread over the beams), centred on the heading."""
+    """angle_min and angle_increment (rad) of an old-format laser of ``beams`` beams.
+
+    The increment is ``laser_front_laser_resolution``, else ``laser_front_laser_fov`` (default 180
+    degrees) spread over the beams. The first beam is at -90 degrees, as CARMEN's own reader puts it
+    (``start_angle = -M_PI / 2`` for every old-format laser; a 360-beam laser of 0.5 degrees covers
+    -90 to +89.5, "last beam ignored"), and as GMapping's reader does; a ``laser_front_laser_fov`` PARAM
+    instead centres that field of view on the heading (slamtrials writes it, for scans centred so)."""
     resolution = param_number(path, params, where, PARAM_RESOLUTION)
     fov = param_number(path, params, where, PARAM_FOV)
     if resolution is not None:
@@ -120,7 +125,11 @@ def _flaser_geometry(path: Path, params: dict[str, str], where: dict[str, int], 
     else:
         spread = math.radians(fov) if fov is not None else math.pi
         increment = spread / (beams - 1) if beams > 1 else 0.0
-    return -increment * (beams - 1) / 2.0 if beams > 0 else 0.0, increment
+    if beams == 0:
+        return 0.0, increment
+    if fov is not None:
+        return -math.radians(fov) / 2.0, increment
+    return -math.pi / 2.0, increment
 
 
 def _check_ranges(path: Path, kind: str, ranges: list[NDArray[np.float64]], numbers: list[int]) -> None:
@@ -177,8 +186,9 @@ def read_carmen(path: str | Path, *, ranges: bool = True) -> CarmenLog:
         Laser lines in timestamp order (``ranges`` float32 [N, B] in metres), the ODOM lines and the
         PARAMs. ROBOTLASER1 lines give their own geometry; FLASER lines take it from the PARAMs
         ``laser_front_laser_resolution`` (deg), ``laser_front_laser_fov`` (deg) and
-        ``robot_front_laser_max`` (m), else 180 degrees spread over the beams, centred on the heading
-        (``angle_min = -pi/2``), and the largest range in the log as ``range_max`` (0 without readings).
+        ``robot_front_laser_max`` (m), else 180 degrees spread over the beams; the first beam at -90
+        degrees as CARMEN's reader puts it (centred on the heading when a ``laser_front_laser_fov`` PARAM
+        gives the field of view), and the largest range in the log as ``range_max`` (0 without readings).
         The odometry of a frame is its laser line's own second pose triple; ODOM lines are returned
         separately, not merged into the frames.
 

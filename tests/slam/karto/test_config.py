@@ -14,6 +14,7 @@ SLAM_TOOLBOX_DEFAULTS = {
     "max_laser_range": 20.0,
     "map_update_interval": 5.0,
     "minimum_time_interval": 0.5,
+    "scan_throttle": True,
     "use_scan_matching": True,
     "use_scan_barycenter": True,
     "minimum_travel_distance": 0.5,
@@ -83,8 +84,8 @@ def test_presets_are_the_defaults():
 
 
 def test_slam_karto_preset_is_slam_karto_s_mapper_params():
-    # slam_karto's config/mapper_params.yaml (open_karto's own defaults); its time interval 3600 s
-    # means "no time rule", which is 0 in slam_toolbox's sense used here
+    # slam_karto's config/mapper_params.yaml (open_karto's own defaults); slam_karto has no scan gate,
+    # and Karto makes a node of any scan minimum_time_interval after the last, so 3600 s is kept as is
     config = resolve_config(get_algorithm("karto"), preset="slam_karto")
     expected = {
         "minimum_travel_distance": 0.2,
@@ -102,7 +103,8 @@ def test_slam_karto_preset_is_slam_karto_s_mapper_params():
         "distance_variance_penalty": 0.3,
         "angle_variance_penalty": 0.349,
         "use_response_expansion": False,
-        "minimum_time_interval": 0.0,
+        "minimum_time_interval": 3600.0,
+        "scan_throttle": False,
         "loop_search_space_dimension": 8.0,
         "coarse_angle_resolution": 0.0349,
     }

@@ -2,11 +2,11 @@
 
 karto with slam_toolbox's defaults over all 1,988 scans of ``mit-csail.clf``; the outputs are written as
 ``slamtrials slam`` writes them and ``trajectory.clf`` is evaluated as ``slamtrials evaluate -e
-trajectory.clf -r mit-csail.relations`` does. It gave 0.049 m mean translational error when the test was
-written (588 nodes, 12 loop closures); the bound is that plus a margin. With the ``slam_karto`` preset
-(open_karto's own defaults: a node every 0.2 m or 0.174 rad) it gave 0.039 m. The issue's target, 0.035 m,
-is NOT met yet (docs/karto.md, "Accuracy"). Skipped when the data set is absent.
-"""
+trajectory.clf -r mit-csail.relations`` does. It gives 0.0459 m mean translational error and 0.0474 rad
+(565 nodes, 14 loop closures); the bounds are those plus a little. With the ``slam_karto`` preset
+(open_karto's own defaults: a node every 0.2 m or 0.174 rad) it gives 0.0370 m and 0.0194 rad. The
+issue's target, 0.035 m, is NOT met, and docs/karto.md ("Accuracy on real data") shows why: most of
+what is left is the log's odometry between nodes. Skipped when the data set is absent."""
 
 from __future__ import annotations
 
@@ -33,12 +33,12 @@ def test_karto_defaults_on_mit_csail(tmp_path):
     record = load_recording(LOG)
     result = run_slam(record, "karto", seed=0, source=str(LOG))
     assert result.config.minimum_travel_distance == 0.5
-    assert 500 <= result.updates <= 700  # one node per 0.5 m or 0.5 rad of odometry, at most every 0.5 s
+    assert 500 <= result.updates <= 700  # slam_toolbox's gate: 0.5 s and 0.447 m of odometry between nodes
     write_slam_outputs(result, tmp_path)
     evaluation = evaluate_files(tmp_path / "trajectory.clf", RELATIONS)
     assert evaluation.translational.n == 1172 and len(evaluation.errors.unmatched) == 0
-    assert evaluation.translational.mean <= 0.055
-    assert evaluation.rotational.mean <= 0.06
+    assert evaluation.translational.mean <= 0.047
+    assert evaluation.rotational.mean <= 0.049
     odometry = evaluate_files(tmp_path / "trajectory.clf", RELATIONS, estimate_pose=PoseTriple.second)
     assert odometry.translational.mean > 10 * evaluation.translational.mean
 
@@ -50,5 +50,5 @@ def test_karto_slam_karto_preset_on_mit_csail(tmp_path):
     write_slam_outputs(result, tmp_path)
     evaluation = evaluate_files(tmp_path / "trajectory.clf", RELATIONS)
     assert evaluation.translational.n == 1172
-    assert evaluation.translational.mean <= 0.045
-    assert evaluation.rotational.mean <= 0.03
+    assert evaluation.translational.mean <= 0.038
+    assert evaluation.rotational.mean <= 0.021

@@ -33,7 +33,15 @@ class KartoConfig(BaseModel):
     map_update_interval:
         Seconds (of recording time) between rebuilds of the published map from the graph's poses.
     minimum_time_interval:
-        A scan becomes a node only if at least this many seconds passed since the last node.
+        Seconds between nodes: slam_toolbox's gate lets a scan through only after this long, and Karto's
+        HasMovedEnough makes a node of any scan this long after the last one.
+    scan_throttle:
+        slam_toolbox's gate (``shouldProcessScan``) before Karto's node rule: a scan is processed only
+        if ``minimum_time_interval`` passed since the last node and the base moved, by odometry, at least
+        ``sqrt(0.8) minimum_travel_distance`` (no heading test; the first scan passes, the next three
+        do not). Such a scan always becomes a node (the time test of HasMovedEnough), so with the gate
+        ``minimum_travel_heading`` has no effect, as in slam_toolbox. False: Karto's HasMovedEnough alone
+        (slam_karto): a node when the time interval passed, or the laser turned or moved enough.
     use_scan_matching:
         Correct each node by scan matching (False: nodes at their odometry poses, no graph).
     use_scan_barycenter:
@@ -87,6 +95,7 @@ class KartoConfig(BaseModel):
     max_laser_range: float = Field(20.0, gt=0.0, le=1000.0, description="range threshold (m)")
     map_update_interval: float = Field(5.0, ge=0.0, le=1.0e6, description="seconds between map rebuilds")
     minimum_time_interval: float = Field(0.5, ge=0.0, le=1.0e6, description="least seconds between nodes")
+    scan_throttle: bool = Field(True, description="slam_toolbox's scan gate before Karto's node rule")
     use_scan_matching: bool = Field(True, description="correct nodes by scan matching")
     use_scan_barycenter: bool = Field(True, description="distances between scans from their barycentres")
     minimum_travel_distance: float = Field(0.5, ge=0.0, le=1000.0, description="node after this travel (m)")

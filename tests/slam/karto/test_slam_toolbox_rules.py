@@ -1,0 +1,118 @@
+"""Behaviour taken from slam_toolbox's and Karto's source that the accuracy on real logs depends on: the
+scan gate before a node, the range threshold of a scan's points, the response's denominator, and where
+the final estimate puts frames between nodes."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from slamtrials.geometry import compose1, ominus1
+from slamtrials.record import Frame
+from slamtrials.slam import make_algorithm
+from slamtrials.slam.karto.scanmatch import MatcherSettings, ScanMatcher, points_in_map
+
+SETTINGS = MatcherSettings(
+    coarse_search_angle_offset=0.349,
+    coarse_angle_resolution=0.0349,
+    fine_search_angle_offset=0.00349,
+    distance_variance=0.25,
+    angle_variance=1.0,
+    minimum_distance_penalty=0.5,
+    minimum_angle_penalty=0.9,
+    use_response_expansion=True,
+)
+
+
+def _frames(synthetic, odometry, times):
+    angles = synthetic.laser.beam_angles(361)
+    ranges = synthetic.raycast(np.array([-6.0, -6.0, 0.0]), angles, synthetic.segments, synthetic.laser.range_max)
+    poses = [np.array(o, dtype=np.float64) for o in odometry]
+    return [Frame(t=t, ranges=ranges, odometry=o, truth=o) for t, o in zip(times, poses)]
+
+
+def _nodes(synthetic, odometry, times, **overrides):
+    karto = make_algorithm("karto", synthetic.laser, overrides={"use_scan_matching": False, **overrides})
+    for frame in _frames(synthetic, odometry, times):
+        karto.process(frame)
+    return [n.frame for n in karto.graph.nodes]
+
+
+def test_the_scan_gate_is_slam_toolboxs(synthetic):
+    # shouldProcessScan: the first scan passes, scans 2-4 never do; then at least 0.5 s and a base
+    # travel of sqrt(0.8) * 0.5 = 0.447 m since the last node, and no heading test at all
+    odometry = [
+        (0.0, 0.0, 0.0),
+        (1.0, 0.0, 0.0),  # 2nd scan: far enough, but too early in the count
+        (2.0, 0.0, 0.0),
+        (3.0, 0.0, 0.0),
+        (3.0, 0.0, 0.0),  # 5th: 3 m from the first node -> node
+        (3.0, 0.0, 1.5),  # turned 1.5 rad in place: no node
+        (3.0, 0.0, -1.5),
+        (3.46, 0.0, -1.5),  # 0.46 m: a node (>= 0.447 m, < 0.5 m)
+        (3.9, 0.0, -1.5),  # 0.44 m: not yet
+        (3.92, 0.0, -1.5),  # 0.46 m, but 0.3 s after the last node
+        (3.93, 0.0, -1.5),  # 0.47 m, 0.6 s after: node
+    ]
+    times = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 7.2, 7.3, 7.6]
+    assert _nodes(synthetic, odometry, times) == [0, 4, 7, 10]
+
+
+def test_without_the_gate_karto_makes_a_node_on_a_turn_or_after_its_time_interval(synthetic):
+    # Karto's HasMovedEnough alone (slam_karto): time interval, or heading, or laser travel
+    odometry = [(0.0, 0.0, 0.0), (0.1, 0.0, 0.0), (0.1, 0.0, 0.6), (0.1, 0.0, 0.6), (0.1, 0.0, 0.6)]
+    times = [0.0, 1.0, 2.0, 3.0, 13.0]
+    nodes = _nodes(synthetic, odometry, times, scan_throttle=False, minimum_time_interval=10.0)
+    assert nodes == [0, 2, 4]
+
+
+def test_readings_beyond_the_range_threshold_give_no_point(synthetic):
+    karto = make_algorithm("karto", synthetic.laser, overrides={"max_laser_range": 3.0})
+    frame = _frames(synthetic, [(0.0, 0.0, 0.0)], [0.0])[0]
+    karto.process(frame)
+    node = karto.graph.nodes[0]
+    ranges = np.asarray(frame.ranges, dtype=np.float64)
+    has_point = ~np.isnan(node.lx)
+    assert (ranges > 3.0).any() and (ranges <= 3.0).any()
+    np.testing.assert_array_equal(has_point, ranges <= 3.0)
+    near = ranges <= 3.0
+    assert np.hypot(*node.barycenter) <= 3.0
+    np.testing.assert_allclose(node.barycenter, [node.lx[near].mean(), node.ly[near].mean()], atol=1e-12)
+
+
+def test_the_response_is_divided_by_the_points_not_the_beams(synthetic):
+    # a scan matched against itself scores about 1 however many of its beams have no return
+    laser = synthetic.laser
+    angles = laser.beam_angles(361)
+    pose = np.array([-6.0, -1.0, math.pi / 2])
+    ranges = synthetic.raycast(pose, angles, synthetic.segments, laser.range_max).astype(np.float64)
+    ranges[::2] = np.nan  # half the beams without a point
+    lx, ly = ranges * np.cos(angles), ranges * np.sin(angles)
+    matcher = ScanMatcher(0.5, 0.01, 0.1, laser.range_max, SETTINGS)
+    result = matcher.match(pose, lx, ly, [points_in_map(pose, lx, ly)])
+    assert result.response > 0.9
+
+
+def test_frames_between_nodes_are_placed_from_the_nearest_node(square_loop):
+    karto = make_algorithm("karto", square_loop.laser, overrides={"use_scan_matching": False})
+    for frame in square_loop.frames:
+        karto.process(frame)
+    nodes = karto.graph.nodes
+    assert len(nodes) > 3
+    # move every node off its odometry chain, as an optimization would
+    poses = karto.graph.poses()
+    poses[:, 0] += 0.3 * np.arange(len(nodes))
+    poses[:, 2] += 0.01 * np.arange(len(nodes))
+    karto.graph.set_poses(poses)
+    trajectory = karto.trajectory()
+    node_t = np.array([n.t for n in nodes])
+    placed_from_next = 0
+    for k, frame in enumerate(square_loop.frames):
+        gaps = np.abs(node_t - frame.t)
+        nearest = int(np.flatnonzero(gaps == gaps.min())[0])  # the earlier one on a tie
+        node = nodes[nearest]
+        expected = compose1(node.pose, ominus1(node.odometry, np.asarray(frame.odometry, dtype=np.float64)))
+        np.testing.assert_allclose(trajectory.poses[k], expected, atol=1e-9)
+        placed_from_next += node.t > frame.t
+    assert placed_from_next > 0

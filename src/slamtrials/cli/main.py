@@ -57,7 +57,19 @@ def root(
 
 
 def _register_commands() -> None:
-    from slamtrials.cli import campaign, config, demo, evaluate, report, simulate, slam, transfer, trial, worlds
+    from slamtrials.cli import (
+        calibrate,
+        campaign,
+        config,
+        demo,
+        evaluate,
+        report,
+        simulate,
+        slam,
+        transfer,
+        trial,
+        worlds,
+    )
 
     app.add_typer(worlds.app, name="worlds", help="List, show, load and generate floor plans.")
     simulate.register(app)
@@ -65,6 +77,7 @@ def _register_commands() -> None:
     transfer.register(app)
     evaluate.register(app)
     slam.register(app)
+    calibrate.register(app)
     trial.register(app)
     campaign.register(app)
     config.register(app)

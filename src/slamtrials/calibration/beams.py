@@ -88,7 +88,11 @@ def beam_sample(
     mount = laser.mount
     limit = float(laser.range_max)
     res = walls.resolution
-    frames, casts, readings, incidences, used = [], [], [], [], 0
+    frame_ids: list[NDArray[np.int64]] = []
+    casts: list[NDArray[np.float64]] = []
+    readings: list[NDArray[np.float64]] = []
+    incidences: list[NDArray[np.float64]] = []
+    used = 0
     for k in chosen[::step].tolist():
         used += 1
         pose = compose1(reference.poses[k], mount)
@@ -102,16 +106,16 @@ def beam_sample(
         index = np.flatnonzero(keep)
         cells = to_wall.astype(np.float64) / res
         cosines = incidence_cosines((float(uv[0]), float(uv[1])), theta, angles, cells)
-        frames.append(np.full(index.size, k, dtype=np.int64))
+        frame_ids.append(np.full(index.size, k, dtype=np.int64))
         casts.append(to_wall[index].astype(np.float64))
         readings.append(record.scans[k, index].astype(np.float64))
         incidences.append(cosines[index])
-    if not frames:
+    if not frame_ids:
         empty = np.zeros(0)
         return BeamSample(np.zeros(0, np.int64), empty, empty, empty, np.zeros(0, bool), used, step, used * beams)
     reading = np.concatenate(readings)
     return BeamSample(
-        frame=np.concatenate(frames),
+        frame=np.concatenate(frame_ids),
         cast=np.concatenate(casts),
         reading=reading,
         incidence=np.concatenate(incidences),

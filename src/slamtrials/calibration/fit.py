@@ -163,7 +163,7 @@ def calibrate(
     if odometry is None:
         raise CalibrationError(
             f"the reference has {anchors.size} frames that are more than odometry carried on; the odometry fit "
-            f"needs at least {4 * cfg.windows[-1] + 1}"
+            f"needs at least {4 * cfg.windows[2] + 1}"
         )
     frames = len(record)
     blocks = math.ceil(frames / cfg.block_frames)

@@ -120,10 +120,10 @@ def fit_laser(sample: BeamSample, settings: CalibrationSettings, range_min: floa
         returned = in_bin & back
         if int(np.count_nonzero(returned)) < settings.min_bin_beams:
             continue
-        centre, sigma, share = central_sigma(e[returned], cut=settings.core_cut)
-        if not (math.isfinite(sigma) and sigma > 0.0):
+        mid, spread, inside = central_sigma(e[returned], cut=settings.core_cut)
+        if not (math.isfinite(spread) and spread > 0.0):
             continue
-        rows.append((b, float(np.mean(r[in_bin])), float(np.count_nonzero(in_bin)), centre, sigma, share))
+        rows.append((b, float(np.mean(r[in_bin])), float(np.count_nonzero(in_bin)), mid, spread, inside))
     if len(rows) < 2:
         return None
     bin_index = np.array([row[0] for row in rows])

@@ -207,7 +207,9 @@ def _noise_fit(
     coef = nonnegative_least_squares(columns, target, weight / scale**2)
     trimming = False
     for _ in range(60):
-        predicted = sum(max(x, f) * c for x, f, c in zip(coef, floors, columns))
+        predicted = np.zeros_like(target)
+        for x, f, c in zip(coef, floors, columns):
+            predicted = predicted + max(x, f) * c
         if trimming:
             keep = target < cut * cut * (coef[0] + coef[1] * main + coef[2] * cross)
         previous = coef
@@ -230,13 +232,15 @@ def fit_odometry(
     """Fit biases and noise to ``steps`` over windows between ``anchors`` (:func:`anchor_frames`).
 
     ``frame_weight`` ``[T]`` weighs each window by the weight of its first frame (bootstrap
-    multiplicities). None when there are fewer than four windows of the longest length.
+    multiplicities). Window lengths with fewer than four windows are left out; None when fewer than three
+    lengths are left.
     """
     segments = anchors.size - 1
-    if segments < 4 * settings.windows[-1]:
+    lengths = [w for w in settings.windows if segments >= 4 * w]  # at least four windows of each length
+    if len(lengths) < 3:
         return None
     weight_of = np.ones(anchors[-1] + 1) if frame_weight is None else frame_weight
-    mid = settings.windows[len(settings.windows) // 2]
+    mid = lengths[len(lengths) // 2]
     wb = weight_of[anchors[: segments - mid + 1]]
     ref_l, ref_t = _sums(steps.length, anchors, mid, 1), _sums(steps.turn, anchors, mid, 1)
     bias_lin = _slope(_sums(steps.odo_length, anchors, mid, 1) - ref_l, ref_l, wb)
@@ -246,7 +250,7 @@ def fit_odometry(
     step_ll = (steps.odo_length / (1.0 + bias_lin)) ** 2
     step_tt = (steps.odo_turn / (1.0 + bias_ang)) ** 2
     parts: dict[str, list[NDArray[np.float64]]] = {k: [] for k in ("el", "ea", "ll", "tt", "w", "len", "l", "t", "raw")}
-    for w in settings.windows:
+    for w in lengths:
         ref_l, ref_t = _sums(steps.length, anchors, w, w), _sums(steps.turn, anchors, w, w)
         parts["el"].append(_sums(steps.odo_length, anchors, w, w) - (1.0 + bias_lin) * ref_l)
         parts["ea"].append(_sums(steps.odo_turn, anchors, w, w) - (1.0 + bias_ang) * ref_t)
@@ -259,7 +263,7 @@ def fit_odometry(
         parts["t"].append(np.abs(ref_t))
     cat = {k: np.concatenate(v) for k, v in parts.items()}
     # every window length weighs the same in all: the short windows, which are many, must not decide alone
-    per_length = {float(w): float(np.sum(cat["w"][cat["len"] == w])) for w in settings.windows}
+    per_length = {float(w): float(np.sum(cat["w"][cat["len"] == w])) for w in lengths}
     cat["w"] = cat["w"] / np.array([max(per_length[v], 1e-300) for v in cat["len"].tolist()])
     cut = settings.outlier_sigmas
     lin, keep_l = _noise_fit(cat["el"], cat["ll"], cat["tt"], cat["w"], cat["len"], cut)
@@ -276,7 +280,7 @@ def fit_odometry(
     pred_l = lin[0] + lin[1] * cat["ll"] + lin[2] * cat["tt"]
     pred_a = ang[0] + ang[1] * cat["tt"] + ang[2] * cat["ll"]
     rows = []
-    for w in settings.windows:
+    for w in lengths:
         sel = cat["len"] == w
         both = sel & keep_l & keep_a
         rows.append(
@@ -294,7 +298,7 @@ def fit_odometry(
             )
         )
     table = np.array(rows)
-    single = cat["len"] == settings.windows[0]
+    single = cat["len"] == lengths[0]
     return OdometryFit(
         values=values,
         reference_linear=lin[0],

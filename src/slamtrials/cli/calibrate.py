@@ -49,6 +49,8 @@ def format_calibration(cal: Calibration, log: str) -> str:
 
     def row(name: str, note: str = "") -> str:
         v = value[name]
+        if v.value == 0.0 and not note:
+            note = "  at its bound 0 (the fit would go negative)"
         return f"  {name:<22} {v.value:>10.5f} +- {v.stderr:<9.5f} {v.unit:<8}{note}".rstrip()
 
     for name in (

@@ -13,10 +13,8 @@ with ``a, b, c, d`` the profile's ``noise_linear_per_m``, ``noise_linear_per_rad
 ``noise_angular_per_rad``, ``noise_angular_per_m``. The biases ``e_lin``, ``e_ang`` are the least-squares
 slopes of the window errors on the reference's window motion (overlapping windows of the middle length);
 the noise coefficients are the non-negative least-squares fit of the squared window errors (bias removed)
-on the window's sums of squared step motions, over non-overlapping windows of every length (each length
-weighing the same in all), weighted by the inverse squared predicted variance and refitted without
-windows beyond ``outlier_sigmas``; then the biases once more, each window weighed by the inverse of its
-predicted variance, and the noise once more with them. The
+on the window's sums of squared step motions, over non-overlapping windows of every length, weighted by
+the inverse squared predicted variance and refitted without windows beyond ``outlier_sigmas``. The
 constant ``k`` takes the reference's own pose error, which does not grow with the window: that is what
 several window lengths separate. The per-step coefficients hold for the log's step; the simulator's step
 of ``sim_dt`` seconds needs them times ``sqrt(log step / sim_dt)`` (the same path in shorter steps has
@@ -224,42 +222,6 @@ def _noise_fit(
     return coef, keep
 
 
-def _noise_pass(
-    steps: StepMotion,
-    anchors: NDArray[np.int64],
-    lengths: list[int],
-    weight_of: NDArray[np.float64],
-    bias_lin: float,
-    bias_ang: float,
-    cut: float,
-) -> tuple[dict[str, NDArray[np.float64]], list[float], NDArray[np.bool_], list[float], NDArray[np.bool_]]:
-    """The window table for the given biases and the noise fits of arc length and heading."""
-    segments = anchors.size - 1
-    # squared step motions: the odometry's, unbiased (between anchors the reference is the odometry; at
-    # an anchor the reference step holds the SLAM correction, which is no motion)
-    step_ll = (steps.odo_length / (1.0 + bias_lin)) ** 2
-    step_tt = (steps.odo_turn / (1.0 + bias_ang)) ** 2
-    parts: dict[str, list[NDArray[np.float64]]] = {k: [] for k in ("el", "ea", "ll", "tt", "w", "len", "l", "t", "raw")}
-    for w in lengths:
-        ref_l, ref_t = _sums(steps.length, anchors, w, w), _sums(steps.turn, anchors, w, w)
-        parts["el"].append(_sums(steps.odo_length, anchors, w, w) - (1.0 + bias_lin) * ref_l)
-        parts["ea"].append(_sums(steps.odo_turn, anchors, w, w) - (1.0 + bias_ang) * ref_t)
-        parts["raw"].append(_sums(steps.odo_turn, anchors, w, w) - ref_t)
-        parts["ll"].append(_sums(step_ll, anchors, w, w))
-        parts["tt"].append(_sums(step_tt, anchors, w, w))
-        parts["w"].append(weight_of[anchors[np.arange(0, segments - w + 1, w)]])
-        parts["len"].append(np.full(ref_l.size, float(w)))
-        parts["l"].append(np.abs(ref_l))
-        parts["t"].append(np.abs(ref_t))
-    cat = {k: np.concatenate(v) for k, v in parts.items()}
-    # every window length weighs the same in all: the short windows, which are many, must not decide alone
-    per_length = {float(w): float(np.sum(cat["w"][cat["len"] == w])) for w in lengths}
-    cat["w"] = cat["w"] / np.array([max(per_length[v], 1e-300) for v in cat["len"].tolist()])
-    lin, keep_l = _noise_fit(cat["el"], cat["ll"], cat["tt"], cat["w"], cat["len"], cut)
-    ang, keep_a = _noise_fit(cat["ea"], cat["tt"], cat["ll"], cat["w"], cat["len"], cut)
-    return cat, lin, keep_l, ang, keep_a
-
-
 def fit_odometry(
     steps: StepMotion,
     anchors: NDArray[np.int64],
@@ -281,20 +243,31 @@ def fit_odometry(
     mid = lengths[len(lengths) // 2]
     wb = weight_of[anchors[: segments - mid + 1]]
     ref_l, ref_t = _sums(steps.length, anchors, mid, 1), _sums(steps.turn, anchors, mid, 1)
-    odo_l, odo_t = _sums(steps.odo_length, anchors, mid, 1), _sums(steps.odo_turn, anchors, mid, 1)
-    bias_lin = _slope(odo_l - ref_l, ref_l, wb)
-    bias_ang = _slope(odo_t - ref_t, ref_t, wb)
+    bias_lin = _slope(_sums(steps.odo_length, anchors, mid, 1) - ref_l, ref_l, wb)
+    bias_ang = _slope(_sums(steps.odo_turn, anchors, mid, 1) - ref_t, ref_t, wb)
+    # squared step motions: the odometry's, unbiased (between anchors the reference is the odometry; at
+    # an anchor the reference step holds the SLAM correction, which is no motion)
+    step_ll = (steps.odo_length / (1.0 + bias_lin)) ** 2
+    step_tt = (steps.odo_turn / (1.0 + bias_ang)) ** 2
+    parts: dict[str, list[NDArray[np.float64]]] = {k: [] for k in ("el", "ea", "ll", "tt", "w", "len", "l", "t", "raw")}
+    for w in lengths:
+        ref_l, ref_t = _sums(steps.length, anchors, w, w), _sums(steps.turn, anchors, w, w)
+        parts["el"].append(_sums(steps.odo_length, anchors, w, w) - (1.0 + bias_lin) * ref_l)
+        parts["ea"].append(_sums(steps.odo_turn, anchors, w, w) - (1.0 + bias_ang) * ref_t)
+        parts["raw"].append(_sums(steps.odo_turn, anchors, w, w) - ref_t)
+        parts["ll"].append(_sums(step_ll, anchors, w, w))
+        parts["tt"].append(_sums(step_tt, anchors, w, w))
+        parts["w"].append(weight_of[anchors[np.arange(0, segments - w + 1, w)]])
+        parts["len"].append(np.full(ref_l.size, float(w)))
+        parts["l"].append(np.abs(ref_l))
+        parts["t"].append(np.abs(ref_t))
+    cat = {k: np.concatenate(v) for k, v in parts.items()}
+    # every window length weighs the same in all: the short windows, which are many, must not decide alone
+    per_length = {float(w): float(np.sum(cat["w"][cat["len"] == w])) for w in lengths}
+    cat["w"] = cat["w"] / np.array([max(per_length[v], 1e-300) for v in cat["len"].tolist()])
     cut = settings.outlier_sigmas
-    cat, lin, keep_l, ang, keep_a = _noise_pass(steps, anchors, lengths, weight_of, bias_lin, bias_ang, cut)
-    # the window errors' variance grows with the motion: the biases again, each window weighed by the
-    # inverse of its predicted variance (the first slopes weigh the noisiest windows most), then the noise
-    mid_ll = _sums((steps.odo_length / (1.0 + bias_lin)) ** 2, anchors, mid, 1)
-    mid_tt = _sums((steps.odo_turn / (1.0 + bias_ang)) ** 2, anchors, mid, 1)
-    var_l = np.maximum(lin[0] + lin[1] * mid_ll + lin[2] * mid_tt, 1e-300)
-    var_t = np.maximum(ang[0] + ang[1] * mid_tt + ang[2] * mid_ll, 1e-300)
-    bias_lin = _slope(odo_l - ref_l, ref_l, wb / var_l)
-    bias_ang = _slope(odo_t - ref_t, ref_t, wb / var_t)
-    cat, lin, keep_l, ang, keep_a = _noise_pass(steps, anchors, lengths, weight_of, bias_lin, bias_ang, cut)
+    lin, keep_l = _noise_fit(cat["el"], cat["ll"], cat["tt"], cat["w"], cat["len"], cut)
+    ang, keep_a = _noise_fit(cat["ea"], cat["tt"], cat["ll"], cat["w"], cat["len"], cut)
     scale = math.sqrt(log_step / settings.sim_dt)
     values = {
         "bias_linear": bias_lin,

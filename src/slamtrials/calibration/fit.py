@@ -79,6 +79,8 @@ class Calibration:
         ``[N]``: whether the real and the modelled reading returned nothing.
     bootstrap:
         Replicates used.
+    laser_frames:
+        Frames whose beams were cast (every ``frame_step``-th, to stay within ``max_beams``).
     """
 
     laser: LaserFit
@@ -92,6 +94,7 @@ class Calibration:
     no_return: NDArray[np.bool_]
     model_no_return: NDArray[np.bool_]
     bootstrap: int
+    laser_frames: int = 0
 
     def value(self, name: str) -> FittedValue:
         """The fitted value called ``name``."""
@@ -103,7 +106,8 @@ class Calibration:
     def profile(self, name: str, description: str) -> ErrorProfile:
         """The error profile: the fitted laser values, the biases as symmetric ranges of their measured
         magnitude (one log is one draw of the per-run bias), the noise coefficients; no slips."""
-        laser = {k: float(self.value(k).value) for k in LASER_VALUES}
+        # the fits keep every value >= 0; the caps are the fields' own (a rate above 1 is a certainty)
+        laser = {k: float(min(self.value(k).value, 1.0)) for k in LASER_VALUES}
         lin = min(abs(self.value("bias_linear").value), 0.49)
         ang = min(abs(self.value("bias_angular").value), 0.49)
         odometry: dict[str, object] = {"bias_linear_range": (-lin, lin), "bias_angular_range": (-ang, ang)}
@@ -196,4 +200,5 @@ def calibrate(
         no_return=sample.no_return,
         model_no_return=model_drop,
         bootstrap=cfg.bootstrap,
+        laser_frames=sample.frames_used,
     )

@@ -41,7 +41,8 @@ def format_calibration(cal: Calibration, log: str) -> str:
     laser, odo = cal.laser, cal.odometry
     lines = [f"{log}: {cal.frames} frames; reference: {cal.reference}"]
     lines.append(
-        f"laser: {laser.beams} beams hit a mapped wall through known free space; robust sigma of their residuals "
+        f"laser: {laser.beams} beams of {cal.laser_frames} frames hit a mapped wall through known free space; "
+        "robust sigma of their residuals "
         f"{laser.robust_sigma:.4f} m, {100 * laser.off_share:.1f} % off by more than 0.2 m, "
         f"{100 * laser.no_return_share:.2f} % no return"
     )

@@ -222,6 +222,31 @@ def _noise_fit(
     return coef, keep
 
 
+def _without_noise(
+    odo_ll: NDArray[np.float64],
+    odo_tt: NDArray[np.float64],
+    lin: list[float],
+    ang: list[float],
+    bias_lin: float,
+    bias_ang: float,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The squared step motions ``[T - 1]`` with the fitted noise's share taken out.
+
+    ``odo_ll``, ``odo_tt`` are the odometry's squared steps over ``(1 + e)^2``; each holds its noise's
+    variance besides the motion's square: ``L'^2 / (1 + e_lin)^2 = L^2 + (a^2 L^2 + b^2 phi^2) / (1 +
+    e_lin)^2`` in expectation, and alike for ``phi``. With a large cross term (fr079's arc length errs by
+    half a metre per radian of turning) a turn in place would otherwise look like driving. The two
+    equations are solved per step for ``L^2`` and ``phi^2``: unbiased over a window, though a single step
+    may come out slightly negative.
+    """
+    alpha = lin[1] / (1.0 + bias_lin) ** 2
+    beta = lin[2] / (1.0 + bias_lin) ** 2
+    gamma = ang[1] / (1.0 + bias_ang) ** 2
+    delta = ang[2] / (1.0 + bias_ang) ** 2
+    det = (1.0 + alpha) * (1.0 + gamma) - beta * delta
+    return ((1.0 + gamma) * odo_ll - beta * odo_tt) / det, ((1.0 + alpha) * odo_tt - delta * odo_ll) / det
+
+
 def fit_odometry(
     steps: StepMotion,
     anchors: NDArray[np.int64],
@@ -268,6 +293,12 @@ def fit_odometry(
     cut = settings.outlier_sigmas
     lin, keep_l = _noise_fit(cat["el"], cat["ll"], cat["tt"], cat["w"], cat["len"], cut)
     ang, keep_a = _noise_fit(cat["ea"], cat["tt"], cat["ll"], cat["w"], cat["len"], cut)
+    for _ in range(3):  # the squared step motions without the fitted noise's share, and the fits again
+        clean_ll, clean_tt = _without_noise(step_ll, step_tt, lin, ang, bias_lin, bias_ang)
+        cat["ll"] = np.concatenate([_sums(clean_ll, anchors, w, w) for w in lengths])
+        cat["tt"] = np.concatenate([_sums(clean_tt, anchors, w, w) for w in lengths])
+        lin, keep_l = _noise_fit(cat["el"], cat["ll"], cat["tt"], cat["w"], cat["len"], cut)
+        ang, keep_a = _noise_fit(cat["ea"], cat["tt"], cat["ll"], cat["w"], cat["len"], cut)
     scale = math.sqrt(log_step / settings.sim_dt)
     values = {
         "bias_linear": bias_lin,

@@ -13,7 +13,8 @@ with ``a, b, c, d`` the profile's ``noise_linear_per_m``, ``noise_linear_per_rad
 ``noise_angular_per_rad``, ``noise_angular_per_m``. The biases ``e_lin``, ``e_ang`` are the least-squares
 slopes of the window errors on the reference's window motion (overlapping windows of the middle length);
 the noise coefficients are the non-negative least-squares fit of the squared window errors (bias removed)
-on the window's sums of squared step motions, over non-overlapping windows of every length, weighted by
+on the window's sums of squared step motions (the odometry's, with the fitted noise's share taken out
+and refitted, :func:`_without_noise`), over non-overlapping windows of every length, weighted by
 the inverse squared predicted variance and refitted without windows beyond ``outlier_sigmas``. The
 constant ``k`` takes the reference's own pose error, which does not grow with the window: that is what
 several window lengths separate. The per-step coefficients hold for the log's step; the simulator's step

@@ -60,10 +60,10 @@ BUNDLED_PROFILES: dict[str, ErrorProfile] = {
         odometry={
             "bias_linear_range": (-0.02207, 0.02207),
             "bias_angular_range": (-0.06411, 0.06411),
-            "noise_linear_per_m": 0.05489,
-            "noise_linear_per_rad": 0.05281,
-            "noise_angular_per_rad": 0.2889,
-            "noise_angular_per_m": 0.08984,
+            "noise_linear_per_m": 0.05505,
+            "noise_linear_per_rad": 0.05409,
+            "noise_angular_per_rad": 0.2957,
+            "noise_angular_per_m": 0.09202,
         },
     ),
     "fr079": ErrorProfile(
@@ -83,10 +83,10 @@ BUNDLED_PROFILES: dict[str, ErrorProfile] = {
         odometry={
             "bias_linear_range": (-0.01750, 0.01750),
             "bias_angular_range": (-0.03592, 0.03592),
-            "noise_linear_per_m": 0.2115,
-            "noise_linear_per_rad": 0.7994,
-            "noise_angular_per_rad": 0.3976,
-            "noise_angular_per_m": 0.2157,
+            "noise_linear_per_m": 0.2510,
+            "noise_linear_per_rad": 0.8457,
+            "noise_angular_per_rad": 0.4343,
+            "noise_angular_per_m": 0.2282,
         },
     ),
 }

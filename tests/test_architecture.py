@@ -24,15 +24,16 @@ ALLOWED = {
     # validation composes sim, slam and metric like a trial (DESIGN.md, "Realism"); it computes only
     "validation": {"geometry", "record", "worlds", "sim", "slam", "metric"},
     "metric": {"geometry", "record"},
+    "calibration": {"geometry", "record", "worlds", "sim", "slam", "metric"},
     "io": {"geometry", "record", "worlds"},
     "campaign": {"geometry", "record", "worlds", "sim", "slam", "explore", "trial", "metric", "io"},
-    "report": {"geometry", "record", "worlds", "metric", "io", "campaign"},
+    "report": {"geometry", "record", "worlds", "metric", "io", "campaign", "calibration"},
 }
 #: Top-level modules that compose layers like the CLI does (no layer may import them).
 COMPOSERS = {"demo", "evaluation", "slamrun", "repeat", "cli", "__init__", "__main__"}
 
 #: Layers that must not do I/O, print or plot (DESIGN.md).
-COMPUTING = {"geometry", "record", "sim", "slam", "explore", "trial", "metric", "validation"}
+COMPUTING = {"geometry", "record", "sim", "slam", "explore", "trial", "metric", "validation", "calibration"}
 
 #: numpy functions whose float64 results depend on the machine: numpy's own SIMD code for these on
 #: AVX-512 CPUs differs from the C library's by a few ulp, and BLAS picks its kernels by CPU.

@@ -18,6 +18,7 @@ __all__ = [
     "WorldError",
     "SimulationError",
     "MetricError",
+    "CalibrationError",
 ]
 
 
@@ -63,6 +64,10 @@ class WorldError(SlamtrialsError):
 
 class SimulationError(SlamtrialsError):
     """The simulator was asked for something it cannot do (e.g. a start pose inside a wall)."""
+
+
+class CalibrationError(SlamtrialsError):
+    """A log cannot be calibrated from (too short, no odometry, too few usable beams or windows)."""
 
 
 class MetricError(SlamtrialsError):

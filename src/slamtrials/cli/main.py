@@ -58,6 +58,7 @@ def root(
 
 def _register_commands() -> None:
     from slamtrials.cli import (
+        calibrate,
         campaign,
         config,
         demo,
@@ -77,6 +78,7 @@ def _register_commands() -> None:
     transfer.register(app)
     evaluate.register(app)
     slam.register(app)
+    calibrate.register(app)
     trial.register(app)
     campaign.register(app)
     config.register(app)

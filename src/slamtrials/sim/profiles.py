@@ -13,6 +13,13 @@ Bundled:
     from +-0.5 % and +-1 deg/rad, nothing else. These are the config's own defaults, so a config that
     names no profile is this one, bit for bit.
 
+``mit-csail``, ``fr079``
+    Fitted by ``slamtrials calibrate`` to the shared real logs (MIT CSAIL with GMapping's defaults;
+    fr079 with the GMapping settings that map it: ``particles=100 srt=0.4 stt=0.4 lstep=0.1 astep=0.1``,
+    seed 2), against GMapping's final path and map. The values are the printed fit rounded to four
+    significant digits; docs/realism.md, "Calibration", has the method, the uncertainties and what the
+    values include besides the sensors' own errors (the reference is itself a SLAM estimate).
+
 Profiles fitted to real logs (``slamtrials calibrate``) are YAML files of the same form; the config
 loaders (campaign config, ``--config`` of the CLI) read a ``profile`` that is a path to such a file.
 """
@@ -36,6 +43,51 @@ BUNDLED_PROFILES: dict[str, ErrorProfile] = {
         "+-1 deg/rad",
         laser={},
         odometry={"bias_linear_range": (-0.005, 0.005), "bias_angular_range": (-math.radians(1.0), math.radians(1.0))},
+    ),
+    "mit-csail": ErrorProfile(
+        name="mit-csail",
+        description="fitted by slamtrials calibrate (2026-11-24) to the shared MIT CSAIL log against GMapping's "
+        "final path and map (default settings, seed 0); biases +- the measured per-run bias; noise per simulator "
+        "step of 0.1 s; no slips (docs/realism.md, Calibration)",
+        laser={
+            "range_noise_std": 0.03337,
+            "range_noise_per_m": 0.005331,
+            "short_rate": 0.1233,
+            "dropout_rate": 0.03450,
+            "dropout_per_m": 0.0,
+            "dropout_grazing": 0.0,
+        },
+        odometry={
+            "bias_linear_range": (-0.02207, 0.02207),
+            "bias_angular_range": (-0.06411, 0.06411),
+            "noise_linear_per_m": 0.05505,
+            "noise_linear_per_rad": 0.05409,
+            "noise_angular_per_rad": 0.2957,
+            "noise_angular_per_m": 0.09202,
+        },
+    ),
+    "fr079": ErrorProfile(
+        name="fr079",
+        description="fitted by slamtrials calibrate (2026-11-24) to the shared fr079 log against GMapping's final "
+        "path and map (particles=100, srt=0.4, stt=0.4, lstep=0.1, astep=0.1, seed 2: GMapping's defaults do not "
+        "map fr079); biases +- the measured per-run bias; noise per simulator step of 0.1 s; no slips "
+        "(docs/realism.md, Calibration)",
+        laser={
+            "range_noise_std": 0.04628,
+            "range_noise_per_m": 0.001680,
+            "short_rate": 0.1915,
+            "dropout_rate": 0.02248,
+            "dropout_per_m": 0.0,
+            "dropout_grazing": 0.01286,
+        },
+        odometry={
+            "bias_linear_range": (-0.01750, 0.01750),
+            "bias_angular_range": (-0.03592, 0.03592),
+            "noise_linear_per_m": 0.2510,
+            "noise_linear_per_rad": 0.8457,
+            "noise_angular_per_rad": 0.4343,
+            "noise_angular_per_m": 0.2282,
+        },
     ),
 }
 

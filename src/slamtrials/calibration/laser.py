@@ -1,0 +1,178 @@
+"""The laser fit: range noise by range bin, short readings and dropouts, from a :class:`BeamSample`.
+
+Residual of a beam: ``e = reading - cast``. Per range bin (by the cast range) of the beams that
+returned something, the Gaussian core of the residuals gives the bin's noise sigma
+(:func:`~slamtrials.calibration.stats.central_sigma`: MAD start, then the truncation-corrected standard
+deviation within ``core_cut`` sigmas of the median); a weighted line through the bins' sigmas (weights
+``n / sigma^2``, the inverse variance of a sigma estimated from ``n`` values, up to a factor) gives
+``range_noise_std + range_noise_per_m r``, both non-negative.
+
+Short readings: a beam that returned more than ``short_sigmas`` sigmas short of the cast range. The model
+draws a short reading uniformly in ``[min_range, r)``, so it is seen as such with probability
+``(r - k sigma(r) - min_range) / (r - min_range)``; the rate is the count of short beams, less the
+Gaussian tail's expected count, over the sum of those probabilities over all kept beams.
+
+Dropouts: the share of kept beams that returned nothing, fitted per beam by non-negative least squares
+as ``(1 - short_rate) (dropout_rate + dropout_per_m r + dropout_grazing (1 - |cos i|))`` (a short
+reading replaces a dropout in the model).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from slamtrials.calibration.beams import BeamSample
+from slamtrials.calibration.settings import CalibrationSettings
+from slamtrials.calibration.stats import central_sigma, nonnegative_least_squares, robust_sigma
+
+__all__ = ["LaserFit", "LaserBins", "fit_laser", "LASER_VALUES"]
+
+#: The fitted laser values, in the order of the profile's fields.
+LASER_VALUES = (
+    "range_noise_std",
+    "range_noise_per_m",
+    "short_rate",
+    "dropout_rate",
+    "dropout_per_m",
+    "dropout_grazing",
+)
+
+
+@dataclass(frozen=True, eq=False)
+class LaserBins:
+    """Per range bin (only bins with enough beams): float64 ``[K]`` arrays.
+
+    Attributes
+    ----------
+    low, high:
+        Bin edges (m).
+    range_mean:
+        Mean cast range of the bin's beams (m).
+    beams:
+        Kept beams in the bin.
+    centre:
+        Median residual of the returned beams (m): the map's offset (cell sides are not wall surfaces).
+    sigma:
+        Noise sigma of the Gaussian core (m).
+    core_share:
+        Share of the returned beams within ``core_cut`` sigmas of the median.
+    no_return:
+        Share of the bin's beams that returned nothing.
+    short:
+        Share of the bin's beams read short (beyond ``short_sigmas`` sigmas).
+    """
+
+    low: NDArray[np.float64]
+    high: NDArray[np.float64]
+    range_mean: NDArray[np.float64]
+    beams: NDArray[np.float64]
+    centre: NDArray[np.float64]
+    sigma: NDArray[np.float64]
+    core_share: NDArray[np.float64]
+    no_return: NDArray[np.float64]
+    short: NDArray[np.float64]
+
+
+@dataclass(frozen=True, eq=False)
+class LaserFit:
+    """The laser's fitted values (:data:`LASER_VALUES`) and the figures behind them.
+
+    Attributes
+    ----------
+    values:
+        Field name -> value (profile units).
+    bins:
+        The per-bin table.
+    beams:
+        Kept beams.
+    robust_sigma:
+        1.4826 MAD of all returned beams' residuals (m), all ranges together.
+    off_share:
+        Share of kept beams that returned something more than 0.2 m from the cast range.
+    no_return_share:
+        Share of kept beams that returned nothing.
+    """
+
+    values: dict[str, float]
+    bins: LaserBins
+    beams: int
+    robust_sigma: float
+    off_share: float
+    no_return_share: float
+
+
+def _normal_tail(k: float) -> float:
+    return 0.5 * math.erfc(k / math.sqrt(2.0))
+
+
+def fit_laser(sample: BeamSample, settings: CalibrationSettings, range_min: float) -> LaserFit | None:
+    """Fit the laser's error models to ``sample``; None when fewer than two range bins have enough beams."""
+    r, e, back = sample.cast, sample.reading - sample.cast, ~sample.no_return
+    edges = np.asarray(settings.range_bins, dtype=np.float64)
+    which = np.searchsorted(edges, r, side="right") - 1
+    rows = []
+    for b in range(len(edges) - 1):
+        in_bin = which == b
+        returned = in_bin & back
+        if int(np.count_nonzero(returned)) < settings.min_bin_beams:
+            continue
+        mid, spread, inside = central_sigma(e[returned], cut=settings.core_cut)
+        if not (math.isfinite(spread) and spread > 0.0):
+            continue
+        rows.append((b, float(np.mean(r[in_bin])), float(np.count_nonzero(in_bin)), mid, spread, inside))
+    if len(rows) < 2:
+        return None
+    bin_index = np.array([row[0] for row in rows])
+    r_mean = np.array([row[1] for row in rows])
+    count = np.array([row[2] for row in rows])
+    centre = np.array([row[3] for row in rows])
+    sigma = np.array([row[4] for row in rows])
+    share = np.array([row[5] for row in rows])
+    a, b_ = nonnegative_least_squares([np.ones_like(r_mean), r_mean], sigma, count / sigma**2)
+    beam_sigma = np.maximum(a + b_ * r, 1e-9)
+    k = settings.short_sigmas
+    # the bin's centre is the map's offset, not a reading error: shortness is counted from it
+    offset = np.zeros_like(r)
+    for row, b in enumerate(bin_index):
+        offset[which == b] = centre[row]
+    short = back & (e - offset < -k * beam_sigma)
+    seen = np.clip((r - k * beam_sigma - range_min) / np.maximum(r - range_min, 1e-9), 0.0, 1.0)
+    false_alarms = _normal_tail(k) * float(np.count_nonzero(back & ~short))
+    short_rate = max(0.0, (float(np.count_nonzero(short)) - false_alarms) / max(float(np.sum(seen)), 1e-9))
+    short_rate = min(short_rate, 0.999)
+    y = sample.no_return.astype(np.float64) / (1.0 - short_rate)
+    columns = [np.ones_like(r), r, 1.0 - sample.incidence]
+    d0, d1, d2 = nonnegative_least_squares(columns, y)
+    values = {
+        "range_noise_std": a,
+        "range_noise_per_m": b_,
+        "short_rate": short_rate,
+        "dropout_rate": d0,
+        "dropout_per_m": d1,
+        "dropout_grazing": d2,
+    }
+    no_return = np.array([float(np.mean(sample.no_return[which == b])) for b in bin_index])
+    short_share = np.array([float(np.mean(short[which == b])) for b in bin_index])
+    returned_e = e[back]
+    return LaserFit(
+        values=values,
+        bins=LaserBins(
+            low=edges[bin_index],
+            high=edges[bin_index + 1],
+            range_mean=r_mean,
+            beams=count,
+            centre=centre,
+            sigma=sigma,
+            core_share=share,
+            no_return=no_return,
+            short=short_share,
+        ),
+        beams=int(r.size),
+        robust_sigma=robust_sigma(returned_e)[1],
+        off_share=float(np.count_nonzero(back & (np.abs(e) > 0.2))) / max(r.size, 1),
+        no_return_share=float(np.mean(sample.no_return)) if r.size else math.nan,
+    )

@@ -1,0 +1,82 @@
+"""The calibration's settings (pydantic, frozen): range bins, cut-offs, window lengths, bootstrap."""
+
+from __future__ import annotations
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator
+
+__all__ = ["CalibrationSettings"]
+
+
+class CalibrationSettings(BaseModel):
+    """How :func:`~slamtrials.calibration.calibrate` fits the error models.
+
+    Attributes
+    ----------
+    range_bins:
+        Edges (m, increasing) of the range bins of the laser fit (by the cast range).
+    min_bin_beams:
+        Fewest beams a range bin needs to enter the noise and dropout fits.
+    core_cut:
+        The Gaussian core of a bin's residuals is taken within this many sigmas of its median.
+    short_sigmas:
+        A reading shorter than the cast range by more than this many sigmas (of its bin) is a short reading.
+    max_beams:
+        Cap on the beams used (scans are thinned evenly to stay below it), for speed.
+    laser_anchors_only:
+        Cast only the frames the reference is more than odometry at (its SLAM updates,
+        :func:`~slamtrials.calibration.odometry.anchor_frames`). Off by default: the updates of GMapping
+        come when the robot has turned or moved enough, so they over-represent turns (docs/realism.md).
+    windows:
+        Odometry window lengths in segments between anchor frames (every frame, with a true path; the
+        SLAM updates, with a SLAM estimate); windows of each length tile the log without overlap.
+    outlier_sigmas:
+        An odometry window whose error is beyond this many predicted sigmas is left out of the noise fit
+        (and counted as a heavy-tail event).
+    sim_dt:
+        The simulator step (s) the odometry noise coefficients are given for (the model's noise is per
+        step, so its coefficients depend on the step: see docs/realism.md, "Calibration").
+    bootstrap:
+        Bootstrap replicates of the uncertainty (blocks of consecutive frames are resampled).
+    block_frames:
+        Length (frames) of a bootstrap block.
+    min_frames:
+        Fewest frames a log needs.
+    min_distance:
+        Least distance (m) the odometry must travel.
+    min_rotation:
+        Least total rotation (rad) the odometry must turn.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    range_bins: tuple[float, ...] = Field(
+        (0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 15.0, 20.0, 30.0, 50.0, 100.0),
+        description="range bin edges (m)",
+    )
+    min_bin_beams: int = Field(200, ge=20, description="fewest beams per range bin")
+    core_cut: float = Field(2.5, gt=1.0, le=5.0, description="Gaussian core cut (sigmas)")
+    short_sigmas: float = Field(3.0, gt=1.0, le=10.0, description="short-reading threshold (sigmas)")
+    max_beams: int = Field(600_000, ge=1000, description="cap on the beams used")
+    laser_anchors_only: bool = Field(False, description="cast only the reference's update frames")
+    windows: tuple[int, ...] = Field((1, 2, 4, 8, 16, 32), description="odometry window lengths (segments)")
+    outlier_sigmas: float = Field(5.0, gt=2.0, le=20.0, description="odometry outlier threshold (sigmas)")
+    sim_dt: float = Field(0.1, gt=0.0, le=1.0, description="simulator step the odometry noise is given for (s)")
+    bootstrap: int = Field(100, ge=10, le=10_000, description="bootstrap replicates")
+    block_frames: int = Field(64, ge=1, description="bootstrap block length (frames)")
+    min_frames: int = Field(200, ge=10, description="fewest frames")
+    min_distance: float = Field(10.0, gt=0.0, description="least odometry distance (m)")
+    min_rotation: float = Field(6.283185307179586, gt=0.0, description="least odometry rotation (rad)")
+
+    @field_validator("range_bins")
+    @classmethod
+    def _increasing(cls, value: tuple[float, ...]) -> tuple[float, ...]:
+        if len(value) < 3 or any(b <= a for a, b in zip(value, value[1:])) or value[0] < 0.0:
+            raise ValueError(f"range_bins must be at least 3 increasing non-negative edges, got {value}")
+        return value
+
+    @field_validator("windows")
+    @classmethod
+    def _windows(cls, value: tuple[int, ...]) -> tuple[int, ...]:
+        if len(value) < 2 or any(b <= a for a, b in zip(value, value[1:])) or value[0] < 1:
+            raise ValueError(f"windows must be at least 2 increasing lengths >= 1 frame, got {value}")
+        return value

@@ -1,0 +1,192 @@
+"""``slamtrials calibrate``: fit the simulator's error models to a real log and write the profile.
+
+A thin wrapper over :mod:`slamtrials.calibration`: it reads the log, checks that it can be calibrated
+from (before anything runs), runs the SLAM algorithm for the reference, fits, prints the values with
+their uncertainty, and writes the profile YAML (:func:`slamtrials.campaign.profilefile.write_profile`)
+and a PNG page of figures next to it.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import re
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated
+
+import typer
+
+from slamtrials.cli.common import make_console
+from slamtrials.errors import ConfigError
+
+if TYPE_CHECKING:
+    from slamtrials.calibration import Calibration
+
+__all__ = ["calibrate", "register", "format_calibration", "profile_name"]
+
+_COMPRESSED = (".gz", ".bz2")
+
+
+def profile_name(log: Path) -> str:
+    """The profile's name from the log's file name: ``mit-csail.clf`` -> ``mit-csail``,
+    ``fr079.clf.bz2`` -> ``fr079``; characters a profile name does not allow become ``_``."""
+    name = log.name
+    for suffix in _COMPRESSED:
+        name = name.removesuffix(suffix)
+    stem = Path(name).stem or "log"
+    return re.sub(r"[^A-Za-z0-9_.\-]", "_", stem)[:100]
+
+
+def format_calibration(cal: Calibration, log: str) -> str:
+    """The printed fit: the log's residual figures, then every value +- its standard error."""
+    laser, odo = cal.laser, cal.odometry
+    lines = [f"{log}: {cal.frames} frames; reference: {cal.reference}"]
+    lines.append(
+        f"laser: {laser.beams} beams of {cal.laser_frames} frames hit a mapped wall through known free space; "
+        "robust sigma of their residuals "
+        f"{laser.robust_sigma:.4f} m, {100 * laser.off_share:.1f} % off by more than 0.2 m, "
+        f"{100 * laser.no_return_share:.2f} % no return"
+    )
+    value = {v.name: v for v in cal.fitted}
+
+    def row(name: str, note: str = "") -> str:
+        v = value[name]
+        if v.value == 0.0 and not note:
+            note = "  at its bound 0 (the fit would go negative)"
+        return f"  {name:<22} {v.value:>10.5f} +- {v.stderr:<9.5f} {v.unit:<8}{note}".rstrip()
+
+    for name in (
+        "range_noise_std",
+        "range_noise_per_m",
+        "short_rate",
+        "dropout_rate",
+        "dropout_per_m",
+        "dropout_grazing",
+    ):
+        lines.append(row(name))
+    lines.append(
+        f"odometry: {odo.anchors} reference frames beyond odometry, {odo.distance:.1f} m, {odo.rotation:.1f} rad; "
+        f"noise per simulator step of {odo.log_step / odo.step_scale**2:.3g} s (log step {odo.log_step:.3f} s)"
+    )
+    lines.append(row("bias_linear", "  -> bias_linear_range +-|value| (one log is one draw)"))
+    lines.append(row("bias_angular", "  -> bias_angular_range +-|value|"))
+    for name in ("noise_linear_per_m", "noise_linear_per_rad", "noise_angular_per_rad", "noise_angular_per_m"):
+        lines.append(row(name))
+    lines.append(
+        f"  reference's own error at a window's ends (not in the profile): {odo.reference_linear**0.5:.4f} m, "
+        f"{odo.reference_angular**0.5:.4f} rad"
+    )
+    lines.append(
+        f"  slips: not fitted; {odo.heavy_tail} single segments beyond the noise (cannot be told from jumps of the "
+        "reference)"
+    )
+    lines.append(f"+- is one block-bootstrap standard error ({cal.bootstrap} replicates)")
+    return "\n".join(lines)
+
+
+def calibrate(
+    log: Annotated[Path, typer.Argument(help="Real log: CARMEN (.clf/.log, .gz, .bz2), ROS bag or run folder.")],
+    out: Annotated[Path, typer.Option("--out", "-o", help="Profile YAML to write (.yaml or .yml).")],
+    algorithm: Annotated[
+        str, typer.Option("--algorithm", "-a", help="SLAM algorithm whose final path and map are the reference.")
+    ] = "gmapping",
+    preset: Annotated[str | None, typer.Option("--preset", "-p", help="Named parameter set of the algorithm.")] = None,
+    settings: Annotated[
+        list[str] | None, typer.Option("--set", help="Algorithm parameter key=value (value read as YAML); repeatable.")
+    ] = None,
+    seed: Annotated[int, typer.Option("--seed", "-s", help="Seed of the SLAM run and of the bootstrap.")] = 0,
+    bootstrap: Annotated[int, typer.Option("--bootstrap", help="Bootstrap replicates of the uncertainty.")] = 100,
+    figures: Annotated[
+        Path | None, typer.Option("--figures", help="PNG page of figures (default: the profile's path with .png).")
+    ] = None,
+    name: Annotated[str | None, typer.Option("--name", help="Profile name (default: the log's file stem).")] = None,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace an existing profile file.")] = False,
+) -> None:
+    """Fit the simulator's error models (laser noise, short readings, dropouts; odometry biases and noise)
+    to the real log LOG, against a SLAM run's path and map, and write them as an error profile."""
+    from pydantic import ValidationError
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+    from slamtrials.calibration import CalibrationSettings, check_calibratable, slam_reference
+    from slamtrials.calibration import calibrate as fit
+    from slamtrials.cli.slam import parse_settings
+    from slamtrials.errors import CalibrationError, validation_problems
+    from slamtrials.slam import get_algorithm, resolve_config
+    from slamtrials.slamrun import load_recording
+
+    if out.suffix.lower() not in (".yaml", ".yml"):
+        raise ConfigError(f"--out {out}: a profile is a YAML file; give a path ending in .yaml")
+    if out.exists() and not overwrite:
+        raise ConfigError(f"{out}: already exists; choose another --out or pass --overwrite")
+    figure_path = figures if figures is not None else out.with_suffix(".png")
+    if figure_path.suffix.lower() != ".png":
+        raise ConfigError(f"--figures {figure_path}: the page of figures is a PNG; give a path ending in .png")
+    if seed < 0:
+        raise ConfigError(f"--seed must be a non-negative integer, got {seed}")
+    try:
+        cfg = CalibrationSettings(bootstrap=bootstrap)
+    except ValidationError as exc:
+        raise ConfigError("--bootstrap: " + validation_problems(exc)) from None
+    overrides = parse_settings(settings or [])
+    resolve_config(get_algorithm(algorithm), preset=preset, overrides=overrides)  # fail before reading the log
+    record = load_recording(log)
+    try:
+        check_calibratable(
+            record, min_frames=cfg.min_frames, min_distance=cfg.min_distance, min_rotation=cfg.min_rotation
+        )
+    except CalibrationError as exc:
+        raise CalibrationError(f"{log}: {exc}") from None
+    profile_id = name if name is not None else profile_name(log)
+    console = make_console()
+    columns = (TextColumn(f"{algorithm} reference"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
+    with Progress(*columns, console=console, transient=True, disable=not console.is_terminal) as progress:
+        task = progress.add_task("slam", total=len(record))
+        reference = slam_reference(
+            record,
+            algorithm,
+            preset=preset,
+            overrides=overrides,
+            seed=seed,
+            on_frame=lambda k, total: progress.update(task, completed=k + 1),
+        )
+    try:
+        result = fit(record, reference, cfg, seed=seed)
+    except CalibrationError as exc:
+        raise CalibrationError(f"{log}: {exc}") from None
+    today = _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d")
+    description = (
+        f"fitted by slamtrials calibrate on {today} to the log {log.name} against {reference.source}; "
+        "biases as +- the measured per-run bias; noise per simulator step of "
+        f"{cfg.sim_dt:g} s; no slips"
+    )
+    try:
+        profile = result.profile(profile_id, description)
+    except ValidationError as exc:
+        raise ConfigError(f"the fitted profile is not valid: {validation_problems(exc)}") from None
+    from slamtrials.campaign.profilefile import write_profile
+
+    text = format_calibration(result, str(log))
+    write_profile(out, profile, header="\n".join(["slamtrials calibrate " + log.name, *text.splitlines()]))
+    _write_figures(result, figure_path, f"{profile_id}: calibration against {reference.source}")
+    console.print(text, soft_wrap=True, highlight=False)
+    console.print(f"wrote {out} and {figure_path}", soft_wrap=True, highlight=False)
+
+
+def _write_figures(result: Calibration, path: Path, title: str) -> None:
+    import matplotlib.pyplot as plt
+
+    from slamtrials.report.calibration_figures import draw_calibration_page
+
+    fig = plt.figure(figsize=(16, 9.5), layout="constrained")
+    try:
+        draw_calibration_page(fig, result, title=title)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(path.name + ".tmp.png")
+        fig.savefig(tmp, dpi=90)
+        tmp.replace(path)
+    finally:
+        plt.close(fig)
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``calibrate`` command to ``app``."""
+    app.command("calibrate")(calibrate)

@@ -1,0 +1,128 @@
+"""The page of figures of a calibration (``slamtrials calibrate``), drawn on a given matplotlib Figure.
+
+Six panels: the laser residuals, real against the fitted model drawn for the same beams; the noise sigma
+by range bin with the fitted line; short readings and no-returns by range bin, real against fitted; the
+odometry's heading and arc-length errors by window length against the fitted growth; the heading error
+before and after the scale bias.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from slamtrials.calibration import Calibration
+
+__all__ = ["draw_calibration_page"]
+
+
+def _binned_share(ranges, flags, low, high):
+    out = np.full(low.size, np.nan)
+    for i in range(low.size):
+        sel = (ranges >= low[i]) & (ranges < high[i])
+        if sel.any():
+            out[i] = float(np.mean(flags[sel]))
+    return out
+
+
+def draw_calibration_page(fig, calibration: Calibration, title: str = "") -> None:
+    """Draw the six panels of ``calibration`` on ``fig`` (a matplotlib Figure, e.g. 15 x 9 inches)."""
+    cal = calibration
+    axes = fig.subplots(2, 3)
+    bins = cal.laser.bins
+    values = {v.name: v.value for v in cal.fitted}
+
+    ax = axes[0, 0]
+    edges = np.linspace(-1.0, 1.0, 161)
+    back = ~cal.no_return
+    model_back = ~cal.model_no_return
+    ax.hist(np.clip(cal.residuals[back], -1, 1), bins=edges, histtype="step", color="tab:blue", label="real")
+    ax.hist(
+        np.clip(cal.model_residuals[model_back], -1, 1),
+        bins=edges,
+        histtype="step",
+        color="tab:orange",
+        label="fitted model",
+    )
+    ax.set_yscale("log")
+    ax.set_xlabel("reading - cast range (m), clipped to +-1 m")
+    ax.set_ylabel("beams")
+    ax.set_title("laser residuals (beams that returned)")
+    ax.legend(fontsize=8)
+
+    ax = axes[0, 1]
+    width = bins.high - bins.low
+    ax.errorbar(
+        bins.range_mean,
+        bins.sigma,
+        yerr=bins.sigma / np.sqrt(2.0 * bins.beams),
+        fmt="o",
+        color="tab:blue",
+        label="core sigma per range bin",
+    )
+    r = np.linspace(0.0, float(bins.high[-1]), 100)
+    ax.plot(r, values["range_noise_std"] + values["range_noise_per_m"] * r, color="tab:orange", label="fit a + b r")
+    ax.plot(bins.range_mean, bins.centre, "s", color="tab:gray", markersize=3, label="median residual (map offset)")
+    ax.set_xscale("log")
+    ax.set_xlim(max(float(bins.low[0]), 0.1), float(bins.high[-1]))
+    ax.set_xlabel("cast range (m)")
+    ax.set_ylabel("m")
+    ax.set_title("range noise")
+    ax.legend(fontsize=8)
+    del width
+
+    ax = axes[0, 2]
+    model_short = (
+        cal.model_residuals < -3.0 * (values["range_noise_std"] + values["range_noise_per_m"] * cal.no_return_range)
+    ) & model_back
+    ax.plot(bins.range_mean, bins.no_return, "o-", color="tab:blue", label="no return, real")
+    ax.plot(
+        bins.range_mean,
+        _binned_share(cal.no_return_range, cal.model_no_return, bins.low, bins.high),
+        "o--",
+        color="tab:orange",
+        label="no return, fitted",
+    )
+    ax.plot(bins.range_mean, bins.short, "^-", color="tab:green", label="short, real")
+    ax.plot(
+        bins.range_mean,
+        _binned_share(cal.no_return_range, model_short, bins.low, bins.high),
+        "^--",
+        color="tab:red",
+        label="short, fitted",
+    )
+    ax.set_xscale("log")
+    ax.set_xlabel("cast range (m)")
+    ax.set_ylabel("share of beams")
+    ax.set_title("short readings, no returns (at mapped walls)")
+    ax.legend(fontsize=8)
+
+    win = cal.odometry.windows
+    ax = axes[1, 0]
+    ax.plot(win.distance, win.rms_linear, "o", color="tab:blue", label="real (bias removed)")
+    ax.plot(win.distance, win.fit_linear, "-", color="tab:orange", label="fitted model")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("mean distance per window (m)")
+    ax.set_ylabel("RMS arc-length error (m)")
+    ax.set_title("odometry: distance error growth")
+    ax.legend(fontsize=8)
+
+    ax = axes[1, 1]
+    ax.plot(win.distance, win.rms_angular, "o", color="tab:blue", label="real (bias removed)")
+    ax.plot(win.distance, win.raw_angular, "x", color="tab:gray", label="real (bias in)")
+    ax.plot(win.distance, win.fit_angular, "-", color="tab:orange", label="fitted model")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("mean distance per window (m)")
+    ax.set_ylabel("RMS heading error (rad)")
+    ax.set_title("odometry: heading error growth")
+    ax.legend(fontsize=8)
+
+    ax = axes[1, 2]
+    ax.axis("off")
+    lines = [f"{v.name} = {v.value:.4g} +- {v.stderr:.2g} {v.unit}".rstrip() for v in cal.fitted]
+    lines.append(f"(+- one block-bootstrap standard error, {cal.bootstrap} replicates)")
+    lines.append(f"reference: {cal.reference}")
+    ax.text(0.0, 1.0, "\n".join(lines), va="top", family="monospace", fontsize=7, wrap=True)
+    if title:
+        fig.suptitle(title)

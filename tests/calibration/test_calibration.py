@@ -1,0 +1,140 @@
+"""The calibration recovers known error-model values from a simulated recording (the truth as reference),
+turns them into a valid profile, and refuses logs it cannot calibrate from."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from slamtrials.calibration import CalibrationSettings, Reference, calibrate, check_calibratable
+from slamtrials.calibration.odometry import anchor_frames, step_motion
+from slamtrials.calibration.stats import central_sigma, nonnegative_least_squares, shortest_interval
+from slamtrials.campaign.profilefile import read_profile, write_profile
+from slamtrials.errors import CalibrationError
+from slamtrials.sim.config import LaserConfig, OdometryConfig, SimConfig
+from slamtrials.sim.tour import tour_waypoints
+from slamtrials.sim.waypoints import simulate_waypoints
+from slamtrials.worlds import load_world
+
+#: The known values: every laser and odometry error model on, at sizes unlike each other.
+LASER = {
+    "range_noise_std": 0.02,
+    "range_noise_per_m": 0.01,
+    "short_rate": 0.08,
+    "dropout_rate": 0.02,
+    "dropout_per_m": 0.004,
+    "dropout_grazing": 0.1,
+}
+ODOMETRY = {
+    "bias_linear": 0.03,
+    "bias_angular": -0.08,
+    "noise_linear_per_m": 0.05,
+    "noise_angular_per_rad": 0.1,
+    "noise_linear_per_rad": 0.01,
+    "noise_angular_per_m": 0.02,
+}
+
+
+@pytest.fixture(scope="module")
+def simulated():
+    world = load_world("office_small_01")
+    config = SimConfig(laser=LaserConfig(**LASER), odometry=OdometryConfig(**ODOMETRY))
+    record = simulate_waypoints(world, tour_waypoints(world, num_goals=6), config, seed=5, max_time=600)
+    assert record.metadata["outcome"] == "completed"
+    return world, record
+
+
+@pytest.fixture(scope="module")
+def fitted(simulated):
+    world, record = simulated
+    reference = Reference.from_world(record.truth, world, "simulation truth")
+    return calibrate(record, reference, CalibrationSettings(bootstrap=30), seed=1)
+
+
+@pytest.mark.parametrize("name", [*LASER, *ODOMETRY])
+def test_fit_recovers_each_known_value_within_its_stated_uncertainty(fitted, name):
+    value = fitted.value(name)
+    truth = {**LASER, **ODOMETRY}[name]
+    # the stated uncertainty is one bootstrap standard error; the 95 % interval is two
+    assert abs(value.value - truth) <= 2.0 * value.stderr, (value, truth)
+    # and it is an uncertainty worth stating: well below the value itself
+    assert 0.0 < value.stderr < 0.25 * abs(truth), value
+
+
+def test_fit_reports_the_residual_figures_of_the_simulated_laser(fitted):
+    laser = fitted.laser
+    assert laser.beams > 100_000
+    # the no-return share is the dropout model's average, less the short readings that replace it
+    assert 0.02 < laser.no_return_share < 0.08
+    assert laser.bins.sigma[0] < laser.bins.sigma[-1]  # noise grows with range
+    # the map is the true world and the path the true one: no offset, no error of the reference
+    assert np.all(np.abs(laser.bins.centre) < 0.01)
+    assert fitted.odometry.reference_linear < 1e-4 and fitted.odometry.reference_angular < 1e-4
+
+
+def test_profile_holds_the_fit_with_symmetric_bias_ranges_and_round_trips(fitted, tmp_path):
+    profile = fitted.profile("sim-test", "fitted to a simulated tour")
+    lin, ang = abs(fitted.value("bias_linear").value), abs(fitted.value("bias_angular").value)
+    assert profile.odometry["bias_linear_range"] == pytest.approx((-lin, lin))
+    assert profile.odometry["bias_angular_range"] == pytest.approx((-ang, ang))
+    assert profile.laser["range_noise_std"] == pytest.approx(fitted.value("range_noise_std").value)
+    assert "slip_per_m" not in profile.odometry
+    write_profile(tmp_path / "p.yaml", profile, header="test")
+    assert read_profile(tmp_path / "p.yaml") == profile
+    config = SimConfig(profile=profile)  # a simulator takes it
+    assert config.laser.short_rate == pytest.approx(fitted.value("short_rate").value)
+
+
+def test_anchor_frames_skip_frames_the_reference_carries_by_odometry(simulated):
+    _, record = simulated
+    reference = record.truth.copy()
+    # a SLAM-like reference: between updates every 5 frames, it moves with the odometry
+    for k in range(1, len(record)):
+        if k % 5:
+            from slamtrials.geometry import compose, ominus
+
+            reference[k] = compose(reference[k - 1], ominus(record.odometry[k - 1], record.odometry[k]))
+    anchors = anchor_frames(reference, record.odometry)
+    assert anchors[0] == 0
+    assert set(anchors[1:].tolist()) <= set(range(0, len(record), 5))
+    steps = step_motion(reference, record.odometry)
+    carried = np.setdiff1d(np.arange(1, len(record)), anchors)
+    np.testing.assert_allclose(steps.odo_turn[carried - 1], steps.turn[carried - 1], atol=1e-9)
+
+
+def test_too_short_or_motionless_logs_are_refused(simulated):
+    _, record = simulated
+    from dataclasses import replace
+
+    short = replace(
+        record,
+        t=record.t[:50],
+        scans=record.scans[:50],
+        odometry=record.odometry[:50],
+        truth=record.truth[:50],
+        stalled=record.stalled[:50],
+    )
+    with pytest.raises(CalibrationError, match="at least 200"):
+        check_calibratable(short, min_frames=200, min_distance=10.0, min_rotation=6.3)
+    still = replace(record, odometry=np.zeros_like(record.odometry))
+    with pytest.raises(CalibrationError, match="no odometry"):
+        check_calibratable(still, min_frames=200, min_distance=10.0, min_rotation=6.3)
+
+
+def test_robust_estimators_find_the_gaussian_core_among_one_sided_outliers():
+    rng = np.random.default_rng(0)
+    core = rng.normal(0.03, 0.05, 4000)
+    outliers = -rng.uniform(0.0, 8.0, 6000)  # 60 % short readings: the median and the MAD are lost
+    values = np.concatenate([core, outliers])
+    centre, sigma = shortest_interval(values)
+    assert abs(centre - 0.03) < 0.02 and 0.02 < sigma < 0.2  # a start: wide when the core is under half
+    centre, sigma, _ = central_sigma(values)
+    assert centre == pytest.approx(0.03, abs=0.01)
+    assert sigma == pytest.approx(0.05, rel=0.1)
+
+
+def test_nonnegative_least_squares_drops_a_column_that_would_go_negative():
+    x = np.linspace(0.0, 1.0, 50)
+    y = 2.0 + 0.0 * x - 0.3 * x  # the unconstrained slope is negative
+    a, b = nonnegative_least_squares([np.ones_like(x), x], y)
+    assert b == 0.0 and a == pytest.approx(float(np.mean(y)))

@@ -148,3 +148,11 @@ def test_bundled_paper_profile_is_the_configs_defaults():
     defaults = SimConfig()
     assert paper.laser_values() == {name: getattr(defaults.laser, name) for name in paper.laser_values()}
     assert paper.odometry_values() == {name: getattr(defaults.odometry, name) for name in paper.odometry_values()}
+
+
+def test_realistic_is_the_mean_laser_fit_and_mit_csails_odometry():
+    mit, fr079, realistic = (BUNDLED_PROFILES[name] for name in ("mit-csail", "fr079", "realistic"))
+    for name, value in realistic.laser_values().items():
+        assert value == pytest.approx(0.5 * (mit.laser_values()[name] + fr079.laser_values()[name]), abs=1e-6)
+    assert realistic.odometry_values() == mit.odometry_values()
+    assert SimConfig(profile="realistic").laser.short_rate == realistic.laser["short_rate"]

@@ -15,10 +15,14 @@ Bundled:
 
 ``mit-csail``, ``fr079``
     Fitted by ``slamtrials calibrate`` to the shared real logs (MIT CSAIL with GMapping's defaults;
-    fr079 with the GMapping settings that map it: ``particles=100 srt=0.4 stt=0.4 lstep=0.1 astep=0.1``,
-    seed 2), against GMapping's final path and map. The values are the printed fit rounded to four
+    fr079 with the GMapping setting that maps it, ``linearUpdate=0.1``, seed 0), against GMapping's
+    final path and map. The values are the printed fit rounded to four
     significant digits; docs/realism.md, "Calibration", has the method, the uncertainties and what the
     values include besides the sensors' own errors (the reference is itself a SLAM estimate).
+
+``realistic``
+    The laser of both fits averaged field by field and MIT CSAIL's odometry (fr079's odometry logs
+    reversing as driving forward, a defect no model should copy): see :func:`_realistic`.
 
 Profiles fitted to real logs (``slamtrials calibrate``) are YAML files of the same form; the config
 loaders (campaign config, ``--config`` of the CLI) read a ``profile`` that is a path to such a file.
@@ -69,27 +73,48 @@ BUNDLED_PROFILES: dict[str, ErrorProfile] = {
     "fr079": ErrorProfile(
         name="fr079",
         description="fitted by slamtrials calibrate (2026-11-24) to the shared fr079 log against GMapping's final "
-        "path and map (particles=100, srt=0.4, stt=0.4, lstep=0.1, astep=0.1, seed 2: GMapping's defaults do not "
-        "map fr079); biases +- the measured per-run bias; noise per simulator step of 0.1 s; no slips "
+        "path and map (linearUpdate=0.1, seed 0: GMapping's defaults do not map fr079, docs/real-datasets.md); "
+        "biases +- the measured per-run bias; noise per simulator step of 0.1 s; no slips "
         "(docs/realism.md, Calibration)",
         laser={
-            "range_noise_std": 0.04628,
-            "range_noise_per_m": 0.001680,
-            "short_rate": 0.1915,
-            "dropout_rate": 0.02248,
+            "range_noise_std": 0.03259,
+            "range_noise_per_m": 0.002105,
+            "short_rate": 0.09754,
+            "dropout_rate": 0.01861,
             "dropout_per_m": 0.0,
-            "dropout_grazing": 0.01286,
+            "dropout_grazing": 0.01696,
         },
         odometry={
-            "bias_linear_range": (-0.01750, 0.01750),
-            "bias_angular_range": (-0.03592, 0.03592),
-            "noise_linear_per_m": 0.2510,
-            "noise_linear_per_rad": 0.8457,
-            "noise_angular_per_rad": 0.4343,
-            "noise_angular_per_m": 0.2282,
+            "bias_linear_range": (-0.007886, 0.007886),
+            "bias_angular_range": (-0.008691, 0.008691),
+            "noise_linear_per_m": 0.0,
+            "noise_linear_per_rad": 0.8198,
+            "noise_angular_per_rad": 0.4064,
+            "noise_angular_per_m": 0.08722,
         },
     ),
 }
+
+
+def _realistic(mit: ErrorProfile, fr079: ErrorProfile) -> ErrorProfile:
+    """``realistic``: the laser of both fitted logs averaged field by field, the odometry of MIT CSAIL's.
+
+    Both logs were recorded with SICK laser scanners in office buildings, so their laser fits are two
+    samples of one kind of sensor in one kind of place. fr079's odometry is not a model to copy: it logs
+    reversing as driving forward (docs/real-datasets.md), which its fit absorbs as huge noise per radian
+    and per metre; MIT CSAIL's odometry has no such defect.
+    """
+    laser = {name: 0.5 * (mit.laser_values()[name] + fr079.laser_values()[name]) for name in mit.laser_values()}
+    return ErrorProfile(
+        name="realistic",
+        description="the mean of the mit-csail and fr079 laser fits and the mit-csail odometry fit "
+        "(docs/realism.md, Profiles)",
+        laser={name: round(value, 6) for name, value in laser.items()},
+        odometry=dict(mit.odometry),
+    )
+
+
+BUNDLED_PROFILES["realistic"] = _realistic(BUNDLED_PROFILES["mit-csail"], BUNDLED_PROFILES["fr079"])
 
 
 def resolve_profile(value: str | dict[str, Any] | ErrorProfile) -> ErrorProfile:

@@ -11,7 +11,7 @@ from slamtrials.errors import ConfigError, FormatError
 from slamtrials.trial import TrialConfig
 
 
-def test_defaults_are_the_papers():
+def test_defaults_are_the_papers_but_the_error_profile():
     config = CampaignConfig(worlds=["office_small_01"])
     assert config.runs.initial == 10 and config.runs.max_runs >= 10
     assert config.metric.pilot == 500 and config.metric.confidence == 0.99
@@ -21,7 +21,11 @@ def test_defaults_are_the_papers():
     paper = CampaignConfig.from_dict({"worlds": ["office_small_01"], "metric": {"rule": "paper"}}).metric
     assert paper.margin_t == 0.02 and paper.margin_r == 0.02 and paper.relative_margin is None
     assert config.runs.margin_t == 0.02 and config.runs.margin_r == 0.02
-    assert config.trial_config() == TrialConfig()
+    # the simulated sensors: the realistic error profile (docs/realism.md), everything else the paper's
+    assert config.sim.profile_name == "realistic" and config.sim.laser.short_rate > 0
+    assert config.trial_config().model_copy(update={"sim": TrialConfig().sim}) == TrialConfig()
+    paper = CampaignConfig.from_dict({"worlds": ["office_small_01"], "sim": {"profile": "paper"}})
+    assert paper.trial_config() == TrialConfig()
     assert config.seed == 0 and config.output is None
 
 

@@ -96,7 +96,7 @@ def test_differences_list_exactly_the_changed_settings(rooms):
     b = CampaignConfig.from_dict(data)
     assert [str(d) for d in setting_differences(a, b)] == [
         "metric.relative_margin: 0.01 -> 0.02",
-        "sim.odometry.noise_linear_per_m: 0.0 -> 0.02",
+        f"sim.odometry.noise_linear_per_m: {a.sim.odometry.noise_linear_per_m} -> 0.02",
     ]
     assert setting_differences(a, a) == []
     # another algorithm: the parameters are not resolved (they are not comparable), only the overrides

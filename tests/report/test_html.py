@@ -123,7 +123,7 @@ def test_report_page_has_table_one_and_every_figure(campaign, report):
     rows = page.tables["summary-table"]
     assert [r[0] for r in rows] == WORLDS  # one row per world, in campaign order, failed one included
     text = path.read_text(encoding="utf-8")
-    assert "error profile paper" in text and "precise rule: pilot 500" in text and "final SLAM estimate" in text
+    assert "error profile realistic" in text and "precise rule: pilot 500" in text and "final SLAM estimate" in text
     for row, (_, world) in zip(rows, data.worlds.iterrows(), strict=True):
         assert row[1] == world["status"]
         if world["runs_done"]:

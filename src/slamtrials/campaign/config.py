@@ -29,12 +29,23 @@ from slamtrials.metric.runcount import DEFAULT_MIN_RUNS
 from slamtrials.sim import SimConfig
 from slamtrials.trial import SlamSettings, TrialConfig
 
-__all__ = ["CampaignConfig", "MetricSettings", "RunSettings", "DEFAULT_MAX_RUNS", "RUN_TOLERANCE", "MAX_SEED"]
+__all__ = [
+    "CampaignConfig",
+    "MetricSettings",
+    "RunSettings",
+    "DEFAULT_MAX_RUNS",
+    "RUN_TOLERANCE",
+    "MAX_SEED",
+    "CAMPAIGN_PROFILE",
+]
 
 _MODEL_CONFIG = ConfigDict(extra="forbid", frozen=True)
 
 #: Smallest ``runs.initial`` of a new campaign (a stored one of an earlier version keeps its own).
 MIN_INITIAL_RUNS = 5
+#: Error profile of a new campaign that names none (docs/realism.md: validated against real logs); the
+#: simulator's own default, and that of campaigns stored by earlier versions, stays ``paper``.
+CAMPAIGN_PROFILE = "realistic"
 #: Default cap on the runs of one world.
 DEFAULT_MAX_RUNS = 60
 #: Largest root seed (seeds are stored as SQLite 64-bit signed integers).
@@ -136,6 +147,9 @@ def _beside(folder: Path, entry: Any) -> Any:
 def upgrade_stored_config(doc: dict[str, Any]) -> dict[str, Any]:
     """A stored campaign config's JSON form, as this version writes it (a copy; ``doc`` is not changed)."""
     doc = copy.deepcopy(doc)
+    sim = doc.get("sim")
+    if isinstance(sim, dict) and "profile" not in sim:
+        sim["profile"] = "paper"  # earlier versions had only the paper's error models
     metric = doc.get("metric")
     if isinstance(metric, dict) and "rule" not in metric:
         metric["rule"] = "paper"  # earlier versions knew only the paper's absolute margins
@@ -171,7 +185,10 @@ class CampaignConfig(BaseModel):
     model_config = _MODEL_CONFIG
 
     worlds: list[str] = Field(min_length=1, description="bundled world names, floor-plan files or folders of them")
-    sim: SimConfig = Field(default_factory=SimConfig, description="simulated robot, laser and odometry")
+    sim: SimConfig = Field(
+        default_factory=lambda: SimConfig(profile=CAMPAIGN_PROFILE),
+        description="simulated robot, laser and odometry (error profile realistic unless named)",
+    )
     slam: SlamSettings = Field(default_factory=SlamSettings, description="the SLAM algorithm under test")
     explore: ExploreConfig = Field(
         default_factory=ExploreConfig, description="frontier explorer (its robot limits come from sim)"
@@ -189,6 +206,16 @@ class CampaignConfig(BaseModel):
     replay_of: str | None = Field(
         None, description="set by 'campaign replay': the campaign whose recorded runs are re-evaluated"
     )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _realistic_unless_named(cls, data: Any, info: ValidationInfo) -> Any:
+        # a new campaign's sim section without a profile gets the campaign default; a stored one was
+        # made with the simulator's own default (paper) and upgrade_stored_config says so explicitly
+        if isinstance(data, dict) and isinstance(data.get("sim"), dict) and "profile" not in data["sim"]:
+            if not (info.context or {}).get("stored"):
+                data = {**data, "sim": {**data["sim"], "profile": CAMPAIGN_PROFILE}}
+        return data
 
     @model_validator(mode="after")
     def _worlds_not_blank(self) -> CampaignConfig:

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from slamtrials.calibration import CalibrationSettings, Reference, calibrate, check_calibratable
-from slamtrials.calibration.odometry import anchor_frames, step_motion
+from slamtrials.calibration.odometry import anchor_frames, fit_odometry, step_motion
 from slamtrials.calibration.stats import central_sigma, nonnegative_least_squares, shortest_interval
 from slamtrials.campaign.profilefile import read_profile, write_profile
 from slamtrials.errors import CalibrationError
@@ -138,3 +138,44 @@ def test_nonnegative_least_squares_drops_a_column_that_would_go_negative():
     y = 2.0 + 0.0 * x - 0.3 * x  # the unconstrained slope is negative
     a, b = nonnegative_least_squares([np.ones_like(x), x], y)
     assert b == 0.0 and a == pytest.approx(float(np.mean(y)))
+
+
+def _reversed_spans(record, spans):
+    """The record's odometry with the translation of every step inside ``spans`` negated (reversing logged
+    as driving forward, or the other way round, as in fr079), composed from the first pose."""
+    from slamtrials.geometry import compose1, ominus1
+
+    odometry = record.odometry
+    flipped = np.empty_like(odometry)
+    flipped[0] = odometry[0]
+    for k in range(1, len(record)):
+        step = ominus1(odometry[k - 1], odometry[k])
+        if any(a <= k < b for a, b in spans):
+            step = np.array([-step[0], -step[1], step[2]])
+        flipped[k] = compose1(flipped[k - 1], step)
+    return flipped
+
+
+def test_odometry_that_moves_against_the_reference_is_left_out_not_fitted_as_noise(simulated, fitted):
+    _, record = simulated
+    spans = [(int(a), int(a) + 25) for a in np.linspace(50, len(record) - 80, 6)]
+    defect = _reversed_spans(record, spans)
+    steps = step_motion(record.truth, defect)
+    anchors = anchor_frames(record.truth, defect)
+    log_step = float(np.median(np.diff(record.t)))
+    kept = fit_odometry(steps, anchors, CalibrationSettings(), log_step)
+    assert kept is not None
+    moving = np.abs(step_motion(record.truth, record.odometry).length) >= 0.02
+    inside = np.zeros(len(record) - 1, dtype=bool)
+    for a, b in spans:
+        inside[a - 1 : b - 1] = True
+    assert kept.conflicts == np.count_nonzero(moving & inside) > 60
+    for name in ("noise_linear_per_m", "noise_linear_per_rad", "noise_angular_per_rad", "noise_angular_per_m"):
+        clean = fitted.value(name)
+        assert abs(kept.values[name] - clean.value) <= 2.0 * clean.stderr, (name, kept.values[name], clean)
+    # the same defect fitted as noise: the linear noise grows many times
+    absorbed = fit_odometry(steps, anchors, CalibrationSettings(direction_min_step=1.0), log_step)
+    assert absorbed is not None and absorbed.conflicts == 0
+    assert absorbed.values["noise_linear_per_m"] + absorbed.values["noise_linear_per_rad"] > 3.0 * (
+        kept.values["noise_linear_per_m"] + kept.values["noise_linear_per_rad"]
+    )

@@ -65,6 +65,26 @@ def test_simulate_path_reproduces_the_simulators_frames(drive):
     assert replayed.laser == driven.laser
 
 
+def test_simulate_path_draws_the_same_odometry_noise_per_metre_whatever_the_frame_rate():
+    """The profile's noise is per simulator step (0.1 s); a log's path replayed at 0.4 s steps must not
+    accumulate more of it: the arc-length error over 10 m has the same spread at both rates."""
+    world = _world()
+    only_noise = ErrorProfile(
+        name="n",
+        odometry={"noise_linear_per_m": 0.05, "bias_linear_range": (0.0, 0.0), "bias_angular_range": (0.0, 0.0)},
+    )
+    config = SimConfig.from_dict({"profile": only_noise, "laser": {"fov": 0.2, "angular_resolution": 0.1}})
+    spreads = {}
+    for step in (0.1, 0.4):
+        t = np.arange(0.0, 20.0 + 1e-9, step)
+        path = np.column_stack([1.0 + 0.25 * t, np.full(t.size, 1.5), np.zeros(t.size)])  # 0.25 m/s for 5 m
+        ends = [simulate_path(world, t, path, config, seed).odometry[-1, 0] for seed in range(300)]
+        spreads[step] = float(np.std(ends, ddof=1))
+    # per 0.1 s step: std 0.05 * 0.025 m, 200 steps -> 0.05 * 0.025 * sqrt(200) = 0.0177 m
+    assert spreads[0.1] == pytest.approx(0.0177, rel=0.15)
+    assert spreads[0.4] == pytest.approx(spreads[0.1], rel=0.2)
+
+
 def test_simulate_path_refuses_bad_paths(drive):
     world, config, driven = drive
     from slamtrials.errors import SimulationError

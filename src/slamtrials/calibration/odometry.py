@@ -39,6 +39,7 @@ __all__ = [
     "StepMotion",
     "step_motion",
     "anchor_frames",
+    "direction_conflicts",
     "OdometryFit",
     "OdometryWindows",
     "fit_odometry",
@@ -140,6 +141,11 @@ class OdometryFit:
         Frames the windows run between (:func:`anchor_frames`).
     heavy_tail:
         Single segments whose heading error is beyond ``outlier_sigmas`` predicted sigmas (slip candidates).
+    conflicts:
+        Segments where the odometry and the reference travel in opposite directions
+        (:func:`direction_conflicts`); every window holding one is left out of the fit.
+    conflict_distance:
+        The reference's absolute arc length over those segments (m).
     windows:
         The per-length table.
     """
@@ -153,6 +159,8 @@ class OdometryFit:
     rotation: float
     anchors: int
     heavy_tail: int
+    conflicts: int
+    conflict_distance: float
     windows: OdometryWindows
 
 
@@ -178,6 +186,26 @@ def anchor_frames(reference: NDArray[np.float64], odometry: NDArray[np.float64])
     d[:, 2] = (d[:, 2] + np.pi) % (2.0 * np.pi) - np.pi
     moved = np.max(np.abs(d), axis=1) > 1e-6
     return np.concatenate(([0], np.flatnonzero(moved) + 1)).astype(np.int64)
+
+
+def direction_conflicts(steps: StepMotion, anchors: NDArray[np.int64], min_step: float) -> NDArray[np.bool_]:
+    """``[A - 1]``: anchor-to-anchor segments where the odometry and the reference move in opposite directions.
+
+    A segment is a conflict when its odometry arc length and its reference arc length have opposite signs
+    and both are at least ``min_step`` (m) long. No odometry noise model turns driving backwards into
+    driving forwards: this is a recording defect (fr079 logs reversing as driving forward,
+    docs/real-datasets.md), and a fit that kept it would read it as huge noise per metre and per radian.
+    """
+    length = _sums(steps.length, anchors, 1, 1)
+    odo_length = _sums(steps.odo_length, anchors, 1, 1)
+    return (length * odo_length < 0.0) & (np.abs(length) >= min_step) & (np.abs(odo_length) >= min_step)
+
+
+def _clean_windows(conflicts: NDArray[np.bool_], w: int, stride: int) -> NDArray[np.bool_]:
+    """Which windows of ``w`` segments (starting every ``stride``, as :func:`_sums`) hold no conflict."""
+    cum = np.concatenate(([0], np.cumsum(conflicts.astype(np.int64))))
+    starts = np.arange(0, conflicts.size + 1 - w, stride)
+    return cum[starts + w] - cum[starts] == 0
 
 
 def _slope(error: NDArray[np.float64], motion: NDArray[np.float64], weight: NDArray[np.float64]) -> float:
@@ -258,16 +286,19 @@ def fit_odometry(
     """Fit biases and noise to ``steps`` over windows between ``anchors`` (:func:`anchor_frames`).
 
     ``frame_weight`` ``[T]`` weighs each window by the weight of its first frame (bootstrap
-    multiplicities). Window lengths with fewer than four windows are left out; None when fewer than three
-    lengths are left.
+    multiplicities). Windows that hold a direction conflict (:func:`direction_conflicts`, segments of at
+    least ``settings.direction_min_step``) are left out. Window lengths with fewer than four clean windows
+    are left out; None when fewer than three lengths are left.
     """
     segments = anchors.size - 1
-    lengths = [w for w in settings.windows if segments >= 4 * w]  # at least four windows of each length
+    conflicts = direction_conflicts(steps, anchors, settings.direction_min_step)
+    clean = {w: _clean_windows(conflicts, w, w) for w in settings.windows if segments >= w}
+    lengths = [w for w in clean if np.count_nonzero(clean[w]) >= 4]  # at least four windows of each length
     if len(lengths) < 3:
         return None
     weight_of = np.ones(anchors[-1] + 1) if frame_weight is None else frame_weight
     mid = lengths[len(lengths) // 2]
-    wb = weight_of[anchors[: segments - mid + 1]]
+    wb = weight_of[anchors[: segments - mid + 1]] * _clean_windows(conflicts, mid, 1)
     ref_l, ref_t = _sums(steps.length, anchors, mid, 1), _sums(steps.turn, anchors, mid, 1)
     bias_lin = _slope(_sums(steps.odo_length, anchors, mid, 1) - ref_l, ref_l, wb)
     bias_ang = _slope(_sums(steps.odo_turn, anchors, mid, 1) - ref_t, ref_t, wb)
@@ -277,13 +308,14 @@ def fit_odometry(
     step_tt = (steps.odo_turn / (1.0 + bias_ang)) ** 2
     parts: dict[str, list[NDArray[np.float64]]] = {k: [] for k in ("el", "ea", "ll", "tt", "w", "len", "l", "t", "raw")}
     for w in lengths:
-        ref_l, ref_t = _sums(steps.length, anchors, w, w), _sums(steps.turn, anchors, w, w)
-        parts["el"].append(_sums(steps.odo_length, anchors, w, w) - (1.0 + bias_lin) * ref_l)
-        parts["ea"].append(_sums(steps.odo_turn, anchors, w, w) - (1.0 + bias_ang) * ref_t)
-        parts["raw"].append(_sums(steps.odo_turn, anchors, w, w) - ref_t)
-        parts["ll"].append(_sums(step_ll, anchors, w, w))
-        parts["tt"].append(_sums(step_tt, anchors, w, w))
-        parts["w"].append(weight_of[anchors[np.arange(0, segments - w + 1, w)]])
+        keep = clean[w]
+        ref_l, ref_t = _sums(steps.length, anchors, w, w)[keep], _sums(steps.turn, anchors, w, w)[keep]
+        parts["el"].append(_sums(steps.odo_length, anchors, w, w)[keep] - (1.0 + bias_lin) * ref_l)
+        parts["ea"].append(_sums(steps.odo_turn, anchors, w, w)[keep] - (1.0 + bias_ang) * ref_t)
+        parts["raw"].append(_sums(steps.odo_turn, anchors, w, w)[keep] - ref_t)
+        parts["ll"].append(_sums(step_ll, anchors, w, w)[keep])
+        parts["tt"].append(_sums(step_tt, anchors, w, w)[keep])
+        parts["w"].append(weight_of[anchors[np.arange(0, segments - w + 1, w)]][keep])
         parts["len"].append(np.full(ref_l.size, float(w)))
         parts["l"].append(np.abs(ref_l))
         parts["t"].append(np.abs(ref_t))
@@ -296,8 +328,8 @@ def fit_odometry(
     ang, keep_a = _noise_fit(cat["ea"], cat["tt"], cat["ll"], cat["w"], cat["len"], cut)
     for _ in range(3):  # the squared step motions without the fitted noise's share, and the fits again
         clean_ll, clean_tt = _without_noise(step_ll, step_tt, lin, ang, bias_lin, bias_ang)
-        cat["ll"] = np.concatenate([_sums(clean_ll, anchors, w, w) for w in lengths])
-        cat["tt"] = np.concatenate([_sums(clean_tt, anchors, w, w) for w in lengths])
+        cat["ll"] = np.concatenate([_sums(clean_ll, anchors, w, w)[clean[w]] for w in lengths])
+        cat["tt"] = np.concatenate([_sums(clean_tt, anchors, w, w)[clean[w]] for w in lengths])
         lin, keep_l = _noise_fit(cat["el"], cat["ll"], cat["tt"], cat["w"], cat["len"], cut)
         ang, keep_a = _noise_fit(cat["ea"], cat["tt"], cat["ll"], cat["w"], cat["len"], cut)
     scale = math.sqrt(log_step / settings.sim_dt)
@@ -341,5 +373,7 @@ def fit_odometry(
         rotation=float(np.sum(np.abs(steps.turn))),
         anchors=int(anchors.size),
         heavy_tail=int(np.count_nonzero(single & ~keep_a)),
+        conflicts=int(np.count_nonzero(conflicts)),
+        conflict_distance=float(np.sum(np.abs(_sums(steps.length, anchors, 1, 1))[conflicts])),
         windows=OdometryWindows(*(table[:, i].copy() for i in range(table.shape[1]))),
     )

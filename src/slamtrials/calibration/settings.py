@@ -32,6 +32,10 @@ class CalibrationSettings(BaseModel):
     outlier_sigmas:
         An odometry window whose error is beyond this many predicted sigmas is left out of the noise fit
         (and counted as a heavy-tail event).
+    direction_min_step:
+        Odometry segments where the odometry and the reference move at least this far (m) in opposite
+        directions are a recording defect, not noise; every window holding one is left out
+        (:func:`~slamtrials.calibration.odometry.direction_conflicts`).
     sim_dt:
         The simulator step (s) the odometry noise coefficients are given for (the model's noise is per
         step, so its coefficients depend on the step: see docs/realism.md, "Calibration").
@@ -60,6 +64,9 @@ class CalibrationSettings(BaseModel):
     laser_anchors_only: bool = Field(False, description="cast only the reference's update frames")
     windows: tuple[int, ...] = Field((1, 2, 4, 8, 16, 32), description="odometry window lengths (segments)")
     outlier_sigmas: float = Field(5.0, gt=2.0, le=20.0, description="odometry outlier threshold (sigmas)")
+    direction_min_step: float = Field(
+        0.02, gt=0.0, le=1.0, description="least opposite travel of a direction conflict (m)"
+    )
     sim_dt: float = Field(0.1, gt=0.0, le=1.0, description="simulator step the odometry noise is given for (s)")
     bootstrap: int = Field(100, ge=10, le=10_000, description="bootstrap replicates")
     block_frames: int = Field(64, ge=1, description="bootstrap block length (frames)")

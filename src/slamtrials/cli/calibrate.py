@@ -67,6 +67,11 @@ def format_calibration(cal: Calibration, log: str) -> str:
         f"odometry: {odo.anchors} reference frames beyond odometry, {odo.distance:.1f} m, {odo.rotation:.1f} rad; "
         f"noise per simulator step of {odo.log_step / odo.step_scale**2:.3g} s (log step {odo.log_step:.3f} s)"
     )
+    if odo.conflicts:
+        lines.append(
+            f"  left out: {odo.conflicts} segments ({odo.conflict_distance:.1f} m) where the odometry moves against "
+            "the reference (a recording defect, e.g. reversing logged as driving forward), and every window holding one"
+        )
     lines.append(row("bias_linear", "  -> bias_linear_range +-|value| (one log is one draw)"))
     lines.append(row("bias_angular", "  -> bias_angular_range +-|value|"))
     for name in ("noise_linear_per_m", "noise_linear_per_rad", "noise_angular_per_rad", "noise_angular_per_m"):

@@ -117,8 +117,13 @@ class Odometry:
         self.rng = rng
         self.pose: NDArray[np.float64] = np.zeros(3)
 
-    def update(self, delta: ArrayLike) -> NDArray[np.float64]:
+    def update(self, delta: ArrayLike, noise_scale: float = 1.0) -> NDArray[np.float64]:
         """Add the measurement of the true step ``delta`` (``[3]``, robot frame) and return the new pose.
+
+        ``noise_scale`` multiplies the random noise's standard deviations (not the bias, not the slips):
+        the coefficients hold for a step of the config's ``dt``, and a step of another length ``h`` needs
+        them times ``sqrt(dt / h)`` for the noise to grow alike along the same path
+        (:func:`~slamtrials.sim.pathreplay.simulate_path`).
 
         Draws, in this order and only for the models that are on: one normal deviate for the arc length
         (``noise_linear_per_m`` or ``noise_linear_per_rad`` > 0; std ``noise_linear_per_m * L``, or
@@ -133,9 +138,11 @@ class Odometry:
         phi = abs(float(delta[2]))
         length = math.hypot(delta[0], delta[1]) / sinc(0.5 * float(delta[2]))
         if cfg.noise_linear_per_m > 0.0 or cfg.noise_linear_per_rad > 0.0:
-            n_lin = float(self.rng.normal(0.0, _std(cfg.noise_linear_per_m * length, cfg.noise_linear_per_rad * phi)))
+            std = _std(cfg.noise_linear_per_m * length, cfg.noise_linear_per_rad * phi)
+            n_lin = float(self.rng.normal(0.0, std * noise_scale))
         if cfg.noise_angular_per_rad > 0.0 or cfg.noise_angular_per_m > 0.0:
-            n_ang = float(self.rng.normal(0.0, _std(cfg.noise_angular_per_rad * phi, cfg.noise_angular_per_m * length)))
+            std = _std(cfg.noise_angular_per_rad * phi, cfg.noise_angular_per_m * length)
+            n_ang = float(self.rng.normal(0.0, std * noise_scale))
         if cfg.slip_per_m > 0.0:
             slips = float(self.rng.random()) < cfg.slip_per_m * length
             slip_lin = float(self.rng.normal(0.0, cfg.slip_linear_std))

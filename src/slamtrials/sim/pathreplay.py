@@ -9,6 +9,8 @@ real run is replicated in the simulator (:mod:`slamtrials.validation`).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -22,6 +24,11 @@ from slamtrials.sim.simulator import as_generator
 from slamtrials.worlds.world import World
 
 __all__ = ["simulate_path"]
+
+
+def _noise_scale(dt: float, step: float) -> float:
+    """``sqrt(dt / step)``, exactly 1 for a step within a millionth of ``dt``."""
+    return 1.0 if abs(step - dt) <= 1e-6 * dt else math.sqrt(dt / step)
 
 
 def simulate_path(
@@ -63,6 +70,12 @@ def simulate_path(
     (:meth:`~slamtrials.sim.odometry.Odometry.update`), then frame ``k``'s laser draws
     (:meth:`~slamtrials.sim.raycast.LaserModel.scan`). With every error model off only the bias is drawn.
 
+    The odometry's random noise is given per simulator step of ``config.dt``; a frame-to-frame step of
+    another length ``h`` draws it with standard deviations times ``sqrt(config.dt / h)``, so that the
+    noise accumulated along the path is what the simulator, stepping every ``config.dt``, would give
+    (a real log's frames come every 0.2 s or so). Steps within a millionth of ``config.dt`` are
+    simulator steps (scale 1, which keeps the bit-for-bit replay above).
+
     Raises
     ------
     SimulationError
@@ -88,7 +101,7 @@ def simulate_path(
     scans[0] = laser.scan(path[0], generator)
     measured[0] = odometry.pose
     for k in range(1, len(times)):
-        measured[k] = odometry.update(ominus1(path[k - 1], path[k]))
+        measured[k] = odometry.update(ominus1(path[k - 1], path[k]), _noise_scale(config.dt, times[k] - times[k - 1]))
         scans[k] = laser.scan(path[k], generator)
     metadata = {
         "world": world.name,

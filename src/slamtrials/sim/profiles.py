@@ -71,9 +71,10 @@ BUNDLED_PROFILES: dict[str, ErrorProfile] = {
     ),
     "fr079": ErrorProfile(
         name="fr079",
-        description="fitted by slamtrials calibrate (2026-11-24) to the shared fr079 log against GMapping's final "
+        description="fitted by slamtrials calibrate (2026-11-25) to the shared fr079 log against GMapping's final "
         "path and map (linearUpdate=0.1, seed 0: GMapping's defaults do not map fr079, docs/real-datasets.md); "
-        "biases +- the measured per-run bias; noise per simulator step of 0.1 s; no slips "
+        "the odometry without the 81 segments where the log moves against the reference (reversing logged as "
+        "driving forward); biases +- the measured per-run bias; noise per simulator step of 0.1 s; no slips "
         "(docs/realism.md, Calibration)",
         laser={
             "range_noise_std": 0.03259,

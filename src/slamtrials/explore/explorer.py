@@ -45,12 +45,14 @@ from numpy.typing import ArrayLike, NDArray
 from slamtrials import stablemath
 from slamtrials.explore.config import ExploreConfig, RobotLimits
 from slamtrials.explore.costmap import influence_distance
+from slamtrials.explore.evidence import EvidenceLayer
 from slamtrials.explore.follower import PathFollower
 from slamtrials.explore.frontiers import frontier_near
 from slamtrials.explore.goals import GoalRecord
 from slamtrials.explore.goalsearch import Found, GoalSearch
 from slamtrials.explore.gridframe import GridFrame, map_arrays
 from slamtrials.explore.recovery import Recovery, StuckMonitor
+from slamtrials.explore.scanfilter import ScanMemory, confirmed_ranges
 from slamtrials.record import LaserGeometry
 
 __all__ = ["ExploreStats", "Explorer"]
@@ -116,6 +118,11 @@ class Explorer:
         self._follower = PathFollower(self.config, self.robot)
         self._monitor = StuckMonitor(self.config)
         self._recovery = Recovery(self.config, self.robot)
+        cfg = self.config
+        self._memory = ScanMemory(cfg.scan_filter_distance)
+        self._evidence = EvidenceLayer(
+            cfg.evidence_min_hits, cfg.evidence_occupied_ratio, cfg.evidence_wall_clearance, cfg.evidence_free_distance
+        )
         self.reset()
 
     # --- state -------------------------------------------------------------------------------------------
@@ -141,6 +148,10 @@ class Explorer:
         self._blocked_since: float | None = None
         self._last_global = -math.inf
         self._checked_for: Any = None
+        self._view_of: Any = None
+        self._view: Any = None
+        self._evidence.reset()
+        self._memory.reset()
         self._search.reset()
         self._follower.reset()
         self._monitor.reset()
@@ -219,10 +230,25 @@ class Explorer:
         self._stalls = self._stalls + 1 if stalled else 0
         self._following = False
         pose_array = np.asarray(pose, dtype=np.float64)
+        ranges = confirmed_ranges(ranges, laser, self.config.scan_filter_window, self.config.scan_filter_distance)
+        if self.config.evidence_layer:
+            self._evidence.add_scan(pose_array, ranges, laser, float(occupancy.resolution))
+            occupancy = self._corrected(occupancy)
+        if self.config.scan_filter_scans >= 2 and self.config.scan_filter_window > 0:
+            ranges = self._memory.persistent(ranges, pose_array, laser)
         v, w = self._decide(float(t), pose_array, ranges, laser, occupancy)
         self._follower.remember(v, w)
         self._stuck = self._monitor.update(float(t), pose_array, v, self.robot.control_period, self._following)
         return v, w
+
+    def _corrected(self, occupancy: Any) -> Any:
+        """The map the explorer plans on: ``occupancy`` corrected by the evidence layer, computed once
+        per map object (the SLAM algorithm publishes a new one every few seconds), so the costmaps and
+        frontiers cached per map object stay valid in between."""
+        if occupancy is not self._view_of:
+            self._view_of = occupancy
+            self._view = self._evidence.view(occupancy)
+        return self._view
 
     def _decide(
         self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: LaserGeometry, occupancy: Any

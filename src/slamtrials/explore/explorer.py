@@ -52,7 +52,7 @@ from slamtrials.explore.goals import GoalRecord
 from slamtrials.explore.goalsearch import Found, GoalSearch
 from slamtrials.explore.gridframe import GridFrame, map_arrays
 from slamtrials.explore.recovery import Recovery, StuckMonitor
-from slamtrials.explore.scanfilter import ScanMemory, confirmed_ranges
+from slamtrials.explore.scanfilter import ScanMemory, confirmed_ranges, inside_footprint
 from slamtrials.record import LaserGeometry
 
 __all__ = ["ExploreStats", "Explorer"]
@@ -230,6 +230,8 @@ class Explorer:
         self._stalls = self._stalls + 1 if stalled else 0
         self._following = False
         pose_array = np.asarray(pose, dtype=np.float64)
+        if self.config.scan_filter_window > 0:
+            ranges = inside_footprint(ranges, laser, self.robot.radius)
         ranges = confirmed_ranges(ranges, laser, self.config.scan_filter_window, self.config.scan_filter_distance)
         if self.config.evidence_layer:
             self._evidence.add_scan(pose_array, ranges, laser, float(occupancy.resolution))

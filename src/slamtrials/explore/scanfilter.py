@@ -32,9 +32,10 @@ from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from slamtrials import stablemath
+from slamtrials.explore.follower import _beam_directions
 from slamtrials.record import LaserGeometry
 
-__all__ = ["ScanMemory", "confirmed_ranges"]
+__all__ = ["ScanMemory", "confirmed_ranges", "inside_footprint"]
 
 #: Largest angle (rad) a point moves across the scan between two consecutive scans besides the turn:
 #: parallax of a point 0.25 m away while the robot moves 0.07 m (0.7 m/s for 0.1 s) across it.
@@ -72,6 +73,20 @@ def _confirmed(ranges, cos_k, range_min, range_max, distance):  # pragma: no cov
         if not confirmed:
             out[i] = np.nan
     return out
+
+
+def inside_footprint(ranges: ArrayLike, laser: LaserGeometry, radius: float) -> NDArray[np.float64]:
+    """float64 ``[B]``: the scan (m) with every return that ends inside the robot's disc (``radius`` m
+    around the base's origin) replaced by NaN: nothing can be there but the robot itself (the footprint
+    filter of ROS's laser_filters). Short readings land there often, since all beams start there."""
+    r = np.array(ranges, dtype=np.float64)
+    if radius <= 0.0 or r.shape[0] == 0:
+        return r
+    cos, sin = _beam_directions(r.shape[0], laser)
+    px = laser.mount[0] + r * cos
+    py = laser.mount[1] + r * sin
+    r[px * px + py * py < radius * radius] = np.nan
+    return r
 
 
 def confirmed_ranges(ranges: ArrayLike, laser: LaserGeometry, window: int, distance: float) -> NDArray[np.float64]:

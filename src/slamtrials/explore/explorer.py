@@ -119,7 +119,7 @@ class Explorer:
         self._monitor = StuckMonitor(self.config)
         self._recovery = Recovery(self.config, self.robot)
         cfg = self.config
-        self._memory = ScanMemory(cfg.scan_filter_distance)
+        self._memory = ScanMemory(cfg.scan_filter_distance, cfg.scan_filter_range)
         self._evidence = EvidenceLayer(
             cfg.evidence_min_hits, cfg.evidence_occupied_ratio, cfg.evidence_wall_clearance, cfg.evidence_free_distance
         )
@@ -230,14 +230,18 @@ class Explorer:
         self._stalls = self._stalls + 1 if stalled else 0
         self._following = False
         pose_array = np.asarray(pose, dtype=np.float64)
-        if self.config.scan_filter_window > 0:
+        cfg = self.config
+        if cfg.scan_filter_window > 0:
             ranges = inside_footprint(ranges, laser, self.robot.radius)
-        ranges = confirmed_ranges(ranges, laser, self.config.scan_filter_window, self.config.scan_filter_distance)
-        if self.config.evidence_layer:
+        if cfg.evidence_layer:  # every return: a stray one marks no wall (evidence_min_hits, evidence_occupied_ratio)
             self._evidence.add_scan(pose_array, ranges, laser, float(occupancy.resolution))
             occupancy = self._corrected(occupancy)
-        if self.config.scan_filter_scans >= 2 and self.config.scan_filter_window > 0:
-            ranges = self._memory.persistent(ranges, pose_array, laser)
+        if cfg.scan_filter_window > 0:
+            ranges = confirmed_ranges(
+                ranges, laser, cfg.scan_filter_window, cfg.scan_filter_distance, cfg.scan_filter_range
+            )
+            if cfg.scan_filter_scans >= 2:
+                ranges = self._memory.persistent(ranges, pose_array, laser)
         v, w = self._decide(float(t), pose_array, ranges, laser, occupancy)
         self._follower.remember(v, w)
         self._stuck = self._monitor.update(float(t), pose_array, v, self.robot.control_period, self._following)

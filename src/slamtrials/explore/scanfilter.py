@@ -11,8 +11,10 @@ was blocked in 67 % of its steps and reached no goal in 1,080 s).
 
 :func:`confirmed_ranges` keeps a return only when another return among the ``window`` beams on either
 side ends within ``distance`` of it (the "distance" speckle filter of ROS's laser_filters does the
-same). Beams it drops become NaN (no information), which the follower and the recovery skip. With a
-noise-free laser every return on a surface at least two beams wide is kept.
+same). Beams it drops become NaN (no information), which the follower and the recovery skip. Only
+returns within ``reach`` are examined: the reactive checks need what is near, and far away the
+returns of one surface lie farther apart than ``distance``. With a noise-free laser every return
+within reach on a surface at least two beams wide, not seen at a grazing angle, is kept.
 
 Close to a wall the short readings of adjacent beams often land close together (a beam whose true
 range is 0.5 m puts its short reading within 0.5 m of the laser), so pairs of phantoms confirm each
@@ -43,7 +45,7 @@ _PARALLAX = math.radians(25.0)
 
 
 @njit(cache=True, nogil=True)
-def _confirmed(ranges, cos_k, range_min, range_max, distance):  # pragma: no cover - compiled
+def _confirmed(ranges, cos_k, range_min, range_max, distance, reach):  # pragma: no cover - compiled
     """float64 [B]: ``ranges`` with returns that no return within ``len(cos_k)`` beams confirms set to NaN.
 
     ``cos_k[k - 1]`` is the cosine of ``k`` beam spacings; endpoints ``i`` and ``j = i + k`` are
@@ -55,7 +57,7 @@ def _confirmed(ranges, cos_k, range_min, range_max, distance):  # pragma: no cov
     out = ranges.copy()
     for i in range(count):
         ri = ranges[i]
-        if not (ri > range_min and ri < range_max):  # False for NaN: not a return, left as it is
+        if not (ri > range_min and ri < range_max) or ri > reach:  # not a return (NaN too), or too far to matter
             continue
         confirmed = False
         for k in range(1, window + 1):
@@ -89,7 +91,9 @@ def inside_footprint(ranges: ArrayLike, laser: LaserGeometry, radius: float) -> 
     return r
 
 
-def confirmed_ranges(ranges: ArrayLike, laser: LaserGeometry, window: int, distance: float) -> NDArray[np.float64]:
+def confirmed_ranges(
+    ranges: ArrayLike, laser: LaserGeometry, window: int, distance: float, reach: float = math.inf
+) -> NDArray[np.float64]:
     """float64 ``[B]``: the scan (m) with every isolated return replaced by NaN (module docstring).
 
     Parameters
@@ -102,16 +106,22 @@ def confirmed_ranges(ranges: ArrayLike, laser: LaserGeometry, window: int, dista
         Beams on either side searched for a confirming return; 0 returns the scan unchanged.
     distance:
         Largest distance (m) between two endpoints that confirm each other.
+    reach:
+        Returns farther than this (m) are kept as they are (they still confirm nearer ones).
     """
     r = np.ascontiguousarray(ranges, dtype=np.float64)
     if window <= 0 or r.shape[0] == 0:
         return r
     spacing = abs(float(laser.angle_increment)) * np.arange(1, window + 1, dtype=np.float64)
-    return _confirmed(r, stablemath.cos(spacing), float(laser.range_min), float(laser.range_max), float(distance))
+    return _confirmed(
+        r, stablemath.cos(spacing), float(laser.range_min), float(laser.range_max), float(distance), float(reach)
+    )
 
 
 @njit(cache=True, nogil=True)
-def _persistent(ranges, ex, ey, prev_x, prev_y, prev_index, shift, window, distance):  # pragma: no cover - compiled
+def _persistent(
+    ranges, ex, ey, prev_x, prev_y, prev_index, shift, window, distance, reach
+):  # pragma: no cover - compiled
     """``ranges`` with returns that no previous return (sorted by beam index) confirms set to NaN.
 
     Return ``b`` ends at map point (ex[b], ey[b]) (NaN where it is not a return); a previous return
@@ -121,7 +131,7 @@ def _persistent(ranges, ex, ey, prev_x, prev_y, prev_index, shift, window, dista
     d2 = distance * distance
     count = prev_index.shape[0]
     for b in range(ranges.shape[0]):
-        if not (ex[b] == ex[b]):  # NaN: not a return
+        if not (ex[b] == ex[b]) or ranges[b] > reach:  # NaN: not a return; or too far to matter
             continue
         lo = b + shift - window
         hi = b + shift + window
@@ -146,10 +156,13 @@ class ScanMemory:
     ----------
     distance:
         Largest distance (m) between a return and the previous scan's return that confirms it.
+    reach:
+        Returns farther than this (m) are kept as they are.
     """
 
-    def __init__(self, distance: float):
+    def __init__(self, distance: float, reach: float = math.inf):
         self.distance = float(distance)
+        self.reach = float(reach)
         self.reset()
 
     def reset(self) -> None:
@@ -179,7 +192,7 @@ class ScanMemory:
             turn = math.remainder(th - pth, 2.0 * math.pi)
             shift = round(math.copysign(1.0, laser.angle_increment) * turn / increment)
             window = math.ceil(_PARALLAX / increment)
-            out = _persistent(r, ex, ey, px, py, pidx, int(shift), int(window), self.distance)
+            out = _persistent(r, ex, ey, px, py, pidx, int(shift), int(window), self.distance, self.reach)
         index = np.flatnonzero(valid).astype(np.int64)
         self._prev = (ex[index].copy(), ey[index].copy(), index, th)
         return out

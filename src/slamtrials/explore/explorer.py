@@ -119,7 +119,7 @@ class Explorer:
         self._monitor = StuckMonitor(self.config)
         self._recovery = Recovery(self.config, self.robot)
         cfg = self.config
-        self._memory = ScanMemory(cfg.scan_filter_distance, cfg.scan_filter_range)
+        self._memory = ScanMemory(cfg.scan_filter_distance, cfg.scan_filter_range, cfg.scan_filter_scans)
         self._evidence = EvidenceLayer(
             cfg.evidence_min_hits, cfg.evidence_occupied_ratio, cfg.evidence_wall_clearance, cfg.evidence_free_distance
         )
@@ -240,8 +240,7 @@ class Explorer:
             ranges = confirmed_ranges(
                 ranges, laser, cfg.scan_filter_window, cfg.scan_filter_distance, cfg.scan_filter_range
             )
-            if cfg.scan_filter_scans >= 2:
-                ranges = self._memory.persistent(ranges, pose_array, laser)
+            ranges = self._memory.persistent(ranges, pose_array, laser)
         v, w = self._decide(float(t), pose_array, ranges, laser, occupancy)
         self._follower.remember(v, w)
         self._stuck = self._monitor.update(float(t), pose_array, v, self.robot.control_period, self._following)

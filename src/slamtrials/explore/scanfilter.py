@@ -150,28 +150,33 @@ def _persistent(
 
 
 class ScanMemory:
-    """Confirmation of returns by the previous scan (module docstring).
+    """Confirmation of returns by the previous scans (module docstring).
 
     Parameters
     ----------
     distance:
-        Largest distance (m) between a return and the previous scan's return that confirms it.
+        Largest distance (m) between a return and a previous scan's return that confirms it.
     reach:
         Returns farther than this (m) are kept as they are.
+    scans:
+        Consecutive scans a return must be seen in: 1 keeps every return, 2 asks for a confirming
+        return in the previous scan, 3 in each of the previous two, and so on.
     """
 
-    def __init__(self, distance: float, reach: float = math.inf):
+    def __init__(self, distance: float, reach: float = math.inf, scans: int = 2):
         self.distance = float(distance)
         self.reach = float(reach)
+        self.scans = int(scans)
         self.reset()
 
     def reset(self) -> None:
-        """Forget the previous scan."""
-        self._prev: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64], float] | None = None
+        """Forget the previous scans."""
+        self._prev: list[tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64], float]] = []
 
     def persistent(self, ranges: ArrayLike, pose: ArrayLike, laser: LaserGeometry) -> NDArray[np.float64]:
         """float64 ``[B]``: the returns of ``ranges`` (one scan, isolated returns already NaN) that a
-        return of the previous scan passed here confirms; the others NaN. The first scan is kept whole.
+        return of each of the previous ``scans - 1`` scans passed here confirms; the others NaN. Until
+        that many scans were seen, the returns are checked against those there are.
 
         ``pose`` is float64 ``[3]`` the robot base's pose (map frame) the scan was taken from.
         """
@@ -187,12 +192,14 @@ class ScanMemory:
         ey = sy + rv * stablemath.sin(angles)
         out = r
         increment = abs(float(laser.angle_increment))
-        if self._prev is not None and increment > 0.0:
-            px, py, pidx, pth = self._prev
-            turn = math.remainder(th - pth, 2.0 * math.pi)
-            shift = round(math.copysign(1.0, laser.angle_increment) * turn / increment)
-            window = math.ceil(_PARALLAX / increment)
-            out = _persistent(r, ex, ey, px, py, pidx, int(shift), int(window), self.distance, self.reach)
-        index = np.flatnonzero(valid).astype(np.int64)
-        self._prev = (ex[index].copy(), ey[index].copy(), index, th)
+        if increment > 0.0:
+            for age, (px, py, pidx, pth) in enumerate(reversed(self._prev), start=1):
+                turn = math.remainder(th - pth, 2.0 * math.pi)
+                shift = round(math.copysign(1.0, laser.angle_increment) * turn / increment)
+                window = math.ceil(age * _PARALLAX / increment)
+                out = _persistent(out, ex, ey, px, py, pidx, int(shift), int(window), self.distance, self.reach)
+        if self.scans > 1:
+            index = np.flatnonzero(valid).astype(np.int64)
+            self._prev.append((ex[index].copy(), ey[index].copy(), index, th))
+            del self._prev[: -(self.scans - 1)]
         return out

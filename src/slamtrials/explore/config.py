@@ -120,11 +120,18 @@ class ExploreConfig(BaseModel):
     counts the cells its own (filtered) laser returns crossed and ended in, and plans on the SLAM map
     corrected by them. A map-free cell that returns hit at least ``evidence_min_hits`` times and in
     more than ``evidence_occupied_ratio`` of the beams through it, with no map-occupied cell within
-    ``evidence_wall_clearance``, is a wall (gaps that rays without a return wear into the map's walls);
+    ``evidence_wall_clearance`` but between two map-occupied cells less than ``evidence_max_gap``
+    apart, and crossed by one of the explorer's beams without a return within
+    ``evidence_no_return_range``, is a wall (gaps that such beams wear into the map's walls);
     a map-free cell with no crossed or hit cell within ``evidence_free_distance`` is unknown (the halo
     of free space GMapping draws beyond walls from beams that returned nothing). Defaults: 2 hits, so
     one stray return marks nothing; 0.25, GMapping's own ``occ_thresh``; 0.05 m, one cell of the
-    usual map, so the layer never thickens a wall the map has; 0.15 m, three cells, enough for the
+    usual map, so the layer never thickens a wall the map has; 2 m, wider than the gaps seen in
+    office_small_01's walls with ``realistic`` and than a door, while the walls the layer sees 0.1 m
+    beside the map's (the pose the explorer drove by and the map's best particle differ by that much
+    even with ``paper``) lie between no two wall cells; 8 m, a few rooms' worth (each such beam costs
+    its length in cells; ``paper``'s laser has none indoors but where it looks 30 m into the open,
+    so its maps are left alone); 0.15 m, three cells, enough for the
     map's best particle and the pose the explorer drove by to differ by a cell or two without free
     cells at the edge of what was seen turning unknown.
 
@@ -211,6 +218,20 @@ class ExploreConfig(BaseModel):
         ge=0.0,
         lt=1.0,
         description="... and the share of the beams crossing or ending in it that must end there",
+    )
+    evidence_max_gap: float = Field(
+        2.0,
+        gt=0.0,
+        le=20.0,
+        description="only map-free cells between two map-occupied cells (on a row, column or diagonal) closer than "
+        "this are turned into walls (m)",
+    )
+    evidence_no_return_range: float = Field(
+        8.0,
+        ge=0.0,
+        le=100.0,
+        description="cells a beam without a return crossed this close to the laser may be turned into walls (m); "
+        "0 = none",
     )
     evidence_wall_clearance: float = Field(
         0.05,

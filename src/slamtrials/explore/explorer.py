@@ -121,7 +121,12 @@ class Explorer:
         cfg = self.config
         self._memory = ScanMemory(cfg.scan_filter_distance, cfg.scan_filter_range, cfg.scan_filter_scans)
         self._evidence = EvidenceLayer(
-            cfg.evidence_min_hits, cfg.evidence_occupied_ratio, cfg.evidence_wall_clearance, cfg.evidence_free_distance
+            cfg.evidence_min_hits,
+            cfg.evidence_occupied_ratio,
+            cfg.evidence_wall_clearance,
+            cfg.evidence_free_distance,
+            cfg.evidence_max_gap,
+            cfg.evidence_no_return_range,
         )
         self.reset()
 
@@ -253,6 +258,7 @@ class Explorer:
         if occupancy is not self._view_of:
             self._view_of = occupancy
             self._view = self._evidence.view(occupancy)
+            self._evidence.decay()
         return self._view
 
     def _decide(

@@ -22,7 +22,9 @@ profile, how the trials ended, the mapped free share of the reachable area, and 
 profile's mean wall time to the first profile's. *Mapped free* is the share of the world's reachable
 cells that the final SLAM map calls free (carried into the map through the nearest trajectory pose,
 as ``mapped_fraction``, but not counting cells the map calls occupied): unlike ``mapped_fraction`` it
-is not fooled by the free space GMapping draws beyond the walls from beams without a return.
+is not fooled by the free space GMapping draws beyond the walls from beams without a return. Each
+trial's progress line ends with a digest of its true and estimated paths (the same digest, the same
+run, bit for bit).
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ import os
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
+import hashlib  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
@@ -78,9 +81,11 @@ def main() -> None:
                 info = record.metadata["trial"]
                 free = mapped_free_fraction(world, record)
                 rows.append((world.name, profile, seed, info, free, load))
+                digest = hashlib.sha256(record.truth.tobytes() + record.estimate.tobytes()).hexdigest()[:16]
                 print(
-                    f"{world.name} {profile} seed {seed}: {info['termination_reason']} after {info['duration_s']:.0f} s "
-                    f"simulated in {info['wall_time_s']:.1f} s, mapped free {free:.3f}, load {load:.1f}",
+                    f"{world.name} {profile} seed {seed}: {info['termination_reason']} after {info['duration_s']:.1f} s "
+                    f"simulated in {info['wall_time_s']:.1f} s, {info['slam_updates']} updates, mapped free {free:.3f}, "
+                    f"load {load:.1f}, run digest {digest}",
                     flush=True,
                 )
 

@@ -117,23 +117,17 @@ class ExploreConfig(BaseModel):
     turning round at each dead end would cost the SLAM about 13 updates.
 
     Evidence layer (:mod:`slamtrials.explore.evidence`, on with ``evidence_layer``): the explorer
-    counts the cells its own (filtered) laser returns crossed and ended in, and plans on the SLAM map
-    corrected by them. A map-free cell that returns hit at least ``evidence_min_hits`` times and in
-    more than ``evidence_occupied_ratio`` of the beams through it, with no map-occupied cell within
-    ``evidence_wall_clearance`` but between two map-occupied cells less than ``evidence_max_gap``
-    apart, and crossed by one of the explorer's beams without a return within
-    ``evidence_no_return_range``, is a wall (gaps that such beams wear into the map's walls);
-    a map-free cell with no crossed or hit cell within ``evidence_free_distance`` is unknown (the halo
-    of free space GMapping draws beyond walls from beams that returned nothing). Defaults: 2 hits, so
-    one stray return marks nothing; 0.25, GMapping's own ``occ_thresh``; 0.05 m, one cell of the
-    usual map, so the layer never thickens a wall the map has; 2 m, wider than the gaps seen in
-    office_small_01's walls with ``realistic`` and than a door, while the walls the layer sees 0.1 m
-    beside the map's (the pose the explorer drove by and the map's best particle differ by that much
-    even with ``paper``) lie between no two wall cells; 8 m, a few rooms' worth (each such beam costs
-    its length in cells; ``paper``'s laser has none indoors but where it looks 30 m into the open,
-    so its maps are left alone); 0.15 m, three cells, enough for the
-    map's best particle and the pose the explorer drove by to differ by a cell or two without free
-    cells at the edge of what was seen turning unknown.
+    counts the cells its own laser returns crossed and ended in, and plans on the SLAM map corrected
+    by them. A map-free cell with no crossed or hit cell within ``evidence_free_distance`` is unknown
+    (the halo of free space GMapping draws beyond the walls from beams that returned nothing). A
+    map-free cell that returns hit at least ``evidence_min_hits`` times and in more than
+    ``evidence_occupied_ratio`` of the beams through it, and that one of the explorer's beams without
+    a return crossed within ``evidence_no_return_range`` of the laser, is a wall (a gap such beams wore
+    into a wall). Defaults: 0.15 m,
+    three cells, enough for the map's best particle and the pose the explorer drove by to differ by a
+    cell or two without free cells at the edge of what was seen turning unknown; 2 hits, so one stray
+    return marks nothing; 0.25, GMapping's own ``occ_thresh``; 8 m, a few rooms' worth (each such
+    beam costs its length in cells; ``paper``'s laser has none indoors).
 
     Scan filter (:mod:`slamtrials.explore.scanfilter`): the follower and the recovery ignore returns
     inside the robot's disc, and react to a return within ``scan_filter_range`` only if another return
@@ -201,7 +195,7 @@ class ExploreConfig(BaseModel):
     evidence_layer: bool = Field(
         True,
         description="correct the SLAM map by the explorer's own laser returns before planning "
-        "(gaps worn into walls closed, free space no return vouches for unknown)",
+        "(free space no return vouches for unknown, gaps worn into walls closed)",
     )
     evidence_free_distance: float = Field(
         0.15,
@@ -211,7 +205,11 @@ class ExploreConfig(BaseModel):
         "count as unknown (m)",
     )
     evidence_min_hits: int = Field(
-        2, ge=1, le=1000, description="returns that must end in a map-free cell before it counts as a wall"
+        2,
+        ge=1,
+        le=1000,
+        description="returns that must end in a map-free cell crossed by a beam without a return before it counts "
+        "as a wall",
     )
     evidence_occupied_ratio: float = Field(
         0.25,
@@ -219,25 +217,11 @@ class ExploreConfig(BaseModel):
         lt=1.0,
         description="... and the share of the beams crossing or ending in it that must end there",
     )
-    evidence_max_gap: float = Field(
-        2.0,
-        gt=0.0,
-        le=20.0,
-        description="only map-free cells between two map-occupied cells (on a row, column or diagonal) closer than "
-        "this are turned into walls (m)",
-    )
     evidence_no_return_range: float = Field(
         8.0,
         ge=0.0,
         le=100.0,
-        description="cells a beam without a return crossed this close to the laser may be turned into walls (m); "
-        "0 = none",
-    )
-    evidence_wall_clearance: float = Field(
-        0.05,
-        ge=0.0,
-        le=1.0,
-        description="map-free cells this close to a map-occupied cell are never turned into walls (m)",
+        description="cells a beam without a return crossed this close to the laser may count as walls (m); 0 = none",
     )
     # --- path follower ------------------------------------------------------------------------------
     smooth_paths: bool = Field(True, description="straighten the planner's 8-connected paths where that costs no more")

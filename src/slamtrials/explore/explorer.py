@@ -1,6 +1,11 @@
 """The frontier explorer: one velocity command per control period, from the SLAM pose, scan and map.
 
-Each call of :meth:`Explorer.command` runs, in this order:
+Each call of :meth:`Explorer.command` first filters the scan and corrects the map: returns inside the
+robot's disc are dropped; the rest go into the evidence layer (:mod:`slamtrials.explore.evidence`),
+which corrects each new SLAM map once (free space that no return vouches for made unknown, gaps that
+beams without a return wore into walls closed) and the explorer plans on that map; for the reactive
+checks below, returns within ``scan_filter_range`` must be confirmed by neighbouring beams and by the
+previous scans (:mod:`slamtrials.explore.scanfilter`). Then, in this order:
 
 1. a manoeuvre under way (the initial full turn, a look-around turn, a recovery) gives the command;
 2. stuck, idle, bumped or blocked (:mod:`slamtrials.explore.recovery`): start a recovery; after
@@ -121,12 +126,7 @@ class Explorer:
         cfg = self.config
         self._memory = ScanMemory(cfg.scan_filter_distance, cfg.scan_filter_range, cfg.scan_filter_scans)
         self._evidence = EvidenceLayer(
-            cfg.evidence_min_hits,
-            cfg.evidence_occupied_ratio,
-            cfg.evidence_wall_clearance,
-            cfg.evidence_free_distance,
-            cfg.evidence_max_gap,
-            cfg.evidence_no_return_range,
+            cfg.evidence_min_hits, cfg.evidence_occupied_ratio, cfg.evidence_free_distance, cfg.evidence_no_return_range
         )
         self.reset()
 
@@ -219,7 +219,7 @@ class Explorer:
         pose:
             float64 ``[3]`` the robot base's pose estimate (x, y, theta) in the map frame.
         ranges:
-            float32 ``[B]`` the current laser scan (m).
+            float32 ``[B]`` the current laser scan (m), as the laser gives it (the explorer filters it).
         laser:
             The laser's geometry (beam angles, valid ranges, pose in the base frame).
         occupancy:
@@ -258,7 +258,6 @@ class Explorer:
         if occupancy is not self._view_of:
             self._view_of = occupancy
             self._view = self._evidence.view(occupancy)
-            self._evidence.decay()
         return self._view
 
     def _decide(

@@ -122,12 +122,12 @@ class ExploreConfig(BaseModel):
     (the halo of free space GMapping draws beyond the walls from beams that returned nothing). A
     map-free cell that returns hit at least ``evidence_min_hits`` times and in more than
     ``evidence_occupied_ratio`` of the beams through it, and that one of the explorer's beams without
-    a return crossed within ``evidence_no_return_range`` of the laser, is a wall (a gap such beams wore
-    into a wall). Defaults: 0.15 m,
-    three cells, enough for the map's best particle and the pose the explorer drove by to differ by a
-    cell or two without free cells at the edge of what was seen turning unknown; 2 hits, so one stray
-    return marks nothing; 0.25, GMapping's own ``occ_thresh``; 8 m, a few rooms' worth (each such
-    beam costs its length in cells; ``paper``'s laser has none indoors).
+    a return (between two that returned) crossed within ``evidence_no_return_range`` of the laser, is
+    a wall (a gap such beams wore into a wall). Defaults: 0.15 m, three cells, enough for the map's
+    best particle and the pose the explorer drove by to differ by a cell or two without free cells at
+    the edge of what was seen turning unknown; 2 hits, so one stray return marks nothing; 0.25,
+    GMapping's own ``occ_thresh``; 8 m, a few rooms' worth (each such beam costs its length in cells;
+    ``paper``'s laser has none indoors).
 
     Scan filter (:mod:`slamtrials.explore.scanfilter`): the follower and the recovery ignore returns
     inside the robot's disc, and react to a return within ``scan_filter_range`` only if another return

@@ -124,7 +124,8 @@ class Explorer:
         self._monitor = StuckMonitor(self.config)
         self._recovery = Recovery(self.config, self.robot)
         cfg = self.config
-        self._memory = ScanMemory(cfg.scan_filter_distance, cfg.scan_filter_range, cfg.scan_filter_scans)
+        step = self.robot.max_linear_speed * self.robot.control_period
+        self._memory = ScanMemory(cfg.scan_filter_distance, cfg.scan_filter_range, cfg.scan_filter_scans, step)
         self._evidence = EvidenceLayer(
             cfg.evidence_min_hits, cfg.evidence_occupied_ratio, cfg.evidence_free_distance, cfg.evidence_no_return_range
         )
@@ -156,6 +157,7 @@ class Explorer:
         self._view_of: Any = None
         self._view: Any = None
         self._evidence.reset()
+        self._traced_at: NDArray[np.float64] | None = None
         self._memory.reset()
         self._search.reset()
         self._follower.reset()
@@ -239,7 +241,14 @@ class Explorer:
         if cfg.scan_filter_window > 0:
             ranges = inside_footprint(ranges, laser, self.robot.radius)
         if cfg.evidence_layer:  # every return: a stray one marks no wall (evidence_min_hits, evidence_occupied_ratio)
-            self._evidence.add_scan(pose_array, ranges, laser, float(occupancy.resolution))
+            last = self._traced_at
+            if (
+                last is None
+                or math.hypot(pose_array[0] - last[0], pose_array[1] - last[1]) >= cfg.evidence_linear_step
+                or abs(math.remainder(pose_array[2] - last[2], 2.0 * math.pi)) >= cfg.evidence_angular_step
+            ):
+                self._evidence.add_scan(pose_array, ranges, laser, float(occupancy.resolution))
+                self._traced_at = pose_array[:3].copy()
             occupancy = self._corrected(occupancy)
         if cfg.scan_filter_window > 0:
             ranges = confirmed_ranges(

@@ -120,12 +120,13 @@ def confirmed_ranges(
 
 @njit(cache=True, nogil=True)
 def _persistent(
-    ranges, ex, ey, prev_x, prev_y, prev_index, shift, window, distance, reach
+    ranges, ex, ey, prev_x, prev_y, prev_index, shift, window, travel, increment, distance, reach
 ):  # pragma: no cover - compiled
     """``ranges`` with returns that no previous return (sorted by beam index) confirms set to NaN.
 
     Return ``b`` ends at map point (ex[b], ey[b]) (NaN where it is not a return); a previous return
-    with beam index in ``[b + shift - window, b + shift + window]`` within ``distance`` confirms it.
+    with beam index in ``[b + shift - w, b + shift + w]`` within ``distance`` confirms it, where ``w``
+    covers the parallax of a point at that range after the robot moved ``travel`` m (at most ``window``).
     """
     out = ranges.copy()
     d2 = distance * distance
@@ -133,8 +134,9 @@ def _persistent(
     for b in range(ranges.shape[0]):
         if not (ex[b] == ex[b]) or ranges[b] > reach:  # NaN: not a return; or too far to matter
             continue
-        lo = b + shift - window
-        hi = b + shift + window
+        w = min(window, int((travel + distance) / (ranges[b] * increment)) + 2)
+        lo = b + shift - w
+        hi = b + shift + w
         k = np.searchsorted(prev_index, lo)
         found = False
         while k < count and prev_index[k] <= hi:
@@ -161,9 +163,12 @@ class ScanMemory:
     scans:
         Consecutive scans a return must be seen in: 1 keeps every return, 2 asks for a confirming
         return in the previous scan, 3 in each of the previous two, and so on.
+    step:
+        Farthest the robot moves from one scan to the next (m): bounds the parallax searched for.
     """
 
-    def __init__(self, distance: float, reach: float = math.inf, scans: int = 2):
+    def __init__(self, distance: float, reach: float = math.inf, scans: int = 2, step: float = 0.07):
+        self.step = float(step)
         self.distance = float(distance)
         self.reach = float(reach)
         self.scans = int(scans)
@@ -182,14 +187,13 @@ class ScanMemory:
         """
         r = np.ascontiguousarray(ranges, dtype=np.float64)
         x, y, th = (float(v) for v in np.asarray(pose, dtype=np.float64)[:3])
-        angles = laser.beam_angles(r.shape[0]) + laser.mount[2] + th
+        cos, sin = _beam_directions(r.shape[0], laser)  # base frame, cached
         valid = (r > laser.range_min) & (r < laser.range_max)
         ct, st = math.cos(th), math.sin(th)
-        sx = x + ct * laser.mount[0] - st * laser.mount[1]
-        sy = y + st * laser.mount[0] + ct * laser.mount[1]
         rv = np.where(valid, r, np.nan)
-        ex = sx + rv * stablemath.cos(angles)
-        ey = sy + rv * stablemath.sin(angles)
+        bx, by = laser.mount[0] + rv * cos, laser.mount[1] + rv * sin
+        ex = x + ct * bx - st * by
+        ey = y + st * bx + ct * by
         out = r
         increment = abs(float(laser.angle_increment))
         if increment > 0.0:
@@ -197,7 +201,20 @@ class ScanMemory:
                 turn = math.remainder(th - pth, 2.0 * math.pi)
                 shift = round(math.copysign(1.0, laser.angle_increment) * turn / increment)
                 window = math.ceil(age * _PARALLAX / increment)
-                out = _persistent(out, ex, ey, px, py, pidx, int(shift), int(window), self.distance, self.reach)
+                out = _persistent(
+                    out,
+                    ex,
+                    ey,
+                    px,
+                    py,
+                    pidx,
+                    int(shift),
+                    int(window),
+                    age * self.step,
+                    increment,
+                    self.distance,
+                    self.reach,
+                )
         if self.scans > 1:
             index = np.flatnonzero(valid).astype(np.int64)
             self._prev.append((ex[index].copy(), ey[index].copy(), index, th))

@@ -177,3 +177,15 @@ def test_the_termination_rule_gets_the_building_reachable_area(world, monkeypatc
     info = record.metadata["trial"]
     assert given == [pytest.approx(info["reachable_area_m2"])]
     assert 25.0 < info["reachable_area_m2"] < 40.0  # two rooms of about 3.8 x 4.7 m, less the robot's margin
+
+
+def test_a_realistic_trial_ends_because_no_frontier_is_left(world):
+    # with the realistic laser the map holds free space beyond the walls (beams without a return) and
+    # phantom returns come and go; the explorer ignores both and stops when the rooms are done
+    config = TrialConfig.from_dict(
+        {"sim": {"profile": "realistic"}, "termination": {"small_period": 60.0, "max_time": 900.0}}
+    )
+    info = run_trial(world, config, seed=4).metadata["trial"]
+    assert info["termination_reason"] == "no_frontiers"
+    assert info["duration_s"] < 60.0  # 21.5 s (paper: 21.7 s); without the scan filter and the evidence layer 840 s
+    assert info["mapped_fraction"] >= 0.95

@@ -1,6 +1,11 @@
 """The frontier explorer: one velocity command per control period, from the SLAM pose, scan and map.
 
-Each call of :meth:`Explorer.command` runs, in this order:
+Each call of :meth:`Explorer.command` first filters the scan and corrects the map: returns inside the
+robot's disc are dropped; the rest go into the evidence layer (:mod:`slamtrials.explore.evidence`),
+which corrects each new SLAM map once (free space that no return vouches for made unknown, gaps that
+beams without a return wore into walls closed) and the explorer plans on that map; for the reactive
+checks below, returns within ``scan_filter_range`` must be confirmed by neighbouring beams and by the
+previous scans (:mod:`slamtrials.explore.scanfilter`). Then, in this order:
 
 1. a manoeuvre under way (the initial full turn, a look-around turn, a recovery) gives the command;
 2. stuck, idle, bumped or blocked (:mod:`slamtrials.explore.recovery`): start a recovery; after
@@ -45,12 +50,14 @@ from numpy.typing import ArrayLike, NDArray
 from slamtrials import stablemath
 from slamtrials.explore.config import ExploreConfig, RobotLimits
 from slamtrials.explore.costmap import influence_distance
+from slamtrials.explore.evidence import EvidenceLayer
 from slamtrials.explore.follower import PathFollower
 from slamtrials.explore.frontiers import frontier_near
 from slamtrials.explore.goals import GoalRecord
 from slamtrials.explore.goalsearch import Found, GoalSearch
 from slamtrials.explore.gridframe import GridFrame, map_arrays
 from slamtrials.explore.recovery import Recovery, StuckMonitor
+from slamtrials.explore.scanfilter import ScanMemory, confirmed_ranges, inside_footprint
 from slamtrials.record import LaserGeometry
 
 __all__ = ["ExploreStats", "Explorer"]
@@ -116,6 +123,12 @@ class Explorer:
         self._follower = PathFollower(self.config, self.robot)
         self._monitor = StuckMonitor(self.config)
         self._recovery = Recovery(self.config, self.robot)
+        cfg = self.config
+        step = self.robot.max_linear_speed * self.robot.control_period
+        self._memory = ScanMemory(cfg.scan_filter_distance, cfg.scan_filter_range, cfg.scan_filter_scans, step)
+        self._evidence = EvidenceLayer(
+            cfg.evidence_min_hits, cfg.evidence_occupied_ratio, cfg.evidence_free_distance, cfg.evidence_no_return_range
+        )
         self.reset()
 
     # --- state -------------------------------------------------------------------------------------------
@@ -141,6 +154,11 @@ class Explorer:
         self._blocked_since: float | None = None
         self._last_global = -math.inf
         self._checked_for: Any = None
+        self._view_of: Any = None
+        self._view: Any = None
+        self._evidence.reset()
+        self._traced_at: NDArray[np.float64] | None = None
+        self._memory.reset()
         self._search.reset()
         self._follower.reset()
         self._monitor.reset()
@@ -203,7 +221,7 @@ class Explorer:
         pose:
             float64 ``[3]`` the robot base's pose estimate (x, y, theta) in the map frame.
         ranges:
-            float32 ``[B]`` the current laser scan (m).
+            float32 ``[B]`` the current laser scan (m), as the laser gives it (the explorer filters it).
         laser:
             The laser's geometry (beam angles, valid ranges, pose in the base frame).
         occupancy:
@@ -219,10 +237,37 @@ class Explorer:
         self._stalls = self._stalls + 1 if stalled else 0
         self._following = False
         pose_array = np.asarray(pose, dtype=np.float64)
+        cfg = self.config
+        if cfg.scan_filter_window > 0:
+            ranges = inside_footprint(ranges, laser, self.robot.radius)
+        if cfg.evidence_layer:  # every return: a stray one marks no wall (evidence_min_hits, evidence_occupied_ratio)
+            last = self._traced_at
+            if (
+                last is None
+                or math.hypot(pose_array[0] - last[0], pose_array[1] - last[1]) >= cfg.evidence_linear_step
+                or abs(math.remainder(pose_array[2] - last[2], 2.0 * math.pi)) >= cfg.evidence_angular_step
+            ):
+                self._evidence.add_scan(pose_array, ranges, laser, float(occupancy.resolution))
+                self._traced_at = pose_array[:3].copy()
+            occupancy = self._corrected(occupancy)
+        if cfg.scan_filter_window > 0:
+            ranges = confirmed_ranges(
+                ranges, laser, cfg.scan_filter_window, cfg.scan_filter_distance, cfg.scan_filter_range
+            )
+            ranges = self._memory.persistent(ranges, pose_array, laser)
         v, w = self._decide(float(t), pose_array, ranges, laser, occupancy)
         self._follower.remember(v, w)
         self._stuck = self._monitor.update(float(t), pose_array, v, self.robot.control_period, self._following)
         return v, w
+
+    def _corrected(self, occupancy: Any) -> Any:
+        """The map the explorer plans on: ``occupancy`` corrected by the evidence layer, computed once
+        per map object (the SLAM algorithm publishes a new one every few seconds), so the costmaps and
+        frontiers cached per map object stay valid in between."""
+        if occupancy is not self._view_of:
+            self._view_of = occupancy
+            self._view = self._evidence.view(occupancy)
+        return self._view
 
     def _decide(
         self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: LaserGeometry, occupancy: Any

@@ -21,6 +21,7 @@ LASER = {
     "range_noise_std": 0.02,
     "range_noise_per_m": 0.01,
     "short_rate": 0.08,
+    "short_run_beams": 3.0,
     "dropout_rate": 0.02,
     "dropout_per_m": 0.004,
     "dropout_grazing": 0.1,

@@ -56,6 +56,7 @@ def test_calibrate_writes_a_valid_profile_and_a_page_of_figures(record, tmp_path
         "range_noise_std",
         "range_noise_per_m",
         "short_rate",
+        "short_run_beams",
         "dropout_rate",
         "dropout_per_m",
         "dropout_grazing",

@@ -46,6 +46,36 @@ def test_short_readings_fall_uniformly_before_the_true_range():
     assert (scans[~short] == np.broadcast_to(true, scans.shape)[~short]).all()  # no noise: others exact
 
 
+def _runs(short: np.ndarray) -> np.ndarray:
+    """Lengths of the runs of True along each row of ``short`` ``[S, B]``."""
+    lengths = []
+    for row in short:
+        edges = np.diff(np.concatenate(([0], row.astype(int), [0])))
+        lengths.extend((np.flatnonzero(edges == -1) - np.flatnonzero(edges == 1)).tolist())
+    return np.array(lengths)
+
+
+def test_short_readings_in_runs_keep_their_rate_and_one_distance_per_run():
+    true, scans = _scans(LaserConfig(short_rate=0.1, short_run_beams=4.0), repeats=400)
+    short = scans < true - 1e-4
+    # a beam of a run whose wall is nearer than the run's object reads the wall: slightly below 0.1
+    assert 0.085 < short.mean() < 0.1
+    runs = _runs(short)
+    assert runs.mean() == pytest.approx(4.0, rel=0.12)
+    assert _runs(_scans(LaserConfig(short_rate=0.1))[1] < true - 1e-4).mean() < 1.2  # independent beams
+    # one object per run: neighbouring short beams of a run read the same distance
+    both = short[:, 1:] & short[:, :-1]
+    same = np.isclose(scans[:, 1:][both], scans[:, :-1][both], atol=1e-5)
+    assert same.mean() > 0.95
+
+
+def test_short_runs_need_a_possible_rate_and_a_length_of_at_least_one_beam():
+    with pytest.raises(ValidationError, match="short_run_beams must be 0"):
+        LaserConfig(short_rate=0.1, short_run_beams=0.5)
+    with pytest.raises(ValidationError, match="cannot be"):
+        LaserConfig(short_rate=0.9, short_run_beams=2.0)
+
+
 def test_dropouts_grow_with_range_and_at_grazing_incidence():
     config = LaserConfig(dropout_rate=0.02, dropout_per_m=0.005)
     true, scans = _scans(config, repeats=300)
@@ -65,14 +95,20 @@ def test_dropouts_grow_with_range_and_at_grazing_incidence():
     assert rate[oblique].mean() == pytest.approx(0.5 * (1 - math.cos(math.radians(45))), abs=0.03)
 
 
-def test_the_number_of_draws_does_not_depend_on_the_scene():
-    config = LaserConfig(range_noise_std=0.01, short_rate=0.1, dropout_rate=0.05, dropout_grazing=0.1)
+@pytest.mark.parametrize("run_beams", [0.0, 3.0])
+def test_the_number_of_draws_does_not_depend_on_the_scene(run_beams):
+    config = LaserConfig(
+        range_noise_std=0.01, short_rate=0.1, short_run_beams=run_beams, dropout_rate=0.05, dropout_grazing=0.1
+    )
     world = room_world(size_m=20.0)
     laser = LaserModel(world, config)
     a, b = np.random.default_rng(5), np.random.default_rng(5)
     laser.scan(np.array([2.0, 2.0, 0.0]), a)
     laser.scan(np.array([15.0, 9.0, 2.0]), b)
     assert a.bit_generator.state == b.bit_generator.state
+    independent = np.random.default_rng(5)  # and runs draw as many as independent beams
+    LaserModel(world, config.model_copy(update={"short_run_beams": 0.0})).scan(np.array([2.0, 2.0, 0.0]), independent)
+    assert independent.bit_generator.state == a.bit_generator.state
 
 
 def test_odometry_cross_terms_and_slips():

@@ -34,6 +34,8 @@ class BeamSample:
     ----------
     frame:
         int64 ``[N]`` index of each beam's frame in the recording.
+    beam:
+        int64 ``[N]`` index of the beam in its scan (neighbours differ by 1).
     cast:
         float64 ``[N]`` range (m) cast in the reference map (a wall within the laser's range).
     reading:
@@ -51,6 +53,7 @@ class BeamSample:
     """
 
     frame: NDArray[np.int64]
+    beam: NDArray[np.int64]
     cast: NDArray[np.float64]
     reading: NDArray[np.float64]
     incidence: NDArray[np.float64]
@@ -63,6 +66,7 @@ class BeamSample:
         """The beams at ``index`` (a bootstrap resample)."""
         return BeamSample(
             frame=self.frame[index],
+            beam=self.beam[index],
             cast=self.cast[index],
             reading=self.reading[index],
             incidence=self.incidence[index],
@@ -89,6 +93,7 @@ def beam_sample(
     limit = float(laser.range_max)
     res = walls.resolution
     frame_ids: list[NDArray[np.int64]] = []
+    beam_ids: list[NDArray[np.int64]] = []
     casts: list[NDArray[np.float64]] = []
     readings: list[NDArray[np.float64]] = []
     incidences: list[NDArray[np.float64]] = []
@@ -107,15 +112,18 @@ def beam_sample(
         cells = to_wall.astype(np.float64) / res
         cosines = incidence_cosines((float(uv[0]), float(uv[1])), theta, angles, cells)
         frame_ids.append(np.full(index.size, k, dtype=np.int64))
+        beam_ids.append(index.astype(np.int64))
         casts.append(to_wall[index].astype(np.float64))
         readings.append(record.scans[k, index].astype(np.float64))
         incidences.append(cosines[index])
     if not frame_ids:
         empty = np.zeros(0)
-        return BeamSample(np.zeros(0, np.int64), empty, empty, empty, np.zeros(0, bool), used, step, used * beams)
+        none = np.zeros(0, np.int64)
+        return BeamSample(none, none, empty, empty, empty, np.zeros(0, bool), used, step, used * beams)
     reading = np.concatenate(readings)
     return BeamSample(
         frame=np.concatenate(frame_ids),
+        beam=np.concatenate(beam_ids),
         cast=np.concatenate(casts),
         reading=reading,
         incidence=np.concatenate(incidences),

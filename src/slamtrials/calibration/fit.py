@@ -41,6 +41,7 @@ _UNITS = {
     "range_noise_std": "m",
     "range_noise_per_m": "m/m",
     "short_rate": "",
+    "short_run_beams": "beams",
     "dropout_rate": "",
     "dropout_per_m": "1/m",
     "dropout_grazing": "",
@@ -106,8 +107,10 @@ class Calibration:
     def profile(self, name: str, description: str) -> ErrorProfile:
         """The error profile: the fitted laser values, the biases as symmetric ranges of their measured
         magnitude (one log is one draw of the per-run bias), the noise coefficients; no slips."""
-        # the fits keep every value >= 0; the caps are the fields' own (a rate above 1 is a certainty)
-        laser = {k: float(min(self.value(k).value, 1.0)) for k in LASER_VALUES}
+        # a rate above 1 is a certainty; a run shorter than 1 beam is none (independent beams)
+        laser = {k: float(min(self.value(k).value, 1.0)) for k in LASER_VALUES if k != "short_run_beams"}
+        run = self.value("short_run_beams").value
+        laser["short_run_beams"] = float(run) if run >= 1.0 and laser["short_rate"] > 0.0 else 0.0
         lin = min(abs(self.value("bias_linear").value), 0.49)
         ang = min(abs(self.value("bias_angular").value), 0.49)
         odometry: dict[str, object] = {"bias_linear_range": (-lin, lin), "bias_angular_range": (-ang, ang)}
@@ -182,7 +185,9 @@ def calibrate(
         refit = fit_odometry(steps, anchors, cfg, log_step, counts[frame_blocks])
         if refit is not None:
             odo_draws.append([refit.values[k] for k in ODOMETRY_VALUES])
-    laser_se = np.std(np.array(laser_draws), axis=0, ddof=1) if len(laser_draws) > 1 else np.full(6, math.nan)
+    laser_se = (
+        np.std(np.array(laser_draws), axis=0, ddof=1) if len(laser_draws) > 1 else np.full(len(LASER_VALUES), math.nan)
+    )
     odo_se = np.std(np.array(odo_draws), axis=0, ddof=1) if len(odo_draws) > 1 else np.full(6, math.nan)
     fitted = tuple(
         FittedValue(k, float(laser.values[k]), float(se), _UNITS[k]) for k, se in zip(LASER_VALUES, laser_se)

@@ -10,7 +10,11 @@ deviation within ``core_cut`` sigmas of the median); a weighted line through the
 Short readings: a beam that returned more than ``short_sigmas`` sigmas short of the cast range. The model
 draws a short reading uniformly in ``[min_range, r)``, so it is seen as such with probability
 ``(r - k sigma(r) - min_range) / (r - min_range)``; the rate is the count of short beams, less the
-Gaussian tail's expected count, over the sum of those probabilities over all kept beams.
+Gaussian tail's expected count, over the sum of those probabilities over all kept beams. Their runs:
+among pairs of neighbouring kept beams of one scan whose first is short, the share whose second is short
+too (counted only where the neighbour's wall is far enough behind the first one's reading for it to be
+seen short: a run is one object at one distance) is the chain's ``q``, and ``short_run_beams = 1 / (1 -
+q)`` (the mean run; independent beams give ``1 / (1 - short_rate)``, about 1.1).
 
 Dropouts: the share of kept beams that returned nothing, fitted per beam by non-negative least squares
 as ``(1 - short_rate) (dropout_rate + dropout_per_m r + dropout_grazing (1 - |cos i|))`` (a short
@@ -36,6 +40,7 @@ LASER_VALUES = (
     "range_noise_std",
     "range_noise_per_m",
     "short_rate",
+    "short_run_beams",
     "dropout_rate",
     "dropout_per_m",
     "dropout_grazing",
@@ -109,15 +114,60 @@ def _normal_tail(k: float) -> float:
     return 0.5 * math.erfc(k / math.sqrt(2.0))
 
 
+def _mean_run(
+    sample: BeamSample, short: NDArray[np.bool_], short_below: NDArray[np.float64], false_share: float, rate: float
+) -> float:
+    """``1 / (1 - q)``: ``q`` the share of short beams whose kept neighbour in the scan reads short too,
+    among those whose neighbour would be seen short at their reading (a run is one object at one
+    distance: a neighbour whose wall is nearer reads the wall); 0 when there is no such pair.
+    ``short_below`` ``[N]``: the reading below which each beam counts as short (m). ``false_share`` of
+    the short beams are the noise's tail, whose neighbours read short at the plain ``rate``: they are
+    taken out of the share."""
+    neighbours = (sample.frame[1:] == sample.frame[:-1]) & (sample.beam[1:] == sample.beam[:-1] + 1)
+    first = neighbours & short[:-1] & (sample.reading[:-1] < short_below[1:])
+    pairs = int(np.count_nonzero(first))
+    if pairs == 0:
+        return 0.0
+    seen = float(np.count_nonzero(first & short[1:])) / pairs
+    stay = (seen - false_share * rate) / (1.0 - false_share) if false_share < 1.0 else seen
+    return 1.0 / (1.0 - min(max(stay, 0.0), 0.999))
+
+
 def fit_laser(sample: BeamSample, settings: CalibrationSettings, range_min: float) -> LaserFit | None:
-    """Fit the laser's error models to ``sample``; None when fewer than two range bins have enough beams."""
+    """Fit the laser's error models to ``sample``; None when fewer than two range bins have enough beams.
+
+    The noise is fitted twice: on every returned beam, then without the neighbours of the short beams
+    the first fit finds (the edge of an object not in the map reads a little short, inside the Gaussian
+    core); the second fit is the result.
+    """
+    back = ~sample.no_return
+    first = _fit(sample, settings, range_min, back)
+    if first is None:
+        return None
+    second = _fit(sample, settings, range_min, back & ~_next_to(sample, first[1]))
+    return None if second is None else second[0]
+
+
+def _next_to(sample: BeamSample, marked: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """``[N]``: beams whose neighbour in the same scan is ``marked``."""
+    neighbours = (sample.frame[1:] == sample.frame[:-1]) & (sample.beam[1:] == sample.beam[:-1] + 1)
+    out = np.zeros(marked.size, dtype=bool)
+    out[1:] |= neighbours & marked[:-1]
+    out[:-1] |= neighbours & marked[1:]
+    return out
+
+
+def _fit(
+    sample: BeamSample, settings: CalibrationSettings, range_min: float, core: NDArray[np.bool_]
+) -> tuple[LaserFit, NDArray[np.bool_]] | None:
+    """The fit with the noise taken from the ``core`` beams ``[N]``, and its short beams ``[N]``."""
     r, e, back = sample.cast, sample.reading - sample.cast, ~sample.no_return
     edges = np.asarray(settings.range_bins, dtype=np.float64)
     which = np.searchsorted(edges, r, side="right") - 1
     rows = []
     for b in range(len(edges) - 1):
         in_bin = which == b
-        returned = in_bin & back
+        returned = in_bin & core
         if int(np.count_nonzero(returned)) < settings.min_bin_beams:
             continue
         mid, spread, inside = central_sigma(e[returned], cut=settings.core_cut)
@@ -144,6 +194,8 @@ def fit_laser(sample: BeamSample, settings: CalibrationSettings, range_min: floa
     false_alarms = _normal_tail(k) * float(np.count_nonzero(back & ~short))
     short_rate = max(0.0, (float(np.count_nonzero(short)) - false_alarms) / max(float(np.sum(seen)), 1e-9))
     short_rate = min(short_rate, 0.999)
+    false_share = min(false_alarms / max(float(np.count_nonzero(short)), 1.0), 1.0)
+    run_beams = _mean_run(sample, short, r + offset - k * beam_sigma, false_share, short_rate)
     y = sample.no_return.astype(np.float64) / (1.0 - short_rate)
     columns = [np.ones_like(r), r, 1.0 - sample.incidence]
     d0, d1, d2 = nonnegative_least_squares(columns, y)
@@ -151,6 +203,7 @@ def fit_laser(sample: BeamSample, settings: CalibrationSettings, range_min: floa
         "range_noise_std": a,
         "range_noise_per_m": b_,
         "short_rate": short_rate,
+        "short_run_beams": run_beams,
         "dropout_rate": d0,
         "dropout_per_m": d1,
         "dropout_grazing": d2,
@@ -158,7 +211,7 @@ def fit_laser(sample: BeamSample, settings: CalibrationSettings, range_min: floa
     no_return = np.array([float(np.mean(sample.no_return[which == b])) for b in bin_index])
     short_share = np.array([float(np.mean(short[which == b])) for b in bin_index])
     returned_e = e[back]
-    return LaserFit(
+    fit = LaserFit(
         values=values,
         bins=LaserBins(
             low=edges[bin_index],
@@ -176,3 +229,4 @@ def fit_laser(sample: BeamSample, settings: CalibrationSettings, range_min: floa
         off_share=float(np.count_nonzero(back & (np.abs(e) > 0.2))) / max(r.size, 1),
         no_return_share=float(np.mean(sample.no_return)) if r.size else math.nan,
     )
+    return fit, short

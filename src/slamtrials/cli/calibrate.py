@@ -58,6 +58,7 @@ def format_calibration(cal: Calibration, log: str) -> str:
         "range_noise_std",
         "range_noise_per_m",
         "short_rate",
+        "short_run_beams",
         "dropout_rate",
         "dropout_per_m",
         "dropout_grazing",

@@ -10,11 +10,15 @@ is hit), the reading of beam ``i`` is:
    sides of occupied cells, so the normal is along x or y);
 3. **short reading** (any beam): with probability ``short_rate`` something not in the map returns the
    beam first; the reading is ``min_range + u (r - min_range)``, ``u`` uniform in [0, 1), and neither
-   noise nor dropout applies to it;
+   noise nor dropout applies to it. With ``short_run_beams`` ``L >= 1`` the short beams come in runs
+   (a Markov chain along the scan: short after a short beam with probability ``1 - 1 / L``, after
+   another with :func:`~slamtrials.sim.config.short_start_chance`, the first beam with ``short_rate``);
+   a run is one object at the distance drawn for its first beam, ``d = min_range + u (r_first -
+   min_range)``, and a beam of the run whose true range is not beyond ``d`` keeps its own reading;
 
 then clipped to ``[min_range, max_range]``. Draws, from the run's stream, in this order and only for
 the models that are on: ``B`` standard normals (noise), ``B`` uniforms (dropout), ``B`` uniforms then
-``B`` uniforms (short: whether, where). Their number never depends on what the beams hit, so a run's
+``B`` uniforms (short: whether, where; the same with runs). Their number never depends on what the beams hit, so a run's
 stream is the same whatever the world looks like. With every rate 0 nothing is drawn (the paper's
 noise-free laser).
 """
@@ -27,7 +31,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
-from slamtrials.sim.config import LaserConfig
+from slamtrials.sim.config import LaserConfig, short_start_chance
 
 __all__ = ["apply_laser_errors", "incidence_cosines"]
 
@@ -57,6 +61,20 @@ def _incidence(ox, oy, theta, angles, t, out):  # pragma: no cover - compiled
             du = abs(u - math.floor(u + 0.5))
             dv = abs(v - math.floor(v + 0.5))
             out[b] = abs(c) if du <= dv else abs(s)
+
+
+@njit(cache=True, fastmath=False, nogil=True)
+def _short_runs(whether, where, r, reading, rate, stay, start, min_range):  # pragma: no cover - compiled
+    short = False
+    distance = 0.0
+    for b in range(r.shape[0]):
+        chance = rate if b == 0 else (stay if short else start)
+        now = whether[b] < chance
+        if now and not short:
+            distance = min_range + where[b] * max(r[b] - min_range, 0.0)
+        short = now
+        if short and distance < r[b]:
+            reading[b] = distance
 
 
 def incidence_cosines(
@@ -108,7 +126,13 @@ def apply_laser_errors(
             chance = chance + cfg.dropout_grazing * (1.0 - incidence)
         dropped = hit & (rng.random(count) < chance)
         reading = np.where(dropped, cfg.max_range, reading)
-    if cfg.short_rate > 0.0:
+    if cfg.short_rate > 0.0 and cfg.short_run_beams >= 1.0:
+        whether = rng.random(count)
+        where = rng.random(count)
+        stay = 1.0 - 1.0 / cfg.short_run_beams
+        reading = np.array(reading, dtype=np.float64)  # a copy: the kernel writes into it
+        _short_runs(whether, where, r, reading, cfg.short_rate, stay, short_start_chance(cfg), cfg.min_range)
+    elif cfg.short_rate > 0.0:
         short = rng.random(count) < cfg.short_rate
         where = rng.random(count)
         reading = np.where(short, cfg.min_range + where * np.maximum(r - cfg.min_range, 0.0), reading)

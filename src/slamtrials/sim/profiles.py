@@ -49,14 +49,15 @@ BUNDLED_PROFILES: dict[str, ErrorProfile] = {
     ),
     "mit-csail": ErrorProfile(
         name="mit-csail",
-        description="fitted by slamtrials calibrate (2026-11-24) to the shared MIT CSAIL log against GMapping's "
+        description="fitted by slamtrials calibrate (2026-11-25) to the shared MIT CSAIL log against GMapping's "
         "final path and map (default settings, seed 0); biases +- the measured per-run bias; noise per simulator "
         "step of 0.1 s; no slips (docs/realism.md, Calibration)",
         laser={
-            "range_noise_std": 0.03337,
-            "range_noise_per_m": 0.005331,
-            "short_rate": 0.1233,
-            "dropout_rate": 0.03450,
+            "range_noise_std": 0.03327,
+            "range_noise_per_m": 0.004496,
+            "short_rate": 0.1266,
+            "short_run_beams": 7.388,
+            "dropout_rate": 0.03464,
             "dropout_per_m": 0.0,
             "dropout_grazing": 0.0,
         },
@@ -77,12 +78,13 @@ BUNDLED_PROFILES: dict[str, ErrorProfile] = {
         "driving forward); biases +- the measured per-run bias; noise per simulator step of 0.1 s; no slips "
         "(docs/realism.md, Calibration)",
         laser={
-            "range_noise_std": 0.03259,
-            "range_noise_per_m": 0.002105,
-            "short_rate": 0.09754,
-            "dropout_rate": 0.01861,
+            "range_noise_std": 0.03329,
+            "range_noise_per_m": 0.001065,
+            "short_rate": 0.1011,
+            "short_run_beams": 5.146,
+            "dropout_rate": 0.01868,
             "dropout_per_m": 0.0,
-            "dropout_grazing": 0.01696,
+            "dropout_grazing": 0.01703,
         },
         odometry={
             "bias_linear_range": (-0.006648, 0.006648),

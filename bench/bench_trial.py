@@ -1,6 +1,7 @@
 """Trial speed: wall time of one complete trial on one core, and the simulated-to-wall-time ratio.
 
-Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/bench_trial.py [--worlds NAME ...] [--seed 1]``.
+Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/bench_trial.py [--worlds NAME ...] [--seeds 1 ...]
+[--algorithms gmapping karto]``.
 
 Each world gets one trial with the paper's set-up (:func:`slamtrials.trial.run_trial` defaults: online
 GMapping ``paper`` preset, the frontier explorer, the paper's termination rule), in this process, after a
@@ -9,6 +10,12 @@ area the robot can reach, how the trial ended, simulated and wall time, their ra
 ran in real time: ratio 1), GMapping updates and their mean cost, the share of the wall time spent in
 SLAM and in planning, distance and turning. The target of issue 6: a world of about 1,000 m^2 in at most
 60 s of wall time on one core.
+
+With several ``--algorithms`` (``gmapping`` runs its ``paper`` preset, any other algorithm its defaults;
+the paper's robot and laser either way) the trials are interleaved, seed by seed and world by world,
+algorithm after algorithm, so that a slower or busier stretch of a shared machine hits them alike; a
+second table then gives each algorithm's wall seconds per simulated second and their ratio to the first
+algorithm's, per world and seed and in total.
 
 Default worlds: office_small_01 (small, 153 m^2), mit_building31 and school_medium_01 (about
 1,000 m^2; the first from ``../shared/worlds/real``), lab_large_01 (large, 3,092 m^2). Names are
@@ -40,44 +47,92 @@ def resolve(name: str) -> str:
     return name
 
 
+def trial_config(algorithm: str):
+    """The paper's set-up with ``algorithm`` online: GMapping's ``paper`` preset, another's defaults."""
+    from slamtrials.trial import TrialConfig
+
+    preset = "paper" if algorithm == "gmapping" else None
+    return TrialConfig.from_dict({"slam": {"algorithm": algorithm, "preset": preset}})
+
+
 def main() -> None:
     from slamtrials.trial import run_trial
     from slamtrials.worlds import load_world
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--worlds", nargs="+", default=list(DEFAULT_WORLDS))
-    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--seeds", "--seed", nargs="+", type=int, default=[1])
+    parser.add_argument(
+        "--algorithms", nargs="+", default=["gmapping"], help="SLAM algorithms to time, interleaved (first: reference)"
+    )
     args = parser.parse_args()
 
-    started = time.perf_counter()
-    run_trial(load_world("house_small_01"), None, 0)  # compiles every kernel
-    print(f"warm-up trial (with compilation): {time.perf_counter() - started:.0f} s", flush=True)
+    configs = {algorithm: trial_config(algorithm) for algorithm in args.algorithms}
+    for algorithm, config in configs.items():
+        started = time.perf_counter()
+        run_trial(load_world("house_small_01"), config, 0)  # compiles every kernel
+        print(f"warm-up trial of {algorithm} (with compilation): {time.perf_counter() - started:.0f} s", flush=True)
     rows = []
-    for name in args.worlds:
-        world = load_world(resolve(name))
-        load = os.getloadavg()[0]
-        info = run_trial(world, None, args.seed).metadata["trial"]
-        rows.append((world.name, info, load))
-        print(f"{world.name}: {info['duration_s']:.0f} s simulated in {info['wall_time_s']:.0f} s", flush=True)
+    for seed in args.seeds:
+        for name in args.worlds:
+            world = load_world(resolve(name))
+            for algorithm, config in configs.items():
+                load = os.getloadavg()[0]
+                info = run_trial(world, config, seed).metadata["trial"]
+                rows.append((world.name, seed, algorithm, info, load))
+                print(
+                    f"{world.name} seed {seed} {algorithm}: {info['duration_s']:.0f} s simulated in "
+                    f"{info['wall_time_s']:.1f} s",
+                    flush=True,
+                )
 
     print(
         f"\n- Machine: {os.cpu_count()} cores, CPU `{cpu_model()}`; one trial at a time, NUMBA_NUM_THREADS=1; "
-        f"date {time.strftime('%Y-%m-%d')}; seed {args.seed}"
+        f"date {time.strftime('%Y-%m-%d')}; seeds {' '.join(map(str, args.seeds))}"
     )
     print()
     print(
-        "| world | reachable m^2 | end | mapped | simulated s | wall s | sim/wall | updates | SLAM ms per update "
-        "| SLAM share | planning share | distance m | turning rad | load avg |"
+        "| world | seed | algorithm | reachable m^2 | end | mapped | simulated s | wall s | sim/wall | updates "
+        "| SLAM ms per update | SLAM share | planning share | distance m | turning rad | load avg |"
     )
-    print("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
-    for name, info, load in rows:
+    print("|---|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for name, seed, algorithm, info, load in rows:
         wall = info["wall_time_s"]
         print(
-            f"| {name} | {info['reachable_area_m2']:,.0f} | {info['termination_reason']} | {info['mapped_fraction']:.3f} | "
+            f"| {name} | {seed} | {algorithm} | {info['reachable_area_m2']:,.0f} | {info['termination_reason']} | "
+            f"{info['mapped_fraction']:.3f} | "
             f"{info['duration_s']:.0f} | {wall:.0f} | {info['realtime_factor']:.1f} | {info['slam_updates']} | "
             f"{1e3 * info['slam_seconds'] / max(info['slam_updates'], 1):.0f} | {info['slam_seconds'] / wall:.0%} | "
             f"{info['explorer']['plan_seconds'] / wall:.0%} | {info['distance_m']:.0f} | {info['turning_rad']:.0f} | {load:.1f} |"
         )
+    if len(configs) > 1:
+        print_ratios(rows, args.algorithms)
+
+
+def print_ratios(rows, algorithms: list[str]) -> None:
+    """Wall seconds per simulated second of each algorithm, and their ratio to the first algorithm's."""
+    reference, others = algorithms[0], algorithms[1:]
+    per = {(name, seed, algorithm): info for name, seed, algorithm, info, _ in rows}
+    cases = list(dict.fromkeys((name, seed) for name, seed, _, _, _ in rows))
+    header = " | ".join(f"{a} wall s per sim s" for a in algorithms)
+    ratios = " | ".join(f"{a} / {reference}" for a in others)
+    print(f"\n| world | seed | {header} | {ratios} |")
+    print("|---|---:|" + "---:|" * (len(algorithms) + len(others)))
+    totals = {a: [0.0, 0.0] for a in algorithms}
+    for name, seed in cases:
+        rate = {}
+        for algorithm in algorithms:
+            info = per[(name, seed, algorithm)]
+            rate[algorithm] = info["wall_time_s"] / info["duration_s"]
+            totals[algorithm][0] += info["wall_time_s"]
+            totals[algorithm][1] += info["duration_s"]
+        cells = " | ".join(f"{rate[a]:.4f}" for a in algorithms)
+        ratio_cells = " | ".join(f"{rate[a] / rate[reference]:.2f}" for a in others)
+        print(f"| {name} | {seed} | {cells} | {ratio_cells} |")
+    rate = {a: wall / sim for a, (wall, sim) in totals.items()}
+    cells = " | ".join(f"{rate[a]:.4f}" for a in algorithms)
+    ratio_cells = " | ".join(f"{rate[a] / rate[reference]:.2f}" for a in others)
+    print(f"| all (total wall / total simulated) | | {cells} | {ratio_cells} |")
 
 
 if __name__ == "__main__":

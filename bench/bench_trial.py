@@ -78,11 +78,13 @@ def main() -> None:
             world = load_world(resolve(name))
             for algorithm, config in configs.items():
                 load = os.getloadavg()[0]
-                info = run_trial(world, config, seed).metadata["trial"]
+                cpu = time.process_time()
+                info = dict(run_trial(world, config, seed).metadata["trial"])
+                info["cpu_time_s"] = time.process_time() - cpu  # this process's CPU time: no waiting for a core
                 rows.append((world.name, seed, algorithm, info, load))
                 print(
                     f"{world.name} seed {seed} {algorithm}: {info['duration_s']:.0f} s simulated in "
-                    f"{info['wall_time_s']:.1f} s",
+                    f"{info['wall_time_s']:.1f} s (CPU {info['cpu_time_s']:.1f} s)",
                     flush=True,
                 )
 
@@ -92,16 +94,16 @@ def main() -> None:
     )
     print()
     print(
-        "| world | seed | algorithm | reachable m^2 | end | mapped | simulated s | wall s | sim/wall | updates "
+        "| world | seed | algorithm | reachable m^2 | end | mapped | simulated s | wall s | CPU s | sim/wall | updates "
         "| SLAM ms per update | SLAM share | planning share | distance m | turning rad | load avg |"
     )
-    print("|---|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("|---|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for name, seed, algorithm, info, load in rows:
         wall = info["wall_time_s"]
         print(
             f"| {name} | {seed} | {algorithm} | {info['reachable_area_m2']:,.0f} | {info['termination_reason']} | "
             f"{info['mapped_fraction']:.3f} | "
-            f"{info['duration_s']:.0f} | {wall:.0f} | {info['realtime_factor']:.1f} | {info['slam_updates']} | "
+            f"{info['duration_s']:.0f} | {wall:.1f} | {info['cpu_time_s']:.1f} | {info['realtime_factor']:.1f} | {info['slam_updates']} | "
             f"{1e3 * info['slam_seconds'] / max(info['slam_updates'], 1):.0f} | {info['slam_seconds'] / wall:.0%} | "
             f"{info['explorer']['plan_seconds'] / wall:.0%} | {info['distance_m']:.0f} | {info['turning_rad']:.0f} | {load:.1f} |"
         )
@@ -110,29 +112,30 @@ def main() -> None:
 
 
 def print_ratios(rows, algorithms: list[str]) -> None:
-    """Wall seconds per simulated second of each algorithm, and their ratio to the first algorithm's."""
+    """Wall and CPU seconds per simulated second of each algorithm, and their ratio to the first algorithm's."""
     reference, others = algorithms[0], algorithms[1:]
     per = {(name, seed, algorithm): info for name, seed, algorithm, info, _ in rows}
     cases = list(dict.fromkeys((name, seed) for name, seed, _, _, _ in rows))
-    header = " | ".join(f"{a} wall s per sim s" for a in algorithms)
-    ratios = " | ".join(f"{a} / {reference}" for a in others)
-    print(f"\n| world | seed | {header} | {ratios} |")
-    print("|---|---:|" + "---:|" * (len(algorithms) + len(others)))
-    totals = {a: [0.0, 0.0] for a in algorithms}
-    for name, seed in cases:
-        rate = {}
-        for algorithm in algorithms:
-            info = per[(name, seed, algorithm)]
-            rate[algorithm] = info["wall_time_s"] / info["duration_s"]
-            totals[algorithm][0] += info["wall_time_s"]
-            totals[algorithm][1] += info["duration_s"]
+    for key, label in (("wall_time_s", "wall"), ("cpu_time_s", "CPU")):
+        header = " | ".join(f"{a} {label} s per sim s" for a in algorithms)
+        ratios = " | ".join(f"{a} / {reference}" for a in others)
+        print(f"\n| world | seed | {header} | {ratios} |")
+        print("|---|---:|" + "---:|" * (len(algorithms) + len(others)))
+        totals = {a: [0.0, 0.0] for a in algorithms}
+        for name, seed in cases:
+            rate = {}
+            for algorithm in algorithms:
+                info = per[(name, seed, algorithm)]
+                rate[algorithm] = info[key] / info["duration_s"]
+                totals[algorithm][0] += info[key]
+                totals[algorithm][1] += info["duration_s"]
+            cells = " | ".join(f"{rate[a]:.4f}" for a in algorithms)
+            ratio_cells = " | ".join(f"{rate[a] / rate[reference]:.2f}" for a in others)
+            print(f"| {name} | {seed} | {cells} | {ratio_cells} |")
+        rate = {a: spent / simulated for a, (spent, simulated) in totals.items()}
         cells = " | ".join(f"{rate[a]:.4f}" for a in algorithms)
         ratio_cells = " | ".join(f"{rate[a] / rate[reference]:.2f}" for a in others)
-        print(f"| {name} | {seed} | {cells} | {ratio_cells} |")
-    rate = {a: wall / sim for a, (wall, sim) in totals.items()}
-    cells = " | ".join(f"{rate[a]:.4f}" for a in algorithms)
-    ratio_cells = " | ".join(f"{rate[a] / rate[reference]:.2f}" for a in others)
-    print(f"| all (total wall / total simulated) | | {cells} | {ratio_cells} |")
+        print(f"| all (total {label} / total simulated) | | {cells} | {ratio_cells} |")
 
 
 if __name__ == "__main__":

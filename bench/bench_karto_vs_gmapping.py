@@ -14,6 +14,9 @@ Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/bench_karto_vs_gmapping.py OUT
    exploration (``OUT/karto_online``), and ``slamtrials compare OUT/gmapping OUT/karto_online``
    (unpaired: Welch).
 
+``--profile paper`` runs all of it with the paper's error profile instead (noise-free laser, the
+paper's odometry bias) in the same folder layout: give it another ``OUT``.
+
 Each step resumes what a previous call left in ``OUT`` (a finished campaign is not run again). The
 real maps are found through ``$SLAMTRIALS_SHARED`` (default: ``../shared`` next to the repository),
 written into a copy of each config in ``OUT``. Figures of the last run: docs/karto.md, "Comparison
@@ -37,9 +40,12 @@ SHARED = Path(os.environ.get("SLAMTRIALS_SHARED", HERE.parent.parent / "shared")
 REAL_PREFIX = "../../../../shared/"
 
 
-def localized_config(name: str, out: Path) -> Path:
-    """``CONFIGS/name`` with its real-map entries pointing into ``$SLAMTRIALS_SHARED``, saved in ``out``."""
+def localized_config(name: str, out: Path, profile: str | None = None) -> Path:
+    """``CONFIGS/name`` with its real-map entries pointing into ``$SLAMTRIALS_SHARED`` (and ``sim.profile``
+    set to ``profile`` if given), saved in ``out``."""
     data = yaml.safe_load((CONFIGS / name).read_text(encoding="utf-8"))
+    if profile is not None:
+        data.setdefault("sim", {})["profile"] = profile
     worlds = []
     for entry in data["worlds"]:
         if entry.startswith(REAL_PREFIX):
@@ -70,13 +76,22 @@ def main() -> None:
     parser.add_argument("out", type=Path, help="folder of the campaigns (created; resumed if it exists)")
     parser.add_argument("--workers", "-j", type=int, default=1, help="worker processes (1 or 2 on a shared machine)")
     parser.add_argument("--online", action="store_true", help="also a campaign where karto explores, compared unpaired")
+    parser.add_argument(
+        "--profile", default=None, help="error profile of every campaign (default: the configs', realistic), e.g. paper"
+    )
     args = parser.parse_args()
     out = args.out.resolve()
     out.mkdir(parents=True, exist_ok=True)
     workers = str(args.workers)
 
     slamtrials(
-        "campaign", "run", str(localized_config("gmapping.yaml", out)), "--out", str(out / "gmapping"), "-j", workers
+        "campaign",
+        "run",
+        str(localized_config("gmapping.yaml", out, args.profile)),
+        "--out",
+        str(out / "gmapping"),
+        "-j",
+        workers,
     )
     slamtrials(
         "campaign",
@@ -91,7 +106,7 @@ def main() -> None:
     )
     slamtrials("compare", str(out / "gmapping"), str(out / "karto_replay"))
     if args.online:
-        config = localized_config("karto.yaml", out)
+        config = localized_config("karto.yaml", out, args.profile)
         slamtrials("campaign", "run", str(config), "--out", str(out / "karto_online"), "-j", workers)
         slamtrials("compare", str(out / "gmapping"), str(out / "karto_online"))
 

@@ -1,6 +1,7 @@
 """Issue 23, point 5: GMapping (paper preset) against karto (defaults), from scratch, into one folder.
 
-Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/bench_karto_vs_gmapping.py OUT [--workers 1] [--online]``.
+Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/bench_karto_vs_gmapping.py [OUT] [--workers 1] [--online]
+[--profile paper]``.
 
 1. ``slamtrials campaign run bench/configs/karto_vs_gmapping/gmapping.yaml --out OUT/gmapping``: online
    GMapping with the ``paper`` preset explores the demo's three bundled worlds and three small real maps
@@ -29,6 +30,7 @@ import argparse
 import os
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -73,14 +75,22 @@ def slamtrials(*args: str) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("out", type=Path, help="folder of the campaigns (created; resumed if it exists)")
+    parser.add_argument(
+        "out",
+        type=Path,
+        nargs="?",
+        default=None,
+        help="folder of the campaigns (created; resumed if it exists; "
+        "default: a new temporary folder, as bench/run_all.py runs it)",
+    )
     parser.add_argument("--workers", "-j", type=int, default=1, help="worker processes (1 or 2 on a shared machine)")
     parser.add_argument("--online", action="store_true", help="also a campaign where karto explores, compared unpaired")
     parser.add_argument(
         "--profile", default=None, help="error profile of every campaign (default: the configs', realistic), e.g. paper"
     )
     args = parser.parse_args()
-    out = args.out.resolve()
+    out = (Path(tempfile.mkdtemp(prefix="karto_vs_gmapping-")) if args.out is None else args.out).resolve()
+    print(f"campaigns in {out}", flush=True)
     out.mkdir(parents=True, exist_ok=True)
     workers = str(args.workers)
 

@@ -1,7 +1,7 @@
 """Trial speed: wall time of one complete trial on one core, and the simulated-to-wall-time ratio.
 
-Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/bench_trial.py [--worlds NAME ...] [--seed 1]
-[--seeds 1 2 3] [--profiles paper realistic]``.
+Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/bench_trial.py [--worlds NAME ...] [--seeds 1 ...]
+[--algorithms gmapping karto] [--profiles paper realistic]``.
 
 Each world gets one trial with the paper's set-up (:func:`slamtrials.trial.run_trial` defaults: online
 GMapping ``paper`` preset, the frontier explorer, the paper's termination rule), in this process, after a
@@ -10,6 +10,12 @@ area the robot can reach, how the trial ended, simulated and wall time, their ra
 ran in real time: ratio 1), GMapping updates and their mean cost, the share of the wall time spent in
 SLAM and in planning, distance and turning. The target of issue 6: a world of about 1,000 m^2 in at most
 60 s of wall time on one core.
+
+With several ``--algorithms`` (``gmapping`` runs its ``paper`` preset, any other algorithm its defaults;
+the paper's robot and laser either way) the trials are interleaved, seed by seed and world by world,
+algorithm after algorithm, so that a slower or busier stretch of a shared machine hits them alike; a
+second table then gives each algorithm's wall seconds per simulated second and their ratio to the first
+algorithm's, per world and seed and in total.
 
 Default worlds: office_small_01 (small, 153 m^2), mit_building31 and school_medium_01 (about
 1,000 m^2; the first from ``../shared/worlds/real``), lab_large_01 (large, 3,092 m^2). Names are
@@ -53,69 +59,85 @@ def resolve(name: str) -> str:
     return name
 
 
+def trial_config(algorithm: str, profile: str = "paper"):
+    """The paper's set-up with ``algorithm`` online (GMapping's ``paper`` preset, another's defaults) and the
+    simulator's error ``profile``."""
+    from slamtrials.trial import TrialConfig
+
+    preset = "paper" if algorithm == "gmapping" else None
+    return TrialConfig.from_dict({"slam": {"algorithm": algorithm, "preset": preset}, "sim": {"profile": profile}})
+
+
 def main() -> None:
     from slamtrials.trial import run_trial
     from slamtrials.worlds import load_world
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--worlds", nargs="+", default=list(DEFAULT_WORLDS))
-    parser.add_argument("--seed", type=int, default=1, help="seed of every trial (unless --seeds)")
-    parser.add_argument("--seeds", type=int, nargs="+", help="several seeds per world and profile")
+    parser.add_argument("--seeds", "--seed", nargs="+", type=int, default=[1])
     parser.add_argument(
-        "--profiles", nargs="+", default=["paper"], help="simulator error profiles, run interleaved (first = reference)"
+        "--algorithms", nargs="+", default=["gmapping"], help="SLAM algorithms to time, interleaved (first: reference)"
+    )
+    parser.add_argument(
+        "--profiles", nargs="+", default=["paper"], help="simulator error profiles, run interleaved (first: reference)"
     )
     args = parser.parse_args()
-    seeds = args.seeds or [args.seed]
 
-    started = time.perf_counter()
-    run_trial(load_world("house_small_01"), None, 0)  # compiles every kernel
-    run_trial(load_world("house_small_01"), _config(args.profiles[-1]), 0)  # and the error models' kernels
-    print(f"warm-up trials (with compilation): {time.perf_counter() - started:.0f} s", flush=True)
+    several = len(args.algorithms) > 1 and len(args.profiles) > 1
+    configs = {
+        (f"{algorithm}/{profile}" if several else algorithm if len(args.algorithms) > 1 else profile): trial_config(
+            algorithm, profile
+        )
+        for algorithm in args.algorithms
+        for profile in args.profiles
+    }
+    for algorithm, config in configs.items():
+        started = time.perf_counter()
+        run_trial(load_world("house_small_01"), config, 0)  # compiles every kernel
+        print(f"warm-up trial of {algorithm} (with compilation): {time.perf_counter() - started:.0f} s", flush=True)
     rows = []
-    for name in args.worlds:
-        world = load_world(resolve(name))
-        for seed in seeds:
-            for profile in args.profiles:
+    for seed in args.seeds:
+        for name in args.worlds:
+            world = load_world(resolve(name))
+            for algorithm, config in configs.items():
                 load = os.getloadavg()[0]
-                record = run_trial(world, _config(profile), seed)
-                info = record.metadata["trial"]
-                free = mapped_free_fraction(world, record)
-                rows.append((world.name, profile, seed, info, free, load))
+                cpu = time.process_time()
+                record = run_trial(world, config, seed)
+                info = dict(record.metadata["trial"])
+                info["cpu_time_s"] = time.process_time() - cpu  # this process's CPU time: no waiting for a core
+                info["mapped_free"] = mapped_free_fraction(world, record)
+                rows.append((world.name, seed, algorithm, info, load))
                 digest = hashlib.sha256(record.truth.tobytes() + record.estimate.tobytes()).hexdigest()[:16]
                 print(
-                    f"{world.name} {profile} seed {seed}: {info['termination_reason']} after {info['duration_s']:.1f} s "
-                    f"simulated in {info['wall_time_s']:.1f} s, {info['slam_updates']} updates, mapped free {free:.3f}, "
-                    f"load {load:.1f}, run digest {digest}",
+                    f"{world.name} seed {seed} {algorithm}: {info['termination_reason']} after {info['duration_s']:.0f} s "
+                    f"simulated in {info['wall_time_s']:.1f} s (CPU {info['cpu_time_s']:.1f} s), mapped free "
+                    f"{info['mapped_free']:.3f}, load {load:.1f}, run digest {digest}",
                     flush=True,
                 )
 
     print(
         f"\n- Machine: {os.cpu_count()} cores, CPU `{cpu_model()}`; one trial at a time, NUMBA_NUM_THREADS=1; "
-        f"date {time.strftime('%Y-%m-%d')}; seeds {' '.join(map(str, seeds))}; profiles {' '.join(args.profiles)}"
+        f"date {time.strftime('%Y-%m-%d')}; seeds {' '.join(map(str, args.seeds))}; "
+        f"algorithms {' '.join(args.algorithms)}; profiles {' '.join(args.profiles)}"
     )
     print()
     print(
-        "| world | profile | seed | reachable m^2 | end | mapped | mapped free | simulated s | wall s | sim/wall | updates "
+        "| world | seed | trial | reachable m^2 | end | mapped | mapped free | simulated s | wall s | CPU s | sim/wall | updates "
         "| SLAM ms per update | SLAM share | planning share | distance m | turning rad | load avg |"
     )
-    print("|---|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
-    for name, profile, seed, info, free, load in rows:
+    print("|---|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for name, seed, algorithm, info, load in rows:
         wall = info["wall_time_s"]
         print(
-            f"| {name} | {profile} | {seed} | {info['reachable_area_m2']:,.0f} | {info['termination_reason']} | "
-            f"{info['mapped_fraction']:.3f} | {free:.3f} | {info['duration_s']:.0f} | {wall:.1f} | "
-            f"{info['realtime_factor']:.1f} | {info['slam_updates']} | "
+            f"| {name} | {seed} | {algorithm} | {info['reachable_area_m2']:,.0f} | {info['termination_reason']} | "
+            f"{info['mapped_fraction']:.3f} | {info['mapped_free']:.3f} | "
+            f"{info['duration_s']:.0f} | {wall:.1f} | {info['cpu_time_s']:.1f} | {info['realtime_factor']:.1f} | {info['slam_updates']} | "
             f"{1e3 * info['slam_seconds'] / max(info['slam_updates'], 1):.0f} | {info['slam_seconds'] / wall:.0%} | "
             f"{info['explorer']['plan_seconds'] / wall:.0%} | {info['distance_m']:.0f} | {info['turning_rad']:.0f} | {load:.1f} |"
         )
-    if len(args.profiles) > 1:
-        _profile_summary(rows, args.profiles)
-
-
-def _config(profile: str):  # noqa: ANN202 - TrialConfig, imported late
-    from slamtrials.trial import TrialConfig
-
-    return TrialConfig.model_validate({"sim": {"profile": profile}})
+    if len(configs) > 1:
+        print_ratios(rows, list(configs))
+        print_summary(rows, list(configs))
 
 
 def mapped_free_fraction(world, record) -> float:  # noqa: ANN001 - World, RunRecord
@@ -133,30 +155,57 @@ def mapped_free_fraction(world, record) -> float:  # noqa: ANN001 - World, RunRe
     )
 
 
-def _profile_summary(rows: list, profiles: list[str]) -> None:
-    """Per world: mean wall and simulated time of each profile, ends, mapped free share, wall-time ratio."""
+def print_ratios(rows, algorithms: list[str]) -> None:
+    """Wall and CPU seconds per simulated second of each algorithm, and their ratio to the first algorithm's."""
+    reference, others = algorithms[0], algorithms[1:]
+    per = {(name, seed, algorithm): info for name, seed, algorithm, info, _ in rows}
+    cases = list(dict.fromkeys((name, seed) for name, seed, _, _, _ in rows))
+    for key, label in (("wall_time_s", "wall"), ("cpu_time_s", "CPU")):
+        header = " | ".join(f"{a} {label} s per sim s" for a in algorithms)
+        ratios = " | ".join(f"{a} / {reference}" for a in others)
+        print(f"\n| world | seed | {header} | {ratios} |")
+        print("|---|---:|" + "---:|" * (len(algorithms) + len(others)))
+        totals = {a: [0.0, 0.0] for a in algorithms}
+        for name, seed in cases:
+            rate = {}
+            for algorithm in algorithms:
+                info = per[(name, seed, algorithm)]
+                rate[algorithm] = info[key] / info["duration_s"]
+                totals[algorithm][0] += info[key]
+                totals[algorithm][1] += info["duration_s"]
+            cells = " | ".join(f"{rate[a]:.4f}" for a in algorithms)
+            ratio_cells = " | ".join(f"{rate[a] / rate[reference]:.2f}" for a in others)
+            print(f"| {name} | {seed} | {cells} | {ratio_cells} |")
+        rate = {a: spent / simulated for a, (spent, simulated) in totals.items()}
+        cells = " | ".join(f"{rate[a]:.4f}" for a in algorithms)
+        ratio_cells = " | ".join(f"{rate[a] / rate[reference]:.2f}" for a in others)
+        print(f"| all (total {label} / total simulated) | | {cells} | {ratio_cells} |")
+
+
+def print_summary(rows: list, labels: list[str]) -> None:
+    """Per world: mean wall and simulated time of each trial kind, ends, mapped free share, wall-time ratio."""
     print()
     print(
-        "| world | profile | trials | ends | mean simulated s | mean wall s | mean mapped free | wall / "
-        + profiles[0]
+        "| world | trial | trials | ends | mean simulated s | mean wall s | mean mapped free | wall / "
+        + labels[0]
         + " |"
     )
     print("|---|---|---:|---|---:|---:|---:|---:|")
     worlds = list(dict.fromkeys(row[0] for row in rows))
     for name in worlds:
         reference = None
-        for profile in profiles:
-            mine = [row for row in rows if row[0] == name and row[1] == profile]
+        for label in labels:
+            mine = [row for row in rows if row[0] == name and row[2] == label]
             wall = sum(row[3]["wall_time_s"] for row in mine) / len(mine)
             sim = sum(row[3]["duration_s"] for row in mine) / len(mine)
-            free = sum(row[4] for row in mine) / len(mine)
+            free = sum(row[3]["mapped_free"] for row in mine) / len(mine)
             ends: dict[str, int] = {}
             for row in mine:
                 ends[row[3]["termination_reason"]] = ends.get(row[3]["termination_reason"], 0) + 1
             reference = wall if reference is None else reference
             end_text = ", ".join(f"{k} {v}" for k, v in sorted(ends.items()))
             print(
-                f"| {name} | {profile} | {len(mine)} | {end_text} | {sim:.0f} | {wall:.1f} | {free:.3f} | "
+                f"| {name} | {label} | {len(mine)} | {end_text} | {sim:.0f} | {wall:.1f} | {free:.3f} | "
                 f"{wall / reference:.2f} |"
             )
 

@@ -4,10 +4,11 @@ An entry of ``worlds`` is
 
 * a bundled catalog name (``office_small_01``): the world's name is the catalog name;
 * a floor-plan file (map_server ``.yaml``/``.yml``, Stage ``.world``, HouseExpo ``.json``): its name is
-  the file stem;
+  the file stem, or the folder's name for the generic ``map.yaml`` of a map_server folder (as
+  :func:`~slamtrials.worlds.load_world` names it: ``real/hbrs_c069/map.yaml`` -> ``hbrs_c069``);
 * a folder: every floor plan inside it, searched recursively, in sorted order of relative path. A
   ``.yaml`` counts only when it is a map_server map (it has an ``image`` key). A plan directly in the
-  folder is named by its stem; one in a subfolder by the subfolder path (``a/b`` -> ``a-b``) when it is
+  folder is named by its stem (a generic ``map.yaml`` by the folder's name); one in a subfolder by the subfolder path (``a/b`` -> ``a-b``) when it is
   the only plan there, else by that path and its stem (``a-b-stem``).
 
 Names are the run folders' names (``runs/<name>/``) and key each run's seed, so they must be unique;
@@ -36,6 +37,13 @@ PLAN_SUFFIXES = (".yaml", ".yml", ".world", ".json")
 
 def _clean(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9._-]", "_", name).lstrip(".") or "world"
+
+
+def _stem_name(path: Path) -> str:
+    """A plan file's own name: its stem, or its folder's name for a generic map_server ``map.yaml``."""
+    if path.stem == "map" and path.suffix.lower() in (".yaml", ".yml") and path.parent.name:
+        return path.parent.name
+    return path.stem
 
 
 def _is_map_yaml(path: Path) -> bool:
@@ -95,14 +103,14 @@ def expand_worlds(entries: Sequence[str], *, base: str | Path | None = None) -> 
             for plan in plans:
                 rel = plan.parent.relative_to(path)
                 if rel == Path("."):
-                    name = plan.stem
+                    name = _stem_name(plan)
                 elif per_folder[plan.parent] == 1:
                     name = "-".join(rel.parts)
                 else:
                     name = "-".join((*rel.parts, plan.stem))
                 out.append((_clean(name), str(plan.resolve()), entry))
         elif path.exists():
-            out.append((_clean(path.stem), str(path.resolve()), entry))
+            out.append((_clean(_stem_name(path)), str(path.resolve()), entry))
         else:
             out.append((_clean(entry), entry, entry))  # a catalog name (load_world reports unknown ones)
     seen: dict[str, str] = {}

@@ -156,7 +156,7 @@ class LaserConfig(BaseModel):
         early: the reading is drawn uniformly between ``min_range`` and the true range. Default 0.
     short_run_beams:
         Mean length (beams) of a run of neighbouring short readings: such things are wider than a beam,
-        so real short readings come in runs (3 to 4 beams of 0.5 degree in the shared logs). 0 (the
+        so real short readings come in runs (fitted: 5 to 7 beams of 0.5 degree in the shared logs). 0 (the
         default): every beam on its own. At least 1: along the scan, a beam reads short with probability
         ``1 - 1 / short_run_beams`` after a short one and such that ``short_rate`` of the beams do in
         all; a run is one object, at the distance drawn for its first beam (beams whose wall is nearer

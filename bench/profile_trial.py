@@ -1,7 +1,7 @@
 """Where a trial's time goes: one trial under cProfile, the functions with the most time.
 
 Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/profile_trial.py --world school_medium_01 --seed 2
-[--algorithm karto] [--top 25]``.
+[--algorithm karto] [--profile realistic] [--top 25]``.
 
 The trial is the paper's set-up with ``--algorithm`` online (``gmapping``: its ``paper`` preset; others:
 their defaults), after a warm-up trial on a tiny world so that numba's compilation is not counted.
@@ -34,10 +34,11 @@ def main() -> None:
     parser.add_argument("--world", default="school_medium_01")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--algorithm", default="karto")
+    parser.add_argument("--profile", default="paper", help="the simulator's error profile")
     parser.add_argument("--top", type=int, default=25)
     args = parser.parse_args()
 
-    config = trial_config(args.algorithm)
+    config = trial_config(args.algorithm, args.profile)
     trial_run.run_trial(load_world("house_small_01"), config, 0)  # compiles every kernel
     caught = []
     original = trial_run.get_algorithm

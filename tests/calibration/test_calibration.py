@@ -180,3 +180,11 @@ def test_odometry_that_moves_against_the_reference_is_left_out_not_fitted_as_noi
     assert absorbed.values["noise_linear_per_m"] + absorbed.values["noise_linear_per_rad"] > 3.0 * (
         kept.values["noise_linear_per_m"] + kept.values["noise_linear_per_rad"]
     )
+
+
+def test_long_readings_are_counted_apart_and_none_come_from_the_simulated_laser(fitted):
+    # the simulated laser reads short (objects not in the map) but never past a wall, and here the
+    # reference is the truth: beyond the cut there are short readings and, tails taken out, no long ones
+    laser = fitted.laser
+    assert laser.short_share > 0.04
+    assert laser.long_share < 0.002

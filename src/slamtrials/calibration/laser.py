@@ -100,6 +100,12 @@ class LaserFit:
         Share of kept beams that returned something more than 0.2 m from the cast range.
     no_return_share:
         Share of kept beams that returned nothing.
+    short_share, long_share:
+        Shares of the returned kept beams read more than ``short_sigmas`` sigmas short of / beyond the
+        cast range (from the bin's centre), the Gaussian tail's expected count taken out. Long readings
+        are not modelled (the simulated laser never reads past a wall): they come from glass and open
+        doors, and from the reference's own pose and map errors, which make readings go long as often
+        as short (docs/realism.md, "Assumptions").
     """
 
     values: dict[str, float]
@@ -108,6 +114,8 @@ class LaserFit:
     robust_sigma: float
     off_share: float
     no_return_share: float
+    short_share: float
+    long_share: float
 
 
 def _normal_tail(k: float) -> float:
@@ -211,6 +219,9 @@ def _fit(
     no_return = np.array([float(np.mean(sample.no_return[which == b])) for b in bin_index])
     short_share = np.array([float(np.mean(short[which == b])) for b in bin_index])
     returned_e = e[back]
+    returned = max(float(np.count_nonzero(back)), 1.0)
+    long = back & (e - offset > k * beam_sigma)
+    tail = _normal_tail(k) * float(np.count_nonzero(back & ~short & ~long))
     fit = LaserFit(
         values=values,
         bins=LaserBins(
@@ -228,5 +239,7 @@ def _fit(
         robust_sigma=robust_sigma(returned_e)[1],
         off_share=float(np.count_nonzero(back & (np.abs(e) > 0.2))) / max(r.size, 1),
         no_return_share=float(np.mean(sample.no_return)) if r.size else math.nan,
+        short_share=max(0.0, (float(np.count_nonzero(short)) - tail) / returned),
+        long_share=max(0.0, (float(np.count_nonzero(long)) - tail) / returned),
     )
     return fit, short

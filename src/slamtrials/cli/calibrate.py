@@ -44,7 +44,9 @@ def format_calibration(cal: Calibration, log: str) -> str:
         f"laser: {laser.beams} beams of {cal.laser_frames} frames hit a mapped wall through known free space; "
         "robust sigma of their residuals "
         f"{laser.robust_sigma:.4f} m, {100 * laser.off_share:.1f} % off by more than 0.2 m, "
-        f"{100 * laser.no_return_share:.2f} % no return"
+        f"{100 * laser.no_return_share:.2f} % no return; past the short-reading cut "
+        f"{100 * laser.short_share:.1f} % short, {100 * laser.long_share:.1f} % long (not modelled: glass, "
+        "open doors, and the reference's own pose and map errors)"
     )
     value = {v.name: v for v in cal.fitted}
 

@@ -124,3 +124,24 @@ def test_reason_sticks_and_reset_forgets():
     assert rule.check(11.0, still) == "time_cap"
     rule.reset()
     assert rule.check(20.0, still) is None  # time counts from the first check after a reset
+
+
+@pytest.mark.parametrize("factor", [1, 3, 4])
+def test_compiled_mse_equals_the_mean_over_downscaled_aligned_images(factor):
+    # random images of odd sizes, the older one placed anywhere, also partly outside the newer one
+    rng = np.random.default_rng(7)
+    res = 0.05
+    for trial in range(12):
+        oh, ow, nh, nw = (int(v) for v in rng.integers(5, 40, size=4))
+        older = rng.choice(np.array([0, 205, 255], np.uint8), size=(oh, ow))
+        newer = rng.choice(np.array([0, 205, 255], np.uint8), size=(nh, nw))
+        shift = rng.integers(-12, 12, size=2) * res
+        a = Snapshot(0.0, older, res, np.array([shift[0], shift[1], 0.0]), 0.0)
+        b = Snapshot(1.0, newer, res, np.zeros(3), 0.0)
+        aligned = downscale(align_into(a, b), factor)
+        expected = float(np.mean((aligned - downscale(newer, factor)) ** 2)) * 3
+        got = snapshot_mse(a, b, factor=factor)
+        if factor in (1, 4):  # block means are exact in binary, so every sum is too, in any order
+            assert got == expected, (trial, factor)
+        else:  # thirds round, and numpy sums pairwise where the kernel sums in row order
+            assert got == pytest.approx(expected, rel=1e-12, abs=1e-12), (trial, factor)

@@ -149,20 +149,32 @@ def _trace_open(crossed, gx0, gy0, sx, sy, ex, ey):  # pragma: no cover - compil
 
 
 @njit(cache=True, nogil=True)
-def _correct(grid, hits, passes, near, crossed, r_off, c_off, min_hits, ratio):  # pragma: no cover - compiled
-    """int8 copy of ``grid`` (a window, row 0 at the top) corrected by the layer (module docstring), and
-    the number of cells changed. Window cell (row, col) is layer cell (r_off - row, c_off + col)."""
+def _correct(
+    grid, hits, passes, near, crossed, r_off, c_off, row0, row1, col0, col1, min_hits, ratio
+):  # pragma: no cover - compiled
+    """int8 copy of the whole map ``grid`` (row 0 at the top) corrected by the layer (module docstring),
+    the number of cells changed inside the layer's window (rows ``row0:row1``, columns ``col0:col1``) and
+    the number of free cells outside it (made unknown). Window cell (row, col) is layer cell
+    (r_off - (row - row0), c_off + (col - col0)). One pass over the map: a building mapped with long
+    free rays holds millions of cells, almost all outside the layer."""
     height, width = grid.shape
     lh, lw = hits.shape
-    out = grid.copy()
+    out = np.empty_like(grid)
     changed = 0
+    outside = 0
     for row in range(height):
-        lr = r_off - row
+        inside_rows = row0 <= row < row1
+        lr = r_off - (row - row0)
         for col in range(width):
             value = grid[row, col]
+            out[row, col] = value
             if value < 0 or value >= 50:
                 continue
-            lc = c_off + col
+            if not (inside_rows and col0 <= col < col1):
+                out[row, col] = -1
+                outside += 1
+                continue
+            lc = c_off + (col - col0)
             if not (0 <= lr < lh and 0 <= lc < lw) or not near[lr, lc]:
                 out[row, col] = -1
                 changed += 1
@@ -171,7 +183,7 @@ def _correct(grid, hits, passes, near, crossed, r_off, c_off, min_hits, ratio): 
             if h >= min_hits and h > ratio * (h + passes[lr, lc]) and crossed[lr, lc]:
                 out[row, col] = 100
                 changed += 1
-    return out, changed
+    return out, changed, outside
 
 
 class EvidenceLayer:
@@ -298,27 +310,23 @@ class EvidenceLayer:
         col1 = min(self.gx0 + lw - gcol0, grid.shape[1])
         row1 = min(height - (self.gy0 - grow0), height)
         row0 = max(height - (self.gy0 + lh - grow0), 0)
-        free = (grid >= 0) & (grid < 50)
-        outside = int(np.count_nonzero(free))
-        out = np.where(free, np.int8(-1), grid).astype(np.int8)
-        changed = 0
-        if row0 < row1 and col0 < col1:
-            window = np.ascontiguousarray(grid[row0:row1, col0:col1])
-            outside -= int(np.count_nonzero(free[row0:row1, col0:col1]))
-            r_off = grow0 + height - 1 - row0 - self.gy0
-            c_off = gcol0 + col0 - self.gx0
-            corrected, changed = _correct(
-                window,
-                self.hits,
-                self.passes,
-                self.near,
-                self.crossed,
-                r_off,
-                c_off,
-                self.min_hits,
-                self.occupied_ratio,
-            )
-            out[row0:row1, col0:col1] = corrected
+        r_off = grow0 + height - 1 - row0 - self.gy0
+        c_off = gcol0 + col0 - self.gx0
+        out, changed, outside = _correct(
+            np.ascontiguousarray(grid, dtype=np.int8),
+            self.hits,
+            self.passes,
+            self.near,
+            self.crossed,
+            r_off,
+            c_off,
+            row0,
+            max(row1, row0),
+            col0,
+            max(col1, col0),
+            self.min_hits,
+            self.occupied_ratio,
+        )
         if changed == 0 and outside == 0:
             return occupancy
         return MapView(out, resolution, origin)

@@ -13,7 +13,8 @@ Printed: the shares of short and long readings by size of the residual (readings
 thing can only be short; the reference's misregistration, glass and open doors make both), and, for the
 short readings of every 5th scan, the share that has a short reading of the scan ``lag`` frames later
 (within 2 m of travel) whose end point lies within 0.15 m of theirs in the map frame: how long what reads
-short stays in place. docs/realism.md, "Assumptions", quotes the figures.
+short stays in place, and the lifetime (s) that the decay between the smallest and the largest lag gives
+(``short_lifetime``, :mod:`slamtrials.sim.unmapped`). docs/realism.md, "Assumptions", quotes the figures.
 """
 
 from __future__ import annotations
@@ -94,6 +95,7 @@ def main() -> None:
 
     print(f"\n| lag (frames) | short readings | share with a short reading of the later scan within {NEAR_M} m |")
     print("|---:|---:|---:|")
+    shares = {}
     for lag in args.lags:
         found = total = 0
         for k in range(0, len(record) - lag, 5):
@@ -103,7 +105,14 @@ def main() -> None:
             total += len(now)
             if len(now) and len(later):
                 found += int(np.count_nonzero(cKDTree(later).query(now, distance_upper_bound=NEAR_M)[0] < NEAR_M))
-        print(f"| {lag} | {total} | {found / max(total, 1):.3f} |")
+        shares[lag] = found / max(total, 1)
+        print(f"| {lag} | {total} | {shares[lag]:.3f} |")
+    first, last = min(shares), max(shares)
+    if last > first and 0.0 < shares[last] < shares[first]:
+        # what persists decays as exp(-dt / lifetime) between the two lags (the robot moves at most 2 m)
+        step = float(np.mean(np.diff(record.t)))
+        lifetime = (last - first) * step / float(np.log(shares[first] / shares[last]))
+        print(f"\nlifetime of what reads short (lags {first} and {last}, {step:.3f} s per frame): {lifetime:.2f} s")
 
 
 if __name__ == "__main__":

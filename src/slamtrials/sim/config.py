@@ -35,6 +35,7 @@ LASER_ERROR_FIELDS = (
     "range_noise_per_m",
     "short_rate",
     "short_run_beams",
+    "short_lifetime",
     "dropout_rate",
     "dropout_per_m",
     "dropout_grazing",
@@ -161,6 +162,10 @@ class LaserConfig(BaseModel):
         ``1 - 1 / short_run_beams`` after a short one and such that ``short_rate`` of the beams do in
         all; a run is one object, at the distance drawn for its first beam (beams whose wall is nearer
         read the wall).
+    short_lifetime:
+        Mean time (s) a thing not in the map stays where a scan saw it, read again by the scans that follow
+        (:mod:`slamtrials.sim.unmapped`; real short readings mostly persist for seconds). 0 (the default):
+        each scan's short readings are drawn anew.
     dropout_rate, dropout_per_m, dropout_grazing:
         Probability per beam of no return (the reading is ``max_range``):
         ``dropout_rate + dropout_per_m * range + dropout_grazing * (1 - |cos(incidence)|)``, capped at 1,
@@ -186,6 +191,9 @@ class LaserConfig(BaseModel):
     short_run_beams: float = Field(
         0.0, ge=0.0, le=1000.0, description="mean run of neighbouring short readings (beams); 0: independent beams"
     )
+    short_lifetime: float = Field(
+        0.0, ge=0.0, le=3600.0, description="mean time a thing not in the map stays (s); 0: drawn anew per scan"
+    )
     dropout_rate: float = Field(0.0, ge=0.0, le=1.0, description="probability per beam of no return")
     dropout_per_m: float = Field(
         0.0, ge=0.0, le=1.0, description="added probability of no return per metre of range (1/m)"
@@ -197,7 +205,8 @@ class LaserConfig(BaseModel):
     @property
     def has_errors(self) -> bool:
         """Whether any reading error is on (the noise-free Stage laser otherwise)."""
-        return any(getattr(self, name) > 0.0 for name in LASER_ERROR_FIELDS if name != "short_run_beams")
+        shape_only = ("short_run_beams", "short_lifetime")  # they shape the short readings, add none
+        return any(getattr(self, name) > 0.0 for name in LASER_ERROR_FIELDS if name not in shape_only)
 
     @field_validator("mount")
     @classmethod

@@ -16,9 +16,13 @@ is hit), the reading of beam ``i`` is:
    a run is one object at the distance drawn for its first beam, ``d = min_range + u (r_first -
    min_range)``, and a beam of the run whose true range is not beyond ``d`` keeps its own reading;
 
+4. **things that stay** (``short_lifetime > 0``): a run of short readings is a thing that stays where
+   it was seen for a while, read again by later scans (:mod:`slamtrials.sim.unmapped`);
+
 then clipped to ``[min_range, max_range]``. Draws, from the run's stream, in this order and only for
 the models that are on: ``B`` standard normals (noise), ``B`` uniforms (dropout), ``B`` uniforms then
-``B`` uniforms (short: whether, where; the same with runs). Their number never depends on what the beams hit, so a run's
+``B`` uniforms (short: whether, where; the same with runs), then ``B`` uniforms (each thing's lifetime,
+with ``short_lifetime > 0``). Their number never depends on what the beams hit, so a run's
 stream is the same whatever the world looks like. With every rate 0 nothing is drawn (the paper's
 noise-free laser).
 """
@@ -32,6 +36,7 @@ from numba import njit
 from numpy.typing import NDArray
 
 from slamtrials.sim.config import LaserConfig, short_start_chance
+from slamtrials.sim.unmapped import UnmappedScan
 
 __all__ = ["apply_laser_errors", "incidence_cosines"]
 
@@ -104,10 +109,13 @@ def apply_laser_errors(
     config: LaserConfig,
     rng: np.random.Generator,
     incidence: NDArray[np.float64] | None = None,
+    unmapped: UnmappedScan | None = None,
 ) -> NDArray[np.float32]:
     """The readings float32 ``[B]`` (m) for ``true_ranges`` float32 ``[B]`` (m) (see the module docstring).
 
-    ``incidence`` (``[B]`` ``|cos|``, :func:`incidence_cosines`) is needed when ``dropout_grazing > 0``.
+    ``incidence`` (``[B]`` ``|cos|``, :func:`incidence_cosines`) is needed when ``dropout_grazing > 0``;
+    ``unmapped`` (the run's things not in the map, and where and when this scan is taken) when
+    ``short_lifetime > 0`` (:mod:`slamtrials.sim.unmapped`).
     """
     cfg = config
     r = true_ranges.astype(np.float64)
@@ -126,7 +134,23 @@ def apply_laser_errors(
             chance = chance + cfg.dropout_grazing * (1.0 - incidence)
         dropped = hit & (rng.random(count) < chance)
         reading = np.where(dropped, cfg.max_range, reading)
-    if cfg.short_rate > 0.0 and cfg.short_run_beams >= 1.0:
+    if cfg.short_rate > 0.0 and cfg.short_lifetime > 0.0:
+        if unmapped is None:
+            raise ValueError("short_lifetime needs the scan's pose and time (an UnmappedScan)")
+        draws = np.asarray(rng.random((3, count)), dtype=np.float64)  # whether, where, lifetime: B each
+        reading = unmapped.things.apply(
+            unmapped,
+            r,
+            np.asarray(reading, dtype=np.float64),
+            draws[0],
+            draws[1],
+            draws[2],
+            cfg.short_rate,
+            cfg.short_run_beams,
+            cfg.min_range,
+            cfg.short_lifetime,
+        )
+    elif cfg.short_rate > 0.0 and cfg.short_run_beams >= 1.0:
         whether = rng.random(count)
         where = rng.random(count)
         stay = 1.0 - 1.0 / cfg.short_run_beams

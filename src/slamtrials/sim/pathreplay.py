@@ -98,11 +98,11 @@ def simulate_path(
     odometry = Odometry(config.odometry, bias, generator)
     scans = np.empty((len(times), laser.num_beams), dtype=np.float32)
     measured = np.empty((len(times), 3), dtype=np.float64)
-    scans[0] = laser.scan(path[0], generator)
+    scans[0] = laser.scan(path[0], generator, float(times[0]))
     measured[0] = odometry.pose
     for k in range(1, len(times)):
         measured[k] = odometry.update(ominus1(path[k - 1], path[k]), _noise_scale(config.dt, times[k] - times[k - 1]))
-        scans[k] = laser.scan(path[k], generator)
+        scans[k] = laser.scan(path[k], generator, float(times[k]))
     metadata = {
         "world": world.name,
         "controller": "path",

@@ -37,6 +37,7 @@ from numpy.typing import NDArray
 from slamtrials.geometry import Pose1Like, compose1
 from slamtrials.record import LaserGeometry
 from slamtrials.sim.config import LaserConfig
+from slamtrials.sim.unmapped import UnmappedScan, UnmappedThings
 from slamtrials.worlds.world import World, world_to_map
 
 __all__ = ["RaycastMap", "LaserModel", "cast_scan", "cast_scan_dda", "SAFETY_CELLS"]
@@ -275,6 +276,7 @@ class LaserModel:
         self.map = RaycastMap.for_world(world)
         self.angles: NDArray[np.float64] = np.ascontiguousarray(config.angles)
         self._mount = np.asarray(config.mount, dtype=np.float64)
+        self._things = UnmappedThings()  # things not in the map that stay (``short_lifetime``)
 
     @property
     def num_beams(self) -> int:
@@ -292,13 +294,14 @@ class LaserModel:
         theta = float(lp[2] - self.world.origin[2])
         return cast_scan(self.map.dist, uv, theta, self.angles, self.config.max_range, self.map.resolution)
 
-    def scan(self, pose: Pose1Like, rng: np.random.Generator) -> NDArray[np.float32]:
+    def scan(self, pose: Pose1Like, rng: np.random.Generator, t: float | None = None) -> NDArray[np.float32]:
         """A laser reading float32 ``[B]`` (m) from robot base pose ``pose`` (world frame).
 
         With any error model on (range noise, dropouts, short readings), the true ranges go through
         :func:`slamtrials.sim.laser_errors.apply_laser_errors`, which draws a fixed number of deviates
         per scan from ``rng``. Otherwise the readings are the true ranges, raised to ``min_range``, and
-        ``rng`` is not used.
+        ``rng`` is not used. ``t`` (s), the scan's time, is needed when ``short_lifetime > 0``: the things
+        not in the map that earlier scans saw stay in this model (:mod:`slamtrials.sim.unmapped`).
         """
         from slamtrials.sim.laser_errors import apply_laser_errors, incidence_cosines
 
@@ -312,7 +315,12 @@ class LaserModel:
             if cfg.dropout_grazing > 0.0:
                 cells = ranges.astype(np.float64) / self.map.resolution
                 incidence = incidence_cosines((float(uv[0]), float(uv[1])), theta, self.angles, cells)
-            return apply_laser_errors(ranges, cfg, rng, incidence)
+            unmapped = None
+            if cfg.short_lifetime > 0.0 and cfg.short_rate > 0.0:
+                if t is None:
+                    raise ValueError("a laser with short_lifetime > 0 needs each scan's time t")
+                unmapped = UnmappedScan(self._things, lp, self.angles, cfg.angular_resolution, float(t))
+            return apply_laser_errors(ranges, cfg, rng, incidence, unmapped)
         if cfg.min_range > 0.0:
             np.maximum(ranges, np.float32(cfg.min_range), out=ranges)
         return ranges

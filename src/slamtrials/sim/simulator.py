@@ -149,7 +149,7 @@ class Simulator:
     def observe(self) -> Frame:
         """The frame at the current time, without moving (the same object if called again)."""
         if self._frame is None:
-            ranges = self._laser.scan(self._robot.pose, self.rng)
+            ranges = self._laser.scan(self._robot.pose, self.rng, self.t)
             self._frame = Frame(
                 t=self.t,
                 ranges=ranges,

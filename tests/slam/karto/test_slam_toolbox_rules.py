@@ -1,6 +1,6 @@
 """Behaviour taken from slam_toolbox's and Karto's source that the accuracy on real logs depends on: the
-scan gate before a node, the range threshold of a scan's points, the response's denominator, and where
-the final estimate puts frames between nodes."""
+scan gate before a node, which readings the matcher and the barycentre see, the response's denominator,
+and where the final estimate puts frames between nodes."""
 
 from __future__ import annotations
 
@@ -67,31 +67,41 @@ def test_without_the_gate_karto_makes_a_node_on_a_turn_or_after_its_time_interva
     assert nodes == [0, 2, 4]
 
 
-def test_readings_beyond_the_range_threshold_give_no_point(synthetic):
+def test_the_matcher_sees_every_reading_and_the_barycentre_only_those_within_the_range_threshold(synthetic):
+    # Karto's matcher takes a scan's unfiltered point readings (GetPointReadings() with its default
+    # wantFiltered = false, in FindValidPoints and GridIndexLookup::ComputeOffsets); only the barycentre
+    # is taken over the readings within the range threshold (m_PointReadings)
     karto = make_algorithm("karto", synthetic.laser, overrides={"max_laser_range": 3.0})
     frame = _frames(synthetic, [(0.0, 0.0, 0.0)], [0.0])[0]
     karto.process(frame)
     node = karto.graph.nodes[0]
     ranges = np.asarray(frame.ranges, dtype=np.float64)
     has_point = ~np.isnan(node.lx)
-    assert (ranges > 3.0).any() and (ranges <= 3.0).any()
-    np.testing.assert_array_equal(has_point, ranges <= 3.0)
+    far = (ranges > 3.0) & (ranges < synthetic.laser.range_max)
+    assert far.any() and (ranges <= 3.0).any()
+    np.testing.assert_array_equal(has_point, ranges < synthetic.laser.range_max)
     near = ranges <= 3.0
     assert np.hypot(*node.barycenter) <= 3.0
     np.testing.assert_allclose(node.barycenter, [node.lx[near].mean(), node.ly[near].mean()], atol=1e-12)
 
 
-def test_the_response_is_divided_by_the_points_not_the_beams(synthetic):
-    # a scan matched against itself scores about 1 however many of its beams have no return
+def test_the_response_is_divided_by_the_readings_not_the_points(synthetic):
+    # GetResponse divides by the size of the scan's lookup array, which holds one entry per unfiltered
+    # point reading, those without a point (INVALID_SCAN) included: a scan matched against itself scores
+    # about the share of its readings that have a point
     laser = synthetic.laser
     angles = laser.beam_angles(361)
     pose = np.array([-6.0, -1.0, math.pi / 2])
     ranges = synthetic.raycast(pose, angles, synthetic.segments, laser.range_max).astype(np.float64)
-    ranges[::2] = np.nan  # half the beams without a point
+    assert np.all(ranges < laser.range_max)
     lx, ly = ranges * np.cos(angles), ranges * np.sin(angles)
     matcher = ScanMatcher(0.5, 0.01, 0.1, laser.range_max, SETTINGS)
-    result = matcher.match(pose, lx, ly, [points_in_map(pose, lx, ly)])
-    assert result.response > 0.9
+    whole = matcher.match(pose, lx, ly, [points_in_map(pose, lx, ly)]).response
+    ranges[::2] = np.nan  # 181 of the 361 readings without a point
+    lx, ly = ranges * np.cos(angles), ranges * np.sin(angles)
+    half = matcher.match(pose, lx, ly, [points_in_map(pose, lx, ly)]).response
+    assert whole > 0.9
+    assert abs(half - whole * 180 / 361) < 0.05
 
 
 def test_frames_between_nodes_are_placed_from_the_nearest_node(square_loop):

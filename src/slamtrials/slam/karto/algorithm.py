@@ -255,18 +255,16 @@ class Karto:
     ) -> ScanNode:
         if self._angles is None or self._angles.shape[0] != ranges.shape[0]:
             self._angles = self.laser.beam_angles(ranges.shape[0])
-        # Karto's point readings: only readings within the range threshold give a point (LocalizedRangeScan::
-        # Update); the matcher, the correlation grid and the barycentre see nothing beyond it
-        has_point = (
-            np.isfinite(ranges)
-            & (ranges > self.laser.range_min)
-            & (ranges < self.laser.range_max)
-            & (ranges <= self.range_threshold)
-        )
+        # The matcher's points are Karto's unfiltered point readings (LocalizedRangeScan::GetPointReadings()
+        # with its default wantFiltered = false, as FindValidPoints and GridIndexLookup::ComputeOffsets call
+        # it): every reading, also those beyond the range threshold. Only the barycentre is taken over the
+        # filtered ones, the readings within the range threshold (m_PointReadings).
+        has_point = np.isfinite(ranges) & (ranges > self.laser.range_min) & (ranges < self.laser.range_max)
         r = np.where(has_point, ranges, np.nan)
         lx, ly = r * stablemath.cos(self._angles), r * stablemath.sin(self._angles)
-        count = int(has_point.sum())  # fsum: correctly rounded, the same on every machine
-        barycenter = np.array([math.fsum(lx[has_point]) / count, math.fsum(ly[has_point]) / count]) if count else None
+        within = has_point & (ranges <= self.range_threshold)
+        count = int(within.sum())  # fsum: correctly rounded, the same on every machine
+        barycenter = np.array([math.fsum(lx[within]) / count, math.fsum(ly[within]) / count]) if count else None
         return ScanNode(
             frame=frame_index,
             t=t,

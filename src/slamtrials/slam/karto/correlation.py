@@ -11,8 +11,8 @@ cell within ``half`` cells to at least the kernel's ``round(100 exp(-d^2 / (2 si
 
 Search. For every searched position (a regular lattice around the search centre) and heading (a regular
 fan), the response is the sum of the grid values under the scan's points, each point's cell offset
-rounded on its own (Karto's lookup tables), divided by ``100 *`` the scan's point count (Karto's
-GetResponse divides by the size of the scan's lookup array: its readings within the range threshold); points that land outside the array add nothing (Karto checks
+rounded on its own (Karto's lookup tables), divided by ``100 *`` the scan's reading count (Karto's
+GetResponse divides by the size of the scan's lookup array: one entry per reading, with a point or not); points that land outside the array add nothing (Karto checks
 only the flat index, so such points may wrap onto another row there: see docs/karto.md).
 """
 
@@ -198,7 +198,7 @@ def correlate(
     """Karto's CorrelateScan: search around ``(cx, cy, ctheta)``; return the best response (<= 1).
 
     ``lx, ly``: the scan's points in the laser frame (m), only beams that have one; ``n_points`` the
-    response's denominator (their count, at least 1). Positions ``c + k search_step`` for ``|k search_step| <= search_offset`` in x and y, headings
+    response's denominator (the scan's reading count, at least 1). Positions ``c + k search_step`` for ``|k search_step| <= search_offset`` in x and y, headings
     ``ctheta + k angle_step`` within ``angle_offset``. ``penalize`` multiplies nonzero responses by the
     distance and angle penalties (variances in m^2 and rad^2). ``mean`` float64 ``[3]`` receives the
     average of the poses with the best response (headings averaged through cos and sin). ``covariance``

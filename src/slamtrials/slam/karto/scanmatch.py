@@ -157,8 +157,9 @@ class ScanMatcher:
             add_points(self.grid, self.border, self.roi, ox, oy, inv_res, px, py, valid, self.kernel, self._box)
         has_point = ~np.isnan(lx)
         mx, my = lx[has_point], ly[has_point]
-        # GetResponse divides by the scan's point count (its lookup array), not by its beam count
-        n_points = max(int(mx.shape[0]), 1)
+        # GetResponse divides by the size of the scan's lookup array, one entry per unfiltered point reading:
+        # every reading, those without a point (INVALID_SCAN) included
+        n_readings = max(int(n_beams), 1)
         coarse_offset = 0.5 * (self.search_side - 1) * res
         coarse_step = 2.0 * res
         args = (s.distance_variance, s.minimum_distance_penalty, s.angle_variance, s.minimum_angle_penalty)
@@ -170,7 +171,7 @@ class ScanMatcher:
             res,
             mx,
             my,
-            n_points,
+            n_readings,
             pose[0],
             pose[1],
             pose[2],
@@ -196,7 +197,7 @@ class ScanMatcher:
                     res,
                     mx,
                     my,
-                    n_points,
+                    n_readings,
                     pose[0],
                     pose[1],
                     pose[2],
@@ -222,7 +223,7 @@ class ScanMatcher:
                 res,
                 mx,
                 my,
-                n_points,
+                n_readings,
                 center[0],
                 center[1],
                 center[2],

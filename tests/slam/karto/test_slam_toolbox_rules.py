@@ -126,3 +126,43 @@ def test_frames_between_nodes_are_placed_from_the_nearest_node(square_loop):
         np.testing.assert_allclose(trajectory.poses[k], expected, atol=1e-9)
         placed_from_next += node.t > frame.t
     assert placed_from_next > 0
+
+
+def test_the_optimizer_starts_from_its_own_copy_of_the_nodes(square_loop, monkeypatch):
+    # slam_toolbox's CeresSolver keeps each node's pose from AddNode (called by AddVertex, right after
+    # sequential matching) and overwrites it only with its own results: a pose set on the scan later
+    # (AddEdges' weighted mean, a loop closure's match) is not its starting point
+    import slamtrials.slam.karto.algorithm as karto_algorithm
+    from slamtrials.slam.karto.graph import PoseGraph
+
+    added: list[np.ndarray] = []
+    add_node = PoseGraph.add_node
+
+    def recording_add_node(self, node):
+        added.append(node.pose.copy())
+        return add_node(self, node)
+
+    calls = []
+    optimize = karto_algorithm.optimize_pose_graph
+
+    def recording_optimize(poses, *args, **kwargs):
+        result = optimize(poses, *args, **kwargs)
+        calls.append((poses.copy(), karto.graph.poses(), len(added), result.poses.copy()))
+        return result
+
+    monkeypatch.setattr(PoseGraph, "add_node", recording_add_node)
+    monkeypatch.setattr(karto_algorithm, "optimize_pose_graph", recording_optimize)
+    karto = make_algorithm("karto", square_loop.laser)
+    for frame in square_loop.frames:
+        karto.process(frame)
+    assert calls
+    previous = None
+    moved_since = False
+    for start, current, count, result in calls:
+        expected = np.array(added[:count])
+        if previous is not None:
+            expected[: len(previous)] = previous
+        np.testing.assert_array_equal(start, expected)
+        moved_since |= not np.array_equal(start, current)
+        previous = result
+    assert moved_since  # some node's pose had been set after it was added

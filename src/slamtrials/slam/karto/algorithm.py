@@ -205,6 +205,11 @@ class Karto:
         self._anchor: list[int] = []
         self._estimates: list[NDArray[np.float64]] = []
         self._angles: NDArray[np.float64] | None = None
+        # The optimizer's own copy of every node's base pose, its starting point. As slam_toolbox's
+        # CeresSolver keeps one (AddNode stores the scan's corrected pose when the vertex is added, right
+        # after sequential matching; Compute starts from it and overwrites it with its result), a pose
+        # set on a node afterwards (AddEdges' weighted mean, a loop closure's match) is not seen by it.
+        self._solver_poses: list[NDArray[np.float64]] = []
 
     # ------------------------------------------------------------------ helpers
 
@@ -355,11 +360,11 @@ class Karto:
                 break
 
     def _optimize(self) -> None:
-        """CorrectPoses: optimize the whole graph and move every node."""
+        """CorrectPoses: optimize the whole graph from the solver's copy of the nodes and move every node."""
         edges = self.graph.edges
         started = time.perf_counter()
         result = optimize_pose_graph(
-            self.graph.poses(),
+            np.array(self._solver_poses, dtype=np.float64).reshape(-1, 3),
             np.array([e.source for e in edges]),
             np.array([e.target for e in edges]),
             np.array([e.mean for e in edges]),
@@ -367,6 +372,7 @@ class Karto:
         )
         self.optimizations.append((len(self.graph.nodes), len(edges), time.perf_counter() - started, result.iterations))
         self.graph.set_poses(result.poses)
+        self._solver_poses = [pose.copy() for pose in result.poses]
 
     def _close_loops(self, index: int) -> None:
         """TryCloseLoop: try every candidate chain in turn; optimize after each accepted closure."""
@@ -428,6 +434,8 @@ class Karto:
             node.pose = self._base_pose(result.pose)
             covariance = result.covariance
         index = self.graph.add_node(node)
+        # the solver's copy of the node (CeresSolver::AddNode, called by AddVertex before AddEdges)
+        self._solver_poses.append(node.pose.copy())
         if c.use_scan_matching:
             self._add_edges(index, covariance)
             self._add_running(index)

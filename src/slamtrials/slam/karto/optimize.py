@@ -5,17 +5,21 @@ to node b with relative pose ``(tx, ty, tth)`` and covariance ``C`` (in a's fram
 
     r = ( R(th_a)^T (p_b - p_a) - (tx, ty),  wrap(th_b - th_a - tth) )
 
-and the cost is ``1/2 sum r^T C^-1 r`` (slam_toolbox hands Ceres ``C^-1`` where Ceres expects its square
-root, which squares every weight; here the weight is ``C^-1`` itself: see docs/karto.md). The first node
-is held fixed. Each iteration solves ``(H + lambda D) dx = -g`` with ``H = J^T W J``, ``D`` its
-diagonal clamped to [1e-6, 1e32] and ``lambda = 1 / radius``, by the sparse Cholesky of
-:mod:`.sparsechol` (no BLAS, so the same bits on every CPU). The trust region follows Ceres'
-Levenberg-Marquardt strategy with slam_toolbox's settings: initial radius 1e4, a step is taken when it
-achieves more than 1e-3 of the predicted decrease, the radius grows by ``1 / max(1/3, 1 - (2 rho -
-1)^3)`` after a taken step and shrinks by a doubling factor after a refused one; it stops after 50
-iterations, when a taken step changes the cost by less than 1e-3 of it (function tolerance), when the
-step is shorter than 1e-3 of the state (parameter tolerance) or when the largest gradient entry is
-below 1e-6.
+and the cost is ``1/2 sum r^T C^-1 r`` (slam_toolbox's CeresSolver::AddConstraint weights the residual by
+the Cholesky factor of ``C^-1``). The first node is held fixed. Each iteration solves ``(H + lambda D) dx
+= -g`` with ``H = J^T W J``, ``D`` its diagonal clamped to [1e-6, 1e32] and ``lambda = 1 / radius``, by
+the sparse Cholesky of :mod:`.sparsechol` (no BLAS, so the same bits on every CPU). The run follows
+Ceres' TrustRegionMinimizer and Levenberg-Marquardt strategy with slam_toolbox's options: initial
+radius 1e4 (at most 1e8); a step whose model decrease is not positive (or whose system is not positive
+definite) is invalid, and three in a row end the run; otherwise the step is tried and the run ends,
+*without taking it*, when it is shorter than 1e-3 of the state (parameter tolerance; not in the first
+iteration, where Ceres does not know the state's norm yet) or changes the cost by at most 1e-3 of it
+(function tolerance, taken or not); it is taken when its quality exceeds 1e-3, the quality being the
+larger of the decrease relative to the model's and the same against a lagging reference cost
+(non-monotonic steps, at most 3 in a row); the radius grows by ``1 / max(1/3, 1 - (2 q - 1)^3)`` after
+a taken step and shrinks by a doubling factor after a refused one; it stops after 50 iterations, when the
+largest gradient entry after a taken step is below 1e-6, or when the radius falls to 1e-16; the result is
+the cheapest state a taken step reached.
 """
 
 from __future__ import annotations
@@ -39,6 +43,9 @@ GRADIENT_TOLERANCE = 1e-6
 MIN_RELATIVE_DECREASE = 1e-3
 INITIAL_RADIUS = 1e4
 MIN_RADIUS = 1e-16
+MAX_RADIUS = 1e8
+MAX_INVALID_STEPS = 3
+MAX_NONMONOTONIC_STEPS = 3
 MIN_DIAGONAL, MAX_DIAGONAL = 1e-6, 1e32
 
 
@@ -192,6 +199,40 @@ def _max_abs(a):  # pragma: no cover - compiled
     return best
 
 
+class _StepEvaluator:
+    """Ceres' TrustRegionStepEvaluator with non-monotonic steps (slam_toolbox: ``use_nonmonotonic_steps``,
+    at most 3 in a row): a step's quality is the larger of its decrease relative to the current cost and
+    to a reference cost that may lag behind (Conn, Gould and Toint, algorithm 10.1.2)."""
+
+    def __init__(self, cost: float):
+        self.minimum = self.current = self.reference = self.candidate = cost
+        self.reference_change = self.candidate_change = 0.0
+        self.nonmonotonic = 0
+
+    def quality(self, cost: float, predicted: float) -> float:
+        relative = (self.current - cost) / predicted
+        historical = (self.reference - cost) / (self.reference_change + predicted)
+        return max(relative, historical)
+
+    def accepted(self, cost: float, predicted: float) -> None:
+        self.current = cost
+        self.candidate_change += predicted
+        self.reference_change += predicted
+        if cost < self.minimum:
+            self.minimum = cost
+            self.nonmonotonic = 0
+            self.candidate = cost
+            self.candidate_change = 0.0
+        else:
+            self.nonmonotonic += 1
+            if cost > self.candidate:
+                self.candidate = cost
+                self.candidate_change = 0.0
+        if self.nonmonotonic == MAX_NONMONOTONIC_STEPS:
+            self.reference = self.candidate
+            self.reference_change = self.candidate_change
+
+
 def _scalar_order(n_free: int, source: NDArray[np.int64], target: NDArray[np.int64]) -> NDArray[np.intp]:
     """Unknown order: minimum degree over the free nodes (node k >= 1 is free node k - 1), 3 unknowns each."""
     pairs = [(int(a) - 1, int(b) - 1) for a, b in zip(source, target) if a > 0 and b > 0]
@@ -235,7 +276,13 @@ def optimize_pose_graph(
     decrease_factor = 2.0
     reason = "maximum iterations"
     iteration = 0
+    invalid_steps = 0
     linearized = True
+    # Ceres knows the state's norm only after its first successful step (TrustRegionMinimizer::Init sets
+    # x_norm_ to -1), so the parameter tolerance cannot end the first iteration
+    state_norm = -1.0
+    best, minimum_cost = x, cost  # the solution returned: the cheapest state a successful step reached
+    steps = _StepEvaluator(cost)
     while iteration < MAX_ITERATIONS:
         if linearized:
             cost, g_all, rows, cols, vals = _linearize(x, source, target, means, weights)
@@ -253,45 +300,56 @@ def optimize_pose_graph(
         damped = permuted + scipy.sparse.diags(lam * diagonal[order], format="csc")
         upper = scipy.sparse.triu(damped, format="csc")
         upper.sort_indices()
+        predicted = 0.0
         try:
             factor = cholesky(upper.indptr, upper.indices, upper.data)
+            step = np.empty(m)
+            step[order] = cholesky_solve(factor, -g[order])
+            scaled = lam * diagonal * step
+            predicted = -0.5 * _dot(g, step) + 0.5 * _dot(step, scaled)
         except NotPositiveDefinite:
+            pass
+        if not predicted > 0.0:  # an invalid step (HandleInvalidStep): counted, then as a refused step
+            invalid_steps += 1
+            if invalid_steps >= MAX_INVALID_STEPS:
+                reason = "invalid steps"
+                break
             radius /= decrease_factor
             decrease_factor *= 2.0
-            if radius < MIN_RADIUS:
+            if radius <= MIN_RADIUS:
                 reason = "trust region too small"
                 break
             continue
-        step = np.empty(m)
-        step[order] = cholesky_solve(factor, -g[order])
-        scaled = lam * diagonal * step
-        predicted = -0.5 * _dot(g, step) + 0.5 * _dot(step, scaled)
+        invalid_steps = 0
         candidate = x.copy()
         candidate[1:] += step.reshape(-1, 3)
         candidate[1:, 2] = (candidate[1:, 2] + math.pi) % (2.0 * math.pi) - math.pi
         new_cost = _cost(candidate, source, target, means, weights)
-        rho = (cost - new_cost) / predicted if predicted > 0.0 else -1.0
-        step_norm = math.sqrt(_dot(step, step))
-        relative = (x[1:] - x[0]).reshape(-1)  # the state measured from the fixed node: where the odometry
-        state_norm = math.sqrt(_dot(relative, relative))  # frame's origin lies must not matter
-        if rho > MIN_RELATIVE_DECREASE:
-            change = cost - new_cost
+        # both tolerances end the run before the step is judged, and the step is not taken
+        moved = (candidate - x).reshape(-1)
+        if math.sqrt(_dot(moved, moved)) <= PARAMETER_TOLERANCE * (state_norm + PARAMETER_TOLERANCE):
+            reason = "parameter tolerance"
+            break
+        if abs(cost - new_cost) <= FUNCTION_TOLERANCE * cost:
+            reason = "function tolerance"
+            break
+        quality = steps.quality(new_cost, predicted)
+        if quality > MIN_RELATIVE_DECREASE:
             x = candidate
+            relative = (x[1:] - x[0]).reshape(-1)  # the state measured from the fixed node: where the odometry
+            state_norm = math.sqrt(_dot(relative, relative))  # frame's origin lies must not matter
             linearized = True
-            radius = radius / max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
+            radius = min(MAX_RADIUS, radius / max(1.0 / 3.0, 1.0 - (2.0 * quality - 1.0) ** 3))
             decrease_factor = 2.0
-            if change <= FUNCTION_TOLERANCE * cost:
-                cost = new_cost
-                reason = "function tolerance"
-                break
+            steps.accepted(new_cost, predicted)
             cost = new_cost
+            if cost < minimum_cost:
+                best, minimum_cost = x, cost
         else:
             radius /= decrease_factor
             decrease_factor *= 2.0
-            if radius < MIN_RADIUS:
-                reason = "trust region too small"
-                break
-        if step_norm <= PARAMETER_TOLERANCE * (state_norm + PARAMETER_TOLERANCE):
-            reason = "parameter tolerance"
+        if radius <= MIN_RADIUS:
+            reason = "trust region too small"
             break
+    x = best
     return OptimizerResult(x, iteration, float(initial), float(_cost(x, source, target, means, weights)), reason)

@@ -2,9 +2,10 @@
 
 karto with slam_toolbox's defaults over all 1,988 scans of ``mit-csail.clf``; the outputs are written as
 ``slamtrials slam`` writes them and ``trajectory.clf`` is evaluated as ``slamtrials evaluate -e
-trajectory.clf -r mit-csail.relations`` does. It gives 0.0459 m mean translational error and 0.0474 rad
-(565 nodes, 14 loop closures); the bounds are those plus a little. With the ``slam_karto`` preset
-(open_karto's own defaults: a node every 0.2 m or 0.174 rad) it gives 0.0370 m and 0.0194 rad. The
+trajectory.clf -r mit-csail.relations`` does. It gives 0.0457 m mean translational error and 0.0474 rad
+(565 nodes, 14 loop closures; commit 6d4658b, 25 Nov 2026); the bounds are those plus a little. With the
+``slam_karto`` preset (open_karto's own defaults: a node every 0.2 m or 0.174 rad) it gives 0.0367 m and
+0.0194 rad. The
 issue's target, 0.035 m, is NOT met, and docs/karto.md ("Accuracy on real data") shows why: most of
 what is left is the log's odometry between nodes. Skipped when the data set is absent."""
 
@@ -37,7 +38,7 @@ def test_karto_defaults_on_mit_csail(tmp_path):
     write_slam_outputs(result, tmp_path)
     evaluation = evaluate_files(tmp_path / "trajectory.clf", RELATIONS)
     assert evaluation.translational.n == 1172 and len(evaluation.errors.unmatched) == 0
-    assert evaluation.translational.mean <= 0.047
+    assert evaluation.translational.mean <= 0.0465
     assert evaluation.rotational.mean <= 0.049
     odometry = evaluate_files(tmp_path / "trajectory.clf", RELATIONS, estimate_pose=PoseTriple.second)
     assert odometry.translational.mean > 10 * evaluation.translational.mean
@@ -50,5 +51,5 @@ def test_karto_slam_karto_preset_on_mit_csail(tmp_path):
     write_slam_outputs(result, tmp_path)
     evaluation = evaluate_files(tmp_path / "trajectory.clf", RELATIONS)
     assert evaluation.translational.n == 1172
-    assert evaluation.translational.mean <= 0.038
+    assert evaluation.translational.mean <= 0.0375
     assert evaluation.rotational.mean <= 0.021

@@ -170,6 +170,55 @@ def _response(grid, row, col, dcol, drow, a, norm):  # pragma: no cover - compil
 
 
 @njit(cache=True, nogil=True)
+def _totals(grid, rows, cols, dcol, drow):  # pragma: no cover - compiled
+    """int32 ``[A, Y, X]``: the sum of the grid values under the points at heading ``a`` from the position
+    in array row ``rows[y]`` and column ``cols[x]``; points off the array add nothing.
+
+    The same sums as :func:`_response` at every position, accumulated point by point over the whole
+    lattice of positions instead (integer sums, at most 100 per point: the order does not change them):
+    for one heading and point the cells read are a small window of the grid, read row by row, where the
+    position-by-position order jumps across the whole grid for every point. When the columns are evenly
+    spaced (they nearly always are) a row of the window is read with a fixed stride.
+    """
+    height, width = grid.shape
+    n_angles, n_points = dcol.shape
+    n_y = rows.shape[0]
+    n_x = cols.shape[0]
+    totals = np.zeros((n_angles, n_y, n_x), dtype=np.int32)
+    stride = cols[1] - cols[0] if n_x > 1 else 0
+    even = True
+    for ix in range(n_x):
+        if cols[ix] != cols[0] + stride * ix:
+            even = False
+    # cols is non-decreasing (rounding a growing sequence), so a point's columns are all on the array when
+    # the first and the last are
+    for a in range(n_angles):
+        for p in range(n_points):
+            dr = drow[a, p]
+            dc = dcol[a, p]
+            first = cols[0] + dc
+            inside = first >= 0 and cols[n_x - 1] + dc < width
+            for iy in range(n_y):
+                r = rows[iy] + dr
+                if r < 0 or r >= height:
+                    continue
+                line = grid[r]
+                out = totals[a, iy]
+                if inside and even:
+                    for ix in range(n_x):
+                        out[ix] += line[first + stride * ix]
+                elif inside:
+                    for ix in range(n_x):
+                        out[ix] += line[cols[ix] + dc]
+                else:
+                    for ix in range(n_x):
+                        c = cols[ix] + dc
+                        if 0 <= c < width:
+                            out[ix] += line[c]
+    return totals
+
+
+@njit(cache=True, nogil=True)
 def correlate(
     grid,
     border,
@@ -212,15 +261,20 @@ def correlate(
     heading0 = ctheta - angle_offset
     dcol, drow = _lookup(lx, ly, heading0, angle_step, n_angles, inv_res)
     norm = float(n_points) * OCCUPIED_VALUE
+    rows = np.empty(n_x, dtype=np.int64)
+    cols = np.empty(n_x, dtype=np.int64)
+    for k in range(n_x):
+        offset = -search_offset + k * search_step
+        rows[k] = int(_round((cy + offset - oy) * inv_res)) + border
+        cols[k] = int(_round((cx + offset - ox) * inv_res)) + border
+    totals = _totals(grid, rows, cols, dcol, drow)
     responses = np.empty((n_x, n_x, n_angles))
     for iy in range(n_x):
         y = -search_offset + iy * search_step
-        row = int(_round((cy + y - oy) * inv_res)) + border
         for ix in range(n_x):
             x = -search_offset + ix * search_step
-            col = int(_round((cx + x - ox) * inv_res)) + border
             for a in range(n_angles):
-                response = _response(grid, row, col, dcol, drow, a, norm)
+                response = totals[a, iy, ix] / norm
                 if penalize and abs(response) >= _TOLERANCE:
                     distance_penalty = 1.0 - _DISTANCE_PENALTY_GAIN * (x * x + y * y) / distance_variance
                     distance_penalty = max(distance_penalty, minimum_distance_penalty)

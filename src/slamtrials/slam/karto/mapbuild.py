@@ -1,8 +1,9 @@
 """The published map: every node's scan traced from its optimized laser pose (Karto's OccupancyGrid).
 
 Rebuilt from the graph, not updated scan by scan: when the optimizer moves nodes, their scans are taken
-out at the old poses (weight -1, exact on the integer counts) and put back at the new ones, so the grid
-always equals a rebuild from scratch. Rays are those of :mod:`slamtrials.slam.gridmap`, with Karto's
+out at the old poses (weight -1, exact on the integer counts) and put back at the new ones, or, when more
+than half of them moved (after a loop closure nearly all do), the counts are cleared and every scan is
+traced again, whichever traces fewer scans; either way the grid equals a rebuild from scratch. Rays are those of :mod:`slamtrials.slam.gridmap`, with Karto's
 range threshold as the usable range. Cells follow Karto's rule: unknown until more than
 ``min_pass_through`` beams crossed them, then occupied when hits / crossings exceeds
 ``occupancy_threshold``, else free.
@@ -76,11 +77,20 @@ class NodeMap:
         """
         laser_poses = np.asarray(laser_poses, dtype=np.float64).reshape(-1, 3)
         traced = self._poses.shape[0]
+        moved = np.flatnonzero(np.any(self._poses != laser_poses[:traced], axis=1)).tolist()
         poses, ranges, weights = [], [], []
-        for k in np.flatnonzero(np.any(self._poses != laser_poses[:traced], axis=1)).tolist():
-            poses += [self._poses[k], laser_poses[k]]
-            ranges += [scans[k], scans[k]]
-            weights += [-1, 1]
+        if 2 * len(moved) > traced:
+            # moving them would trace more scans than tracing every scan again on cleared counts: the same
+            # integer counts, and the same window (it only grows, the scans' new boxes come in the same
+            # order, and the boxes of the scans that stay were inside it already)
+            self.grid.hits[:] = 0
+            self.grid.visits[:] = 0
+            traced = 0
+        else:
+            for k in moved:
+                poses += [self._poses[k], laser_poses[k]]
+                ranges += [scans[k], scans[k]]
+                weights += [-1, 1]
         for k in range(traced, len(scans)):
             poses.append(laser_poses[k])
             ranges.append(scans[k])

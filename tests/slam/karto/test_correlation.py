@@ -1,0 +1,32 @@
+"""The correlation kernel's sums over the search lattice equal the point-by-point response of each pose."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from slamtrials.slam.karto.correlation import _response, _totals
+
+
+@pytest.mark.parametrize("even", [True, False])
+def test_lattice_sums_equal_each_poses_response(even):
+    rng = np.random.default_rng(7)
+    grid = rng.integers(0, 101, size=(60, 70)).astype(np.uint8)
+    n_angles, n_points = 3, 40
+    # offsets reaching past every edge of the array from some of the positions
+    drow = rng.integers(-35, 36, size=(n_angles, n_points))
+    dcol = rng.integers(-40, 41, size=(n_angles, n_points))
+    rows = np.arange(5, 55, 5, dtype=np.int64)
+    cols = np.arange(3, 67, 4, dtype=np.int64)
+    if not even:
+        cols[4:] += 1  # a rounding step off the stride
+    totals = _totals(grid, rows, cols, dcol, drow)
+    expected = np.array(
+        [[[_response(grid, r, c, dcol, drow, a, 1.0) for c in cols] for r in rows] for a in range(n_angles)]
+    )
+    assert np.array_equal(totals, expected)
+    off_rows = (rows[:, None] + drow.ravel() < 0) | (rows[:, None] + drow.ravel() >= grid.shape[0])
+    off_cols = (cols[:, None] + dcol.ravel() < 0) | (cols[:, None] + dcol.ravel() >= grid.shape[1])
+    inside = (~off_cols).all(axis=0)  # points whose columns are all on the array, from every position
+    assert off_rows.any() and inside.any() and not inside.all()  # both paths of the kernel
+    assert (totals > 0).all()

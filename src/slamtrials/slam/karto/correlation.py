@@ -131,10 +131,12 @@ def add_points(grid, border, roi, ox, oy, inv_res, px, py, valid, kernel, box): 
             continue
         grid[r, c] = OCCUPIED_VALUE
         for j in range(-half, half + 1):
+            line = grid[r + j]
+            weights = kernel[j + half]
             for i in range(-half, half + 1):
-                value = kernel[j + half, i + half]
-                if value > grid[r + j, c + i]:
-                    grid[r + j, c + i] = value
+                value = weights[i + half]
+                cell = line[c + i]
+                line[c + i] = value if value > cell else cell  # no branch: the row is done in vector steps
         box[0] = min(box[0], r - half)
         box[1] = max(box[1], r + half)
         box[2] = min(box[2], c - half)
@@ -176,38 +178,42 @@ def _totals(grid, rows, cols, dcol, drow):  # pragma: no cover - compiled
 
     The same sums as :func:`_response` at every position, accumulated point by point over the whole
     lattice of positions instead (integer sums, at most 100 per point: the order does not change them):
-    for one heading and point the cells read are a small window of the grid, read row by row, where the
-    position-by-position order jumps across the whole grid for every point. When the columns are evenly
-    spaced (they nearly always are) a row of the window is read with a fixed stride.
+    for one heading and point the cells read are a small window of the grid, read as a strided view
+    when the rows and columns are evenly spaced (they nearly always are) and the window lies on the
+    array, else row by row.
     """
     height, width = grid.shape
     n_angles, n_points = dcol.shape
     n_y = rows.shape[0]
     n_x = cols.shape[0]
     totals = np.zeros((n_angles, n_y, n_x), dtype=np.int32)
-    stride = cols[1] - cols[0] if n_x > 1 else 0
-    even = True
-    for ix in range(n_x):
-        if cols[ix] != cols[0] + stride * ix:
-            even = False
-    # cols is non-decreasing (rounding a growing sequence), so a point's columns are all on the array when
-    # the first and the last are
+    even = _evenly_spaced(rows) and _evenly_spaced(cols)
+    row_stride = rows[1] - rows[0] if n_y > 1 else 1
+    col_stride = cols[1] - cols[0] if n_x > 1 else 1
+    # rows and cols are non-decreasing (rounding a growing sequence), so a point's window is on the array
+    # when its first and last row and column are
     for a in range(n_angles):
         for p in range(n_points):
             dr = drow[a, p]
             dc = dcol[a, p]
+            top = rows[0] + dr
             first = cols[0] + dc
+            rows_inside = top >= 0 and rows[n_y - 1] + dr < height
             inside = first >= 0 and cols[n_x - 1] + dc < width
+            if even and rows_inside and inside:
+                window = grid[top : top + row_stride * n_y : row_stride, first : first + col_stride * n_x : col_stride]
+                out2 = totals[a]
+                for iy in range(n_y):
+                    for ix in range(n_x):
+                        out2[iy, ix] += window[iy, ix]
+                continue
             for iy in range(n_y):
                 r = rows[iy] + dr
                 if r < 0 or r >= height:
                     continue
                 line = grid[r]
                 out = totals[a, iy]
-                if inside and even:
-                    for ix in range(n_x):
-                        out[ix] += line[first + stride * ix]
-                elif inside:
+                if inside:
                     for ix in range(n_x):
                         out[ix] += line[cols[ix] + dc]
                 else:
@@ -215,6 +221,78 @@ def _totals(grid, rows, cols, dcol, drow):  # pragma: no cover - compiled
                         c = cols[ix] + dc
                         if 0 <= c < width:
                             out[ix] += line[c]
+    return totals
+
+
+@njit(cache=True, nogil=True)
+def _evenly_spaced(cols):  # pragma: no cover - compiled
+    """Whether ``cols`` is ``cols[0] + k stride``, ``stride > 0`` (rounding may, rarely, make one step
+    longer)."""
+    stride = cols[1] - cols[0] if cols.shape[0] > 1 else 1
+    if stride <= 0:
+        return False
+    for k in range(cols.shape[0]):
+        if cols[k] != cols[0] + stride * k:
+            return False
+    return True
+
+
+@njit(cache=True, nogil=True)
+def _nonzero_rows(grid):  # pragma: no cover - compiled
+    """The grid's nonzero cells row by row: ``starts`` int64 ``[H + 1]`` (row ``r``'s cells are
+    ``starts[r]:starts[r + 1]``), their columns (increasing within a row) and values."""
+    height, width = grid.shape
+    starts = np.zeros(height + 1, dtype=np.int64)
+    count = 0
+    for r in range(height):
+        for c in range(width):
+            if grid[r, c] != 0:
+                count += 1
+        starts[r + 1] = count
+    nonzero_cols = np.empty(count, dtype=np.int64)
+    values = np.empty(count, dtype=np.int32)
+    k = 0
+    for r in range(height):
+        for c in range(width):
+            if grid[r, c] != 0:
+                nonzero_cols[k] = c
+                values[k] = grid[r, c]
+                k += 1
+    return starts, nonzero_cols, values
+
+
+@njit(cache=True, nogil=True)
+def _totals_sparse(starts, nonzero_cols, values, rows, cols, dcol, drow):  # pragma: no cover - compiled
+    """:func:`_totals` from the grid's nonzero cells (:func:`_nonzero_rows`), for evenly spaced ``cols``:
+    a point adds to the positions whose cell is one of the nonzero cells of its window's row (zeros add
+    nothing), so the row's nonzero cells between the window's first and last column are walked instead
+    of every cell of the window."""
+    height = starts.shape[0] - 1
+    n_angles, n_points = dcol.shape
+    n_y = rows.shape[0]
+    n_x = cols.shape[0]
+    totals = np.zeros((n_angles, n_y, n_x), dtype=np.int32)
+    stride = cols[1] - cols[0] if n_x > 1 else 1
+    for a in range(n_angles):
+        for p in range(n_points):
+            dr = drow[a, p]
+            first = cols[0] + dcol[a, p]
+            last = cols[n_x - 1] + dcol[a, p]
+            for iy in range(n_y):
+                r = rows[iy] + dr
+                if r < 0 or r >= height:
+                    continue
+                lo = starts[r]
+                hi = starts[r + 1]
+                if lo == hi or nonzero_cols[lo] > last or nonzero_cols[hi - 1] < first:
+                    continue
+                k = lo + np.searchsorted(nonzero_cols[lo:hi], first)
+                out = totals[a, iy]
+                while k < hi and nonzero_cols[k] <= last:
+                    offset = nonzero_cols[k] - first
+                    if offset % stride == 0:
+                        out[offset // stride] += values[k]
+                    k += 1
     return totals
 
 
@@ -267,7 +345,13 @@ def correlate(
         offset = -search_offset + k * search_step
         rows[k] = int(_round((cy + offset - oy) * inv_res)) + border
         cols[k] = int(_round((cx + offset - ox) * inv_res)) + border
-    totals = _totals(grid, rows, cols, dcol, drow)
+    height, width = grid.shape
+    if height * width * 4 < n_angles * lx.shape[0] * n_x * n_x and _evenly_spaced(cols):
+        # a large search on a small grid (the loop matcher): walk only the nonzero cells of each row
+        starts, nonzero_cols, values = _nonzero_rows(grid)
+        totals = _totals_sparse(starts, nonzero_cols, values, rows, cols, dcol, drow)
+    else:
+        totals = _totals(grid, rows, cols, dcol, drow)
     responses = np.empty((n_x, n_x, n_angles))
     for iy in range(n_x):
         y = -search_offset + iy * search_step

@@ -131,12 +131,10 @@ def add_points(grid, border, roi, ox, oy, inv_res, px, py, valid, kernel, box): 
             continue
         grid[r, c] = OCCUPIED_VALUE
         for j in range(-half, half + 1):
-            line = grid[r + j]
-            weights = kernel[j + half]
             for i in range(-half, half + 1):
-                value = weights[i + half]
-                cell = line[c + i]
-                line[c + i] = value if value > cell else cell  # no branch: the row is done in vector steps
+                value = kernel[j + half, i + half]
+                if value > grid[r + j, c + i]:
+                    grid[r + j, c + i] = value
         box[0] = min(box[0], r - half)
         box[1] = max(box[1], r + half)
         box[2] = min(box[2], c - half)

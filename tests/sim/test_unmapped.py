@@ -93,3 +93,28 @@ def test_a_lifetime_needs_the_scan_time_and_changes_nothing_without_short_readin
     want = LaserModel(world, plain).scan(POSE, np.random.default_rng(1))
     assert np.array_equal(got, want)
     assert not LaserConfig(short_lifetime=3.0).has_errors
+
+
+def test_fleeting_runs_leave_no_thing_and_the_share_keeps_the_rate():
+    world = room_world(size_m=20.0)
+    base = LaserConfig(short_rate=0.1, short_run_beams=4.0, short_lifetime=3600.0)
+    fleeting = base.model_copy(update={"short_fleeting_share": 0.75})
+    runs = things = 0
+    for seed in range(20):  # first scans: the same draws make the same runs; about 1 in 4 leaves a thing
+        every, some = LaserModel(world, base), LaserModel(world, fleeting)
+        a = every.scan(POSE, np.random.default_rng(seed), t=0.0)
+        b = some.scan(POSE, np.random.default_rng(seed), t=0.0)
+        assert np.array_equal(a, b)
+        runs, things = runs + len(every._things), things + len(some._things)
+    assert runs > 200
+    assert things / runs == pytest.approx(0.25, abs=0.07)
+    # later scans draw more new runs where fewer things cover the beams: the share of short readings holds
+    laser = LaserModel(world, fleeting)
+    rng = np.random.default_rng(11)
+    shares = []
+    for k in range(60):
+        pose = POSE + np.array([0.0, 0.0, 0.05 * k])
+        reading = laser.scan(pose, rng, t=0.1 * k).astype(float)
+        shares.append(np.mean(reading < laser.true_ranges(pose) - 1e-4))
+    assert np.mean(shares[10:]) == pytest.approx(0.1, abs=0.015)
+    assert not LaserConfig(short_fleeting_share=0.5).has_errors

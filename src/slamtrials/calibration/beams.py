@@ -23,7 +23,7 @@ from slamtrials.sim.laser_errors import incidence_cosines
 from slamtrials.sim.raycast import RaycastMap, cast_scan
 from slamtrials.worlds.world import world_to_map
 
-__all__ = ["BeamSample", "beam_sample"]
+__all__ = ["BeamSample", "beam_sample", "FrameCast", "FrameCaster"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -77,21 +77,62 @@ class BeamSample:
         )
 
 
+@dataclass(frozen=True, eq=False)
+class FrameCast:
+    """One frame's beams cast in the reference map.
+
+    Attributes
+    ----------
+    laser_pose:
+        float64 ``[3]`` the laser's pose (map frame: m, m, rad).
+    ranges:
+        float32 ``[B]`` range (m) to the first wall of the map, ``range_max`` where none is within it.
+    kept:
+        bool ``[B]`` the beam hit a wall within the laser's range through known free space only.
+    incidence:
+        float64 ``[B]`` ``|cos|`` of the angle between the beam and the normal of the wall cell side.
+    """
+
+    laser_pose: NDArray[np.float64]
+    ranges: NDArray[np.float32]
+    kept: NDArray[np.bool_]
+    incidence: NDArray[np.float64]
+
+
+class FrameCaster:
+    """Casts the frames of ``record`` from the reference poses in the reference map (module docstring)."""
+
+    def __init__(self, record: RunRecord, reference: Reference) -> None:
+        self._walls, known = reference.worlds()
+        self._walls_map, self._known_map = RaycastMap.for_world(self._walls), RaycastMap.for_world(known)
+        self._poses = reference.poses
+        self._mount = record.laser.mount
+        self._limit = float(record.laser.range_max)
+        self.angles: NDArray[np.float64] = np.ascontiguousarray(record.laser.beam_angles(record.scans.shape[1]))
+
+    def cast(self, k: int) -> FrameCast:
+        """Frame ``k``'s beams."""
+        walls, res = self._walls, self._walls.resolution
+        pose = compose1(self._poses[k], self._mount)
+        uv = world_to_map(walls, pose[:2])
+        theta = float(pose[2] - walls.origin[2])
+        to_wall = cast_scan(self._walls_map.dist, uv, theta, self.angles, self._limit, res)
+        to_known = cast_scan(self._known_map.dist, uv, theta, self.angles, self._limit, res)
+        kept = (to_wall == to_known) & (to_wall > 0.0) & (to_wall < np.float32(self._limit))
+        cells = to_wall.astype(np.float64) / res
+        incidence = incidence_cosines((float(uv[0]), float(uv[1])), theta, self.angles, cells)
+        return FrameCast(laser_pose=pose, ranges=to_wall, kept=kept, incidence=incidence)
+
+
 def beam_sample(
     record: RunRecord, reference: Reference, max_beams: int, frames: NDArray[np.int64] | None = None
 ) -> BeamSample:
     """Cast the beams of every ``step``-th of ``frames`` (default all; ``step`` keeps the beams cast at
     most ``max_beams``)."""
-    walls, known = reference.worlds()
-    walls_map, known_map = RaycastMap.for_world(walls), RaycastMap.for_world(known)
-    laser = record.laser
+    caster = FrameCaster(record, reference)
     beams = record.scans.shape[1]
-    angles = np.ascontiguousarray(laser.beam_angles(beams))
     chosen = np.arange(len(record)) if frames is None else np.asarray(frames, dtype=np.int64)
     step = max(1, math.ceil(chosen.size * beams / max_beams))
-    mount = laser.mount
-    limit = float(laser.range_max)
-    res = walls.resolution
     frame_ids: list[NDArray[np.int64]] = []
     beam_ids: list[NDArray[np.int64]] = []
     casts: list[NDArray[np.float64]] = []
@@ -100,22 +141,16 @@ def beam_sample(
     used = 0
     for k in chosen[::step].tolist():
         used += 1
-        pose = compose1(reference.poses[k], mount)
-        uv = world_to_map(walls, pose[:2])
-        theta = float(pose[2] - walls.origin[2])
-        to_wall = cast_scan(walls_map.dist, uv, theta, angles, limit, res)
-        to_known = cast_scan(known_map.dist, uv, theta, angles, limit, res)
-        keep = (to_wall == to_known) & (to_wall > 0.0) & (to_wall < np.float32(limit))
-        if not keep.any():
+        cast = caster.cast(k)
+        if not cast.kept.any():
             continue
-        index = np.flatnonzero(keep)
-        cells = to_wall.astype(np.float64) / res
-        cosines = incidence_cosines((float(uv[0]), float(uv[1])), theta, angles, cells)
+        index = np.flatnonzero(cast.kept)
         frame_ids.append(np.full(index.size, k, dtype=np.int64))
         beam_ids.append(index.astype(np.int64))
-        casts.append(to_wall[index].astype(np.float64))
+        casts.append(cast.ranges[index].astype(np.float64))
         readings.append(record.scans[k, index].astype(np.float64))
-        incidences.append(cosines[index])
+        incidences.append(cast.incidence[index])
+    limit = float(record.laser.range_max)
     if not frame_ids:
         empty = np.zeros(0)
         none = np.zeros(0, np.int64)

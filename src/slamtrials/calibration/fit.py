@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 
 from slamtrials.calibration.beams import BeamSample, beam_sample
 from slamtrials.calibration.laser import LASER_VALUES, LaserFit, fit_laser
+from slamtrials.calibration.lifetime import LifetimeFit, fit_lifetime, model_laser_values
 from slamtrials.calibration.odometry import ODOMETRY_VALUES, OdometryFit, anchor_frames, fit_odometry, step_motion
 from slamtrials.calibration.reference import Reference, check_calibratable
 from slamtrials.calibration.settings import CalibrationSettings
@@ -45,6 +46,8 @@ _UNITS = {
     "dropout_rate": "",
     "dropout_per_m": "1/m",
     "dropout_grazing": "",
+    "short_lifetime": "s",
+    "short_fleeting_share": "",
     "bias_linear": "m/m",
     "bias_angular": "rad/rad",
     "noise_linear_per_m": "m/m",
@@ -64,8 +67,11 @@ class Calibration:
         The laser fit on all beams.
     odometry:
         The odometry fit on all steps.
+    lifetime:
+        The fit of the short readings' lifetime; None when it could not be fitted (too few short readings).
     fitted:
-        Every value of :data:`LASER_VALUES` then :data:`ODOMETRY_VALUES` with its standard error.
+        Every value of :data:`LASER_VALUES`, ``short_lifetime`` and ``short_fleeting_share`` (0 when not
+        fitted), then :data:`ODOMETRY_VALUES`, with its standard error.
     reference:
         What the reference is.
     frames:
@@ -86,6 +92,7 @@ class Calibration:
 
     laser: LaserFit
     odometry: OdometryFit
+    lifetime: LifetimeFit | None
     fitted: tuple[FittedValue, ...]
     reference: str
     frames: int
@@ -107,10 +114,10 @@ class Calibration:
     def profile(self, name: str, description: str) -> ErrorProfile:
         """The error profile: the fitted laser values, the biases as symmetric ranges of their measured
         magnitude (one log is one draw of the per-run bias), the noise coefficients; no slips."""
-        # a rate above 1 is a certainty; a run shorter than 1 beam is none (independent beams)
-        laser = {k: float(min(self.value(k).value, 1.0)) for k in LASER_VALUES if k != "short_run_beams"}
-        run = self.value("short_run_beams").value
-        laser["short_run_beams"] = float(run) if run >= 1.0 and laser["short_rate"] > 0.0 else 0.0
+        laser: dict[str, float] = model_laser_values(self.laser)
+        lifetime = self.value("short_lifetime").value if laser["short_rate"] > 0.0 else 0.0
+        laser["short_lifetime"] = lifetime
+        laser["short_fleeting_share"] = min(self.value("short_fleeting_share").value, 0.99) if lifetime > 0.0 else 0.0
         lin = min(abs(self.value("bias_linear").value), 0.49)
         ang = min(abs(self.value("bias_angular").value), 0.49)
         odometry: dict[str, object] = {"bias_linear_range": (-lin, lin), "bias_angular_range": (-ang, ang)}
@@ -189,13 +196,27 @@ def calibrate(
         np.std(np.array(laser_draws), axis=0, ddof=1) if len(laser_draws) > 1 else np.full(len(LASER_VALUES), math.nan)
     )
     odo_se = np.std(np.array(odo_draws), axis=0, ddof=1) if len(odo_draws) > 1 else np.full(6, math.nan)
-    fitted = tuple(
-        FittedValue(k, float(laser.values[k]), float(se), _UNITS[k]) for k, se in zip(LASER_VALUES, laser_se)
-    ) + tuple(FittedValue(k, float(odometry.values[k]), float(se), _UNITS[k]) for k, se in zip(ODOMETRY_VALUES, odo_se))
+    lifetime = fit_lifetime(record, reference, laser, cfg, seed=seed)
+    lifetime_values = (
+        (
+            FittedValue("short_lifetime", lifetime.lifetime, lifetime.stderr, "s"),
+            FittedValue("short_fleeting_share", lifetime.fleeting, lifetime.fleeting_stderr, ""),
+        )
+        if lifetime is not None
+        else (FittedValue("short_lifetime", 0.0, math.nan, "s"), FittedValue("short_fleeting_share", 0.0, math.nan, ""))
+    )
+    fitted = (
+        tuple(FittedValue(k, float(laser.values[k]), float(se), _UNITS[k]) for k, se in zip(LASER_VALUES, laser_se))
+        + lifetime_values
+        + tuple(
+            FittedValue(k, float(odometry.values[k]), float(se), _UNITS[k]) for k, se in zip(ODOMETRY_VALUES, odo_se)
+        )
+    )
     model_e, model_drop = _laser_model(sample, laser, record.laser.range_min, record.laser.range_max, rng)
     return Calibration(
         laser=laser,
         odometry=odometry,
+        lifetime=lifetime,
         fitted=fitted,
         reference=reference.source,
         frames=frames,

@@ -117,6 +117,17 @@ class LaserFit:
     short_share: float
     long_share: float
 
+    def short_below(self, cast: NDArray[np.float64], short_sigmas: float) -> NDArray[np.float64]:
+        """float64 ``[N]``: the reading (m) below which a beam whose cast range is ``cast`` ``[N]`` (m) reads
+        short, as the fit counts them: ``short_sigmas`` fitted noise sigmas short of the cast range moved by
+        its range bin's median residual (by none outside the table's bins)."""
+        v = self.values
+        sigma = np.maximum(v["range_noise_std"] + v["range_noise_per_m"] * cast, 1e-9)
+        offset = np.zeros_like(cast)
+        for low, high, centre in zip(self.bins.low, self.bins.high, self.bins.centre):
+            offset[(cast >= low) & (cast < high)] = centre
+        return cast + offset - short_sigmas * sigma
+
 
 def _normal_tail(k: float) -> float:
     return 0.5 * math.erfc(k / math.sqrt(2.0))

@@ -39,6 +39,19 @@ class CalibrationSettings(BaseModel):
     sim_dt:
         The simulator step (s) the odometry noise coefficients are given for (the model's noise is per
         step, so its coefficients depend on the step: see docs/realism.md, "Calibration").
+    lifetime_lags:
+        Lags (s, rounded to whole frames) of the persistence curve the short readings' lifetime is fitted to
+        (:mod:`~slamtrials.calibration.lifetime`).
+    lifetime_grid:
+        Lifetimes (s, increasing) the laser model is replayed with for that fit (besides 0).
+    fleeting_grid:
+        Fleeting shares (increasing, in [0, 1)) the laser model is replayed with, with every lifetime.
+    persistence_radius:
+        A short reading persists when a later frame reads short within this distance (m) of its end point.
+    lifetime_base_frames:
+        Most base frames of the persistence curve (spread evenly over the log).
+    lifetime_min_short:
+        Fewest short readings the base frames need for the lifetime to be fitted (else it stays 0).
     bootstrap:
         Bootstrap replicates of the uncertainty (blocks of consecutive frames are resampled).
     block_frames:
@@ -68,6 +81,16 @@ class CalibrationSettings(BaseModel):
         0.02, gt=0.0, le=1.0, description="least opposite travel of a direction conflict (m)"
     )
     sim_dt: float = Field(0.1, gt=0.0, le=1.0, description="simulator step the odometry noise is given for (s)")
+    lifetime_lags: tuple[float, ...] = Field((0.2, 0.6, 1.0, 2.0, 4.0), description="persistence lags (s)")
+    lifetime_grid: tuple[float, ...] = Field(
+        (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0), description="lifetimes replayed (s)"
+    )
+    fleeting_grid: tuple[float, ...] = Field(
+        (0.0, 0.2, 0.4, 0.6, 0.8, 0.9, 0.95), description="fleeting shares replayed"
+    )
+    persistence_radius: float = Field(0.15, gt=0.0, le=2.0, description="persistence radius (m)")
+    lifetime_base_frames: int = Field(600, ge=10, description="most base frames of the persistence curve")
+    lifetime_min_short: int = Field(100, ge=1, description="fewest short readings to fit the lifetime")
     bootstrap: int = Field(100, ge=10, le=10_000, description="bootstrap replicates")
     block_frames: int = Field(64, ge=1, description="bootstrap block length (frames)")
     min_frames: int = Field(200, ge=10, description="fewest frames")
@@ -86,4 +109,18 @@ class CalibrationSettings(BaseModel):
     def _windows(cls, value: tuple[int, ...]) -> tuple[int, ...]:
         if len(value) < 2 or any(b <= a for a, b in zip(value, value[1:])) or value[0] < 1:
             raise ValueError(f"windows must be at least 2 increasing lengths >= 1 frame, got {value}")
+        return value
+
+    @field_validator("lifetime_lags", "lifetime_grid")
+    @classmethod
+    def _positive_increasing(cls, value: tuple[float, ...]) -> tuple[float, ...]:
+        if len(value) < 2 or any(b <= a for a, b in zip(value, value[1:])) or value[0] <= 0.0:
+            raise ValueError(f"must be at least 2 increasing positive values (s), got {value}")
+        return value
+
+    @field_validator("fleeting_grid")
+    @classmethod
+    def _shares(cls, value: tuple[float, ...]) -> tuple[float, ...]:
+        if len(value) < 2 or any(b <= a for a, b in zip(value, value[1:])) or value[0] < 0.0 or value[-1] >= 1.0:
+            raise ValueError(f"must be at least 2 increasing shares in [0, 1), got {value}")
         return value

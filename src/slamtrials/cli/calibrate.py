@@ -66,6 +66,18 @@ def format_calibration(cal: Calibration, log: str) -> str:
         "dropout_grazing",
     ):
         lines.append(row(name))
+    life = cal.lifetime
+    if life is None:
+        lines.append("  short_lifetime, short_fleeting_share: not fitted (too few short readings); 0 in the profile")
+    else:
+        bound = "  (at the grid's largest: at least this)" if life.at_bound else ""
+        lines.append(row("short_lifetime", bound or " "))
+        lines.append(row("short_fleeting_share", " "))
+        curve = ", ".join(f"{s:.2f} s {r:.3f} / {f:.3f}" for s, r, f in zip(life.lag_seconds, life.real, life.fitted))
+        lines.append(
+            f"  short readings still read short within the radius after (real / fitted; {life.short_readings} "
+            f"short readings of {life.base_frames} frames): {curve}"
+        )
     lines.append(
         f"odometry: {odo.anchors} reference frames beyond odometry, {odo.distance:.1f} m, {odo.rotation:.1f} rad; "
         f"noise per simulator step of {odo.log_step / odo.step_scale**2:.3g} s (log step {odo.log_step:.3f} s)"

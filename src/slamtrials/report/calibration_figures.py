@@ -1,9 +1,9 @@
 """The page of figures of a calibration (``slamtrials calibrate``), drawn on a given matplotlib Figure.
 
-Six panels: the laser residuals, real against the fitted model drawn for the same beams; the noise sigma
-by range bin with the fitted line; short readings and no-returns by range bin, real against fitted; the
-odometry's heading and arc-length errors by window length against the fitted growth; the heading error
-before and after the scale bias.
+Seven panels and the fitted values: the laser residuals, real against the fitted model drawn for the same
+beams; the noise sigma by range bin with the fitted line; short readings and no-returns by range bin, real
+against fitted; how long short readings persist, real against the replayed model; the odometry's
+arc-length and heading errors by window length against the fitted growth.
 """
 
 from __future__ import annotations
@@ -25,9 +25,9 @@ def _binned_share(ranges, flags, low, high):
 
 
 def draw_calibration_page(fig, calibration: Calibration, title: str = "") -> None:
-    """Draw the six panels of ``calibration`` on ``fig`` (a matplotlib Figure, e.g. 15 x 9 inches)."""
+    """Draw the panels of ``calibration`` on ``fig`` (a matplotlib Figure, e.g. 16 x 9.5 inches)."""
     cal = calibration
-    axes = fig.subplots(2, 3)
+    axes = fig.subplots(2, 4)
     bins = cal.laser.bins
     values = {v.name: v.value for v in cal.fitted}
 
@@ -96,6 +96,30 @@ def draw_calibration_page(fig, calibration: Calibration, title: str = "") -> Non
     ax.set_title("short readings, no returns (at mapped walls)")
     ax.legend(fontsize=8)
 
+    ax = axes[0, 3]
+    life = cal.lifetime
+    if life is None:
+        ax.axis("off")
+        ax.text(0.0, 0.5, "short readings' lifetime: not fitted\n(too few short readings)", fontsize=9)
+    else:
+        for g in range(life.fleeting_grid.size):
+            for i in range(1, life.grid.size):
+                ax.plot(life.lag_seconds, life.model[g, i], "-", color="tab:gray", alpha=0.15, linewidth=0.8)
+        ax.plot(life.lag_seconds, life.model[0, 0], ":", color="tab:gray", label="model, drawn anew each scan")
+        ax.plot(life.lag_seconds, life.real, "o", color="tab:blue", label="real")
+        ax.plot(
+            life.lag_seconds,
+            life.fitted,
+            "-",
+            color="tab:orange",
+            label=f"fitted: {life.lifetime:.3g} s, {100 * life.fleeting:.0f} % fleeting",
+        )
+        ax.set_xscale("log")
+        ax.set_xlabel("time later (s)")
+        ax.set_ylabel("share of short readings read short again")
+        ax.set_title("short readings that persist (grey: model grid)")
+        ax.legend(fontsize=8)
+
     win = cal.odometry.windows
     ax = axes[1, 0]
     ax.plot(win.distance, win.rms_linear, "o", color="tab:blue", label="real (bias removed)")
@@ -118,6 +142,7 @@ def draw_calibration_page(fig, calibration: Calibration, title: str = "") -> Non
     ax.set_title("odometry: heading error growth")
     ax.legend(fontsize=8)
 
+    axes[1, 3].axis("off")
     ax = axes[1, 2]
     ax.axis("off")
     lines = [f"{v.name} = {v.value:.4g} +- {v.stderr:.2g} {v.unit}".rstrip() for v in cal.fitted]

@@ -36,6 +36,7 @@ LASER_ERROR_FIELDS = (
     "short_rate",
     "short_run_beams",
     "short_lifetime",
+    "short_fleeting_share",
     "dropout_rate",
     "dropout_per_m",
     "dropout_grazing",
@@ -166,6 +167,11 @@ class LaserConfig(BaseModel):
         Mean time (s) a thing not in the map stays where a scan saw it, read again by the scans that follow
         (:mod:`slamtrials.sim.unmapped`; real short readings mostly persist for seconds). 0 (the default):
         each scan's short readings are drawn anew.
+    short_fleeting_share:
+        With ``short_lifetime > 0``: the share of the new runs of short readings that leave no thing (gone
+        by the next scan, like the readings of things that move); the others stay for ``short_lifetime``
+        on average. 0 (the default): every run leaves a thing. Real logs have both kinds
+        (:mod:`slamtrials.calibration.lifetime` fits the two values together).
     dropout_rate, dropout_per_m, dropout_grazing:
         Probability per beam of no return (the reading is ``max_range``):
         ``dropout_rate + dropout_per_m * range + dropout_grazing * (1 - |cos(incidence)|)``, capped at 1,
@@ -194,6 +200,9 @@ class LaserConfig(BaseModel):
     short_lifetime: float = Field(
         0.0, ge=0.0, le=3600.0, description="mean time a thing not in the map stays (s); 0: drawn anew per scan"
     )
+    short_fleeting_share: float = Field(
+        0.0, ge=0.0, lt=1.0, description="share of new short-reading runs that leave no thing (with short_lifetime)"
+    )
     dropout_rate: float = Field(0.0, ge=0.0, le=1.0, description="probability per beam of no return")
     dropout_per_m: float = Field(
         0.0, ge=0.0, le=1.0, description="added probability of no return per metre of range (1/m)"
@@ -205,7 +214,11 @@ class LaserConfig(BaseModel):
     @property
     def has_errors(self) -> bool:
         """Whether any reading error is on (the noise-free Stage laser otherwise)."""
-        shape_only = ("short_run_beams", "short_lifetime")  # they shape the short readings, add none
+        shape_only = (
+            "short_run_beams",
+            "short_lifetime",
+            "short_fleeting_share",
+        )  # they shape the short readings, add none
         return any(getattr(self, name) > 0.0 for name in LASER_ERROR_FIELDS if name not in shape_only)
 
     @field_validator("mount")

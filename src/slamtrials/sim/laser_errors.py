@@ -17,7 +17,8 @@ is hit), the reading of beam ``i`` is:
    min_range)``, and a beam of the run whose true range is not beyond ``d`` keeps its own reading;
 
 4. **things that stay** (``short_lifetime > 0``): a run of short readings is a thing that stays where
-   it was seen for a while, read again by later scans (:mod:`slamtrials.sim.unmapped`);
+   it was seen for a while, read again by later scans, unless it is one of the ``short_fleeting_share``
+   that are gone by the next scan (:mod:`slamtrials.sim.unmapped`);
 
 then clipped to ``[min_range, max_range]``. Draws, from the run's stream, in this order and only for
 the models that are on: ``B`` standard normals (noise), ``B`` uniforms (dropout), ``B`` uniforms then
@@ -149,6 +150,7 @@ def apply_laser_errors(
             cfg.short_run_beams,
             cfg.min_range,
             cfg.short_lifetime,
+            cfg.short_fleeting_share,
         )
     elif cfg.short_rate > 0.0 and cfg.short_run_beams >= 1.0:
         whether = rng.random(count)

@@ -9,7 +9,8 @@ for every scan are things that jump about, which only hurt.
 What. With ``short_lifetime`` ``> 0`` a run of short readings (:mod:`slamtrials.sim.laser_errors`, item
 3: one thing at one distance ``d``) leaves a thing in the world: the chord at distance ``d`` across the
 run's beams (from half a beam before its first to half a beam after its last), in world coordinates,
-with a lifetime drawn from an exponential distribution of mean ``short_lifetime`` seconds. Every later
+with a lifetime drawn from an exponential distribution of mean ``short_lifetime`` seconds, unless the
+run is one of the ``short_fleeting_share`` that leave nothing (things that move on at once). Every later
 scan casts its beams against the things still alive; a beam that meets one before its wall (and not
 within ``min_range``) reads the distance to it, with neither noise nor dropout (as a short reading).
 New runs are then drawn along the scan as before on the beams no thing covers, at the rate that makes
@@ -18,7 +19,9 @@ covered) / (1 - covered)``, at least 0), so ``short_rate`` keeps its meaning and
 value. Things never stop the robot (they are in the laser's world only).
 
 Draws: as without lifetime, then ``B`` more uniforms per scan (each beam's lifetime, used only by the
-first beam of a new run), whatever the beams hit.
+first beam of a new run), whatever the beams hit. The one uniform ``u`` of a run decides both: below
+``short_fleeting_share`` ``g`` the run leaves nothing, else its thing lives ``-short_lifetime log((1 - u) /
+(1 - g))`` seconds (the exponential, as ``(u - g) / (1 - g)`` is uniform given ``u >= g``).
 """
 
 from __future__ import annotations
@@ -75,7 +78,24 @@ def _cast_at_things(segments, ox, oy, heading, first_angle, increment, true_r, m
 
 @njit(cache=True, fastmath=False, nogil=True)
 def _new_runs(
-    whether, where, life, r, reading, covered, rate, stay, start, min_range, lifetime, t, ox, oy, heading, angles, half
+    whether,
+    where,
+    life,
+    r,
+    reading,
+    covered,
+    rate,
+    stay,
+    start,
+    min_range,
+    lifetime,
+    fleeting,
+    t,
+    ox,
+    oy,
+    heading,
+    angles,
+    half,
 ):  # pragma: no cover - compiled
     """The chain of :func:`slamtrials.sim.laser_errors._short_runs` on the beams no thing covers (a covered
     beam ends a run); writes the new short readings into ``reading`` and returns the new things:
@@ -95,14 +115,14 @@ def _new_runs(
         if now and not short:
             distance = min_range + where[b] * max(r[b] - min_range, 0.0)
             first = b
-        if short and not now:  # the run first .. b - 1 ends: it leaves a thing
+        if short and not now and life[first] >= fleeting:  # the run first .. b - 1 ends: it leaves a thing
             a1 = heading + angles[first] - half
             a2 = heading + angles[b - 1] + half
             segments[count, 0] = ox + distance * math.cos(a1)
             segments[count, 1] = oy + distance * math.sin(a1)
             segments[count, 2] = ox + distance * math.cos(a2)
             segments[count, 3] = oy + distance * math.sin(a2)
-            deaths[count] = t - lifetime * math.log(1.0 - life[first])
+            deaths[count] = t - lifetime * math.log(1.0 - (life[first] - fleeting) / (1.0 - fleeting))
             count += 1
         short = now
         if short and distance < r[b]:
@@ -132,11 +152,13 @@ class UnmappedThings:
         run_beams: float,
         min_range: float,
         lifetime: float,
+        fleeting: float = 0.0,
     ) -> NDArray[np.float64]:
         """The readings float64 ``[B]`` (m) with the things alive at ``scan.t`` and the new ones of this scan.
 
         ``true_ranges`` ``[B]`` the cast ranges (m), ``reading`` ``[B]`` the readings after noise and dropout
-        (not changed), ``whether``, ``where``, ``life`` ``[B]`` uniforms in [0, 1).
+        (not changed), ``whether``, ``where``, ``life`` ``[B]`` uniforms in [0, 1); ``fleeting`` the share of new
+        runs that leave no thing.
         """
         alive = self.deaths > scan.t
         self.segments, self.deaths = self.segments[alive], self.deaths[alive]
@@ -168,6 +190,7 @@ class UnmappedThings:
             start,
             min_range,
             lifetime,
+            fleeting,
             float(scan.t),
             ox,
             oy,

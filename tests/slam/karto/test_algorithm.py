@@ -106,3 +106,31 @@ def test_a_trial_config_names_karto_alone():
     assert isinstance(config.slam.resolved(), KartoConfig)
     with pytest.raises(ConfigError, match="no parameter particles"):
         TrialConfig.from_dict({"slam": {"algorithm": "karto", "params": {"particles": 30}}})
+
+
+def test_every_loop_candidate_is_recorded_with_the_gates_it_met(square_loop):
+    # TryCloseLoop's log (slam_toolbox prints "COARSE RESPONSE", "var", "FINE RESPONSE" per candidate):
+    # one record per chain tried, accepted exactly when the three gates pass, as many accepted as closed
+    karto, _ = _run(square_loop)
+    c = karto.config
+    checks = karto.loop_checks
+    assert checks and sum(check.accepted for check in checks) == karto.loop_closures >= 1
+    bound = c.loop_match_maximum_variance_coarse**2
+    for check in checks:
+        assert (
+            check.last - check.first + 1 >= c.loop_match_minimum_chain_size and check.first <= check.last < check.node
+        )
+        coarse_ok = (
+            check.coarse_response > c.loop_match_minimum_response_coarse
+            and check.variance_x < bound
+            and check.variance_y < bound
+        )
+        assert coarse_ok == (not math.isnan(check.fine_response))
+        assert check.accepted == (coarse_ok and check.fine_response >= c.loop_match_minimum_response_fine)
+        assert check.jump >= 0.0 and (check.accepted or check.jump == 0.0)
+    # the closures on this loop are right: none moves its node by more than a few centimetres
+    assert max(check.jump for check in checks if check.accepted) < 0.1
+    # a coarse bound no response exceeds: every candidate is still recorded, none reaches the fine match
+    strict, _ = _run(square_loop, loop_match_minimum_response_coarse=1.0)
+    assert strict.loop_closures == 0 and strict.loop_checks
+    assert all(math.isnan(k.fine_response) and not k.accepted for k in strict.loop_checks)

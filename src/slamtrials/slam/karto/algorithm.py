@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
@@ -54,7 +55,7 @@ from slamtrials.slam.karto.mapbuild import NodeMap
 from slamtrials.slam.karto.optimize import information, optimize_pose_graph
 from slamtrials.slam.karto.scanmatch import MatcherSettings, MatchResult, ScanMatcher, points_in_map
 
-__all__ = ["Karto"]
+__all__ = ["Karto", "LoopCheck"]
 
 _TOLERANCE = 1e-9
 #: slam_toolbox's gate: a scan passes when its squared travel is at least this share of the squared
@@ -92,6 +93,40 @@ def weighted_mean(means: list[NDArray[np.float64]], covariances: list[NDArray[np
     return out
 
 
+@dataclass(frozen=True)
+class LoopCheck:
+    """One loop-closure candidate tried by TryCloseLoop (a diagnostic; what slam_toolbox logs as "COARSE
+    RESPONSE", "var" and "FINE RESPONSE").
+
+    Attributes
+    ----------
+    node:
+        Index of the new node.
+    first, last:
+        Indices of the candidate chain's first and last node (consecutive).
+    coarse_response:
+        The loop matcher's response (unpenalised, no fine pass).
+    variance_x, variance_y:
+        Its position variances (m^2, map frame).
+    fine_response:
+        The sequential matcher's response from the coarse pose; NaN when the coarse gates failed.
+    accepted:
+        The closure was accepted (linked, then the graph optimized).
+    jump:
+        Distance (m) the loop match moved the node's laser position (0 when not accepted).
+    """
+
+    node: int
+    first: int
+    last: int
+    coarse_response: float
+    variance_x: float
+    variance_y: float
+    fine_response: float
+    accepted: bool
+    jump: float
+
+
 @register_algorithm
 class Karto:
     """Karto graph SLAM (registry name ``karto``; see the module docstring).
@@ -109,6 +144,8 @@ class Karto:
         Nodes added since :meth:`reset`.
     loop_closures:
         Loop closures accepted since :meth:`reset`.
+    loop_checks:
+        Every loop-closure candidate tried since :meth:`reset` (:class:`LoopCheck`), in order.
     timings:
         ``[(node index, seconds)]``: wall time of every node's processing (matching, linking, loop
         closing and optimizing).
@@ -188,6 +225,7 @@ class Karto:
         c = self.config
         self.updates = 0
         self.loop_closures = 0
+        self.loop_checks: list[LoopCheck] = []
         self.timings: list[tuple[int, float]] = []
         self.optimizations: list[tuple[int, int, float, int]] = []
         self.graph = PoseGraph()
@@ -388,19 +426,37 @@ class Karto:
             start,
         )
         while chain:
-            coarse = self._match(self.loop_matcher, self._laser_pose(index), index, chain, penalize=False, refine=False)
+            laser_pose = self._laser_pose(index)
+            coarse = self._match(self.loop_matcher, laser_pose, index, chain, penalize=False, refine=False)
             bound = c.loop_match_maximum_variance_coarse**2
+            fine_response, accepted, jump = math.nan, False, 0.0
             if (
                 coarse.response > c.loop_match_minimum_response_coarse
                 and coarse.covariance[0, 0] < bound
                 and coarse.covariance[1, 1] < bound
             ):
                 fine = self._match(self.sequential, coarse.pose, index, chain, penalize=False)
+                fine_response = fine.response
                 if fine.response >= c.loop_match_minimum_response_fine:
+                    accepted = True
+                    jump = math.hypot(fine.pose[0] - laser_pose[0], fine.pose[1] - laser_pose[1])
                     node.pose = self._base_pose(fine.pose)
                     self._link_chain(chain, index, fine.pose, fine.covariance)
                     self._optimize()
                     self.loop_closures += 1
+            self.loop_checks.append(
+                LoopCheck(
+                    index,
+                    chain[0],
+                    chain[-1],
+                    float(coarse.response),
+                    float(coarse.covariance[0, 0]),
+                    float(coarse.covariance[1, 1]),
+                    float(fine_response),
+                    accepted,
+                    jump,
+                )
+            )
             chain, start = find_loop_closure_chain(
                 self.graph,
                 index,

@@ -26,6 +26,8 @@ def _binned_share(ranges, flags, low, high):
 
 def draw_calibration_page(fig, calibration: Calibration, title: str = "") -> None:
     """Draw the panels of ``calibration`` on ``fig`` (a matplotlib Figure, e.g. 16 x 9.5 inches)."""
+    from matplotlib.ticker import NullFormatter
+
     cal = calibration
     axes = fig.subplots(2, 4)
     bins = cal.laser.bins
@@ -114,10 +116,9 @@ def draw_calibration_page(fig, calibration: Calibration, title: str = "") -> Non
             color="tab:orange",
             label=f"fitted: {life.lifetime:.3g} s, {100 * life.fleeting:.0f} % fleeting",
         )
-        ax.set_xscale("log")
         ax.set_xlabel("time later (s)")
-        ax.set_ylabel("share of short readings read short again")
-        ax.set_title("short readings that persist (grey: model grid)")
+        ax.set_ylabel("share read short again within the radius")
+        ax.set_title("persisting short readings (grey: grid)")
         ax.legend(fontsize=8)
 
     win = cal.odometry.windows
@@ -149,5 +150,8 @@ def draw_calibration_page(fig, calibration: Calibration, title: str = "") -> Non
     lines.append(f"(+- one block-bootstrap standard error, {cal.bootstrap} replicates)")
     lines.append(f"reference: {cal.reference}")
     ax.text(0.0, 1.0, "\n".join(lines), va="top", family="monospace", fontsize=7, wrap=True)
+    for ax in axes.ravel():
+        if ax.get_xscale() == "log":  # the minor ticks' labels overlap on short decades
+            ax.xaxis.set_minor_formatter(NullFormatter())
     if title:
         fig.suptitle(title)

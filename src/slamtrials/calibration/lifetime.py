@@ -247,7 +247,7 @@ def _best(real: NDArray[np.float64], curves: NDArray[np.float64]) -> int:
 def fit_lifetime(
     record: RunRecord, reference: Reference, laser: LaserFit, settings: CalibrationSettings, *, seed: int
 ) -> LifetimeFit | None:
-    """Fit ``short_lifetime`` (module docstring); None when the log's base frames hold fewer than
+    """Fit ``short_lifetime`` and ``short_fleeting_share`` (module docstring); None when the log's base frames hold fewer than
     ``lifetime_min_short`` short readings or the log is shorter than its longest lag."""
     step = float(np.median(np.diff(record.t)))
     lags = np.unique(np.maximum(np.rint(np.asarray(settings.lifetime_lags) / step).astype(np.int64), 1))

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from slamtrials.record import LaserGeometry
-from slamtrials.slam.gridmap import GridMap, beam_endpoints
+from slamtrials.slam.gridmap import GridMap, _classify, beam_endpoints
 
 RES = 0.05
 HALF = 2.025  # walls through cell centres (cells are anchored at the origin), so no endpoint lies on a cell edge
@@ -118,3 +118,16 @@ def test_mount_and_pose_are_applied():
     m = np.maximum(np.abs(x), np.abs(y))
     assert np.mean(grid.grid[np.isclose(m, HALF)] == 100) > 0.95
     assert not np.any(grid.grid[m > HALF + 0.01] == 100)
+
+
+def test_the_compiled_classification_equals_the_threshold_rule():
+    """Random counts: unknown where never visited, occupied where hits / visits > occ_thresh, else free,
+    rows flipped to the top first when asked (the compiled pass is branch-free)."""
+    rng = np.random.default_rng(4)
+    visits = (rng.integers(0, 6, (57, 83)) * (rng.random((57, 83)) < 0.6)).astype(np.int32)
+    hits = np.minimum(rng.integers(0, 6, visits.shape), visits).astype(np.int32)
+    for occ_thresh in (0.0, 0.25, 0.5):
+        want = np.where(visits <= 0, -1, np.where(hits > occ_thresh * visits, 100, 0)).astype(np.int8)
+        np.testing.assert_array_equal(_classify(hits, visits, occ_thresh, False), want)
+        np.testing.assert_array_equal(_classify(hits, visits, occ_thresh, True), want[::-1])
+    assert set(np.unique(want).tolist()) == {-1, 0, 100}

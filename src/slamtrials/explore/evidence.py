@@ -148,6 +148,24 @@ def _trace_open(crossed, gx0, gy0, sx, sy, ex, ey):  # pragma: no cover - compil
                 cy += step_y
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _unknown_if_free(grid, out, row, start, stop):  # pragma: no cover - compiled
+    """``out[row, start:stop]`` = ``grid``'s cells there with the free ones (0 <= value < 50) made unknown;
+    returns how many were free. Without branches, so that the compiler vectorizes it (an integer
+    count: the same in any order)."""
+    count = 0
+    start = max(start, 0)
+    if stop <= start:
+        return 0
+    r = np.uint64(row)
+    for col in range(np.uint64(start), np.uint64(stop)):  # unsigned: no negative-index wrap-around
+        value = grid[r, col]
+        free = value >= 0 and value < 50
+        out[r, col] = -1 if free else value
+        count += 1 if free else 0
+    return count
+
+
 @njit(cache=True, nogil=True)
 def _correct(
     grid, hits, passes, near, crossed, r_off, c_off, row0, row1, col0, col1, min_hits, ratio
@@ -163,16 +181,16 @@ def _correct(
     changed = 0
     outside = 0
     for row in range(height):
-        inside_rows = row0 <= row < row1
+        if not row0 <= row < row1:
+            outside += _unknown_if_free(grid, out, row, 0, width)
+            continue
+        outside += _unknown_if_free(grid, out, row, 0, min(col0, width))
+        outside += _unknown_if_free(grid, out, row, max(col1, col0), width)
         lr = r_off - (row - row0)
-        for col in range(width):
+        for col in range(max(col0, 0), min(col1, width)):
             value = grid[row, col]
             out[row, col] = value
             if value < 0 or value >= 50:
-                continue
-            if not (inside_rows and col0 <= col < col1):
-                out[row, col] = -1
-                outside += 1
                 continue
             lc = c_off + (col - col0)
             if not (0 <= lr < lh and 0 <= lc < lw) or not near[lr, lc]:

@@ -27,6 +27,7 @@ __all__ = [
     "TILE",
     "score_pose",
     "score_3x3",
+    "STOPPED",
     "likelihood_3x3",
     "score_scratch",
     "match_particles",
@@ -240,29 +241,24 @@ def score_scratch(beams):
 
 @njit(cache=True, nogil=True, inline="always")
 def _window_minima_3x3(
-    directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, floats, ints, row
+    directory, mean, tile_col0, tile_row0, res, x, y, c, s, lx, ly, offset_x, offset_y, best, ints, lo, hi
 ):  # pragma: no cover - compiled
-    """Stages 1 and 2 of :func:`score_3x3`: each beam's smallest squared distance to a mean in its 3 x 3
-    window goes to ``floats[row]`` (:data:`NOTHING_D2` if none; ``row`` >= 2); ``floats[0]`` is left
-    free for reuse."""
+    """Stages 1 and 2 of :func:`score_3x3` for beams ``lo`` to ``hi - 1`` from laser pose (x, y) with
+    heading cosine ``c`` and sine ``s``: each beam's smallest squared distance to a mean in its 3 x 3
+    window goes to ``best`` (:data:`NOTHING_D2` if none), its endpoint's offset in its cell to
+    ``offset_x`` and ``offset_y``; ``ints``: four int64 ``[B]`` work rows (a tuple: first window index,
+    the beams whose window crosses a tile border, their columns and rows). The loops count with unsigned
+    integers: from a signed start numba keeps its negative-index wrap-around in every access, which
+    kept the compiler from vectorizing them (the score took a third longer)."""
     inv_res = 1.0 / res
-    c = math.cos(theta)
-    s = math.sin(theta)
-    n = lx.shape[0]
     rows, cols = directory.shape
     base_c = tile_col0 << TILE_SHIFT
     base_r = tile_row0 << TILE_SHIFT
     row_stride = 2 * TILE
     tile_stride = 2 * TILE * TILE
-    offset_x = floats[0]
-    offset_y = floats[1]
-    best = floats[row]
-    first = ints[0]
-    crossing = ints[1]  # the beams whose window crosses a tile border, and their cells
-    crossing_col = ints[2]
-    crossing_row = ints[3]
+    first, crossing, crossing_col, crossing_row = ints  # crossing: beams whose window crosses a tile border
     crossings = 0
-    for b in range(n):
+    for b in range(np.uint64(lo), np.uint64(hi)):
         ex = x + c * lx[b] - s * ly[b]
         ey = y + s * lx[b] + c * ly[b]
         gc = int(math.floor(ex * inv_res))
@@ -282,7 +278,7 @@ def _window_minima_3x3(
             crossing_col[crossings] = dcol
             crossing_row[crossings] = drow
             crossings += 1
-    for b in range(n):
+    for b in range(np.uint64(lo), np.uint64(hi)):
         best[b] = window_min_3x3(mean, first[b], row_stride, offset_x[b], offset_y[b], res)
     for i in range(crossings):
         b = crossing[i]
@@ -291,39 +287,69 @@ def _window_minima_3x3(
         )
 
 
+#: Beams per block of :func:`score_3x3`: after each block it checks whether the score can still beat
+#: its ``floor``.
+_BLOCK = 64
+#: More than the rounding error of any score sum and of the terms' own (at most a few thousand terms,
+#: each at most 1 to within an ulp, every rounding below 1e-12), so that a bound with it added is an
+#: upper bound of the computed score.
+_BOUND_SLACK = 1.0e-6
+#: What :func:`score_3x3` returns when it stopped early: below every score.
+STOPPED = -1.0
+
+
 @njit(cache=True, nogil=True, fastmath={"nnan", "ninf", "nsz"})
 def score_3x3(
-    directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats, ints, row=2
+    directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats, ints, row=2, floor=-1.0
 ):  # pragma: no cover - compiled
     """The score of :func:`score_pose` for its default window (``kernel`` 1, no free-cell test), bit for
-    bit, in stages that keep each loop short: the hill climbing's hot spot.
+    bit, in stages that keep each loop short: the hill climbing's hot spot. Blocks of :data:`_BLOCK`
+    beams in beam order go through
 
-    1. Per beam: endpoint, offset in its cell and, when the 3 x 3 window lies in one tile, the window's
-       first index in ``mean`` (else the beam goes on a list).
-    2. Per beam: the window minimum in vector code (:func:`~slamtrials.slam.gmapping.window.window_min_3x3`;
+    1. per beam: endpoint, offset in its cell and, when the 3 x 3 window lies in one tile, the window's
+       first index in ``mean`` (else the beam goes on a list);
+    2. per beam: the window minimum in vector code (:func:`~slamtrials.slam.gmapping.window.window_min_3x3`;
        listed beams read the empty tile here); then the listed beams again, one directory lookup per
-       cell.
-    3. The exp series of every beam (a loop the compiler vectorizes), then the sum in beam order, with
+       cell;
+    3. the exp series of every beam (a loop the compiler vectorizes), then the sum in beam order, with
        libm's exp where the series does not apply.
+
+    Early stop: every beam adds at most 1 (``exp`` of a number <= 0), so after a block the score can
+    reach at most the sum so far plus the number of beams left. When that bound (plus
+    :data:`_BOUND_SLACK` for rounding) is at most ``floor``, the score cannot exceed ``floor`` and the
+    function returns :data:`STOPPED` at once (the hill climbing passes its current score: a candidate
+    is taken only when it scores strictly more). The sum is the same sequence of additions either way,
+    so a score that is returned is the same number bit for bit.
 
     ``floats`` and ``ints`` come from :func:`score_scratch` (at least ``len(lx)`` columns); the window
     minima are left in ``floats[row]`` (``row`` 2, 3 or 4) for :func:`_likelihood_of`. The arithmetic per
     beam is the same as in :func:`score_pose`, and the fast-math flags allowed here (no NaN, no
     infinity, no signed zero; all values are finite) do not change any result.
     """
-    _window_minima_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, floats, ints, row)
     inv_sigma = 1.0 / sigma
     n = lx.shape[0]
     best = floats[row]
-    terms = floats[0]  # the offsets are no longer needed
-    for b in range(n):
-        terms[b] = _exp_series_minus(best[b] * inv_sigma)
+    offset_x = floats[0]
+    terms = offset_x  # a block's offsets are no longer needed once its minima are known
+    offset_y = floats[1]
+    work = (ints[0], ints[1], ints[2], ints[3])
+    c = math.cos(theta)
+    s = math.sin(theta)
     score = 0.0
-    for b in range(n):
-        d2 = best[b]
-        if d2 < _FOUND_D2:
-            a = d2 * inv_sigma
-            score += terms[b] if a <= _EXP_SERIES_MAX else math.exp(-a)
+    for lo in range(0, n, _BLOCK):
+        hi = min(lo + _BLOCK, n)
+        _window_minima_3x3(
+            directory, mean, tile_col0, tile_row0, res, x, y, c, s, lx, ly, offset_x, offset_y, best, work, lo, hi
+        )
+        for b in range(np.uint64(lo), np.uint64(hi)):
+            terms[b] = _exp_series_minus(best[b] * inv_sigma)
+        for b in range(np.uint64(lo), np.uint64(hi)):
+            d2 = best[b]
+            if d2 < _FOUND_D2:
+                a = d2 * inv_sigma
+                score += terms[b] if a <= _EXP_SERIES_MAX else math.exp(-a)
+        if hi < n and score + (n - hi) + _BOUND_SLACK <= floor:
+            return STOPPED
     return score
 
 
@@ -333,7 +359,28 @@ def likelihood_3x3(
 ):  # pragma: no cover - compiled
     """The log-likelihood of :func:`score_pose` for its default window (``kernel`` 1, no free-cell
     test), bit for bit: the window minima of :func:`score_3x3`, then the sum in beam order."""
-    _window_minima_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, floats, ints, 2)
+    c = math.cos(theta)
+    s = math.sin(theta)
+    work = (ints[0], ints[1], ints[2], ints[3])
+    _window_minima_3x3(
+        directory,
+        mean,
+        tile_col0,
+        tile_row0,
+        res,
+        x,
+        y,
+        c,
+        s,
+        lx,
+        ly,
+        floats[0],
+        floats[1],
+        floats[2],
+        work,
+        0,
+        lx.shape[0],
+    )
     return _likelihood_of(floats[2], lsigma)
 
 
@@ -371,11 +418,14 @@ def _match_score(
     floats,
     ints,
     row,
+    floor,
 ):  # pragma: no cover - compiled
     """The scan-matching score at one pose: :func:`score_3x3` for the default window (window minima left
-    in ``floats[row]``), else :func:`score_pose`."""
+    in ``floats[row]``; :data:`STOPPED` when the score cannot exceed ``floor``), else :func:`score_pose`."""
     if kernel == 1 and not free_test:
-        return score_3x3(directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats, ints, row)
+        return score_3x3(
+            directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats, ints, row, floor
+        )
     score, _ = score_pose(
         directory,
         mean,
@@ -440,7 +490,7 @@ def _hill_climb(
     likelihood). ``floats``, ``ints``: work arrays from :func:`score_scratch`; ``seen``: float64
     ``[S, 3]`` work array.
 
-    Two savings over the original, neither of which changes the result:
+    Three savings over the original, none of which changes the result:
 
     - right after a move, the move straight back (same step) is not tried; it returns to the pose just
       left, whose score is lower than the current one, so it could not win;
@@ -448,7 +498,9 @@ def _hill_climb(
       two axes, one step back along the first lands where the previous iteration already looked, about
       6 % of all candidates) is not scored again. Its score cannot exceed the current one: the current
       score never decreases and a pose is taken only when it scores strictly more, so an earlier pose
-      scored at most what was current then.
+      scored at most what was current then;
+    - a candidate is scored with the current score as floor (:func:`score_3x3`): it is given up as soon
+      as its beams so far show it cannot score more, which it would need to be taken.
     """
     cx, cy, ct = pose[0], pose[1], pose[2]
     seen[0, 0], seen[0, 1], seen[0, 2] = cx, cy, ct
@@ -475,6 +527,7 @@ def _hill_climb(
         floats,
         ints,
         at,
+        STOPPED,
     )
     ld = lstep
     ad = astep
@@ -531,6 +584,7 @@ def _hill_climb(
                 floats,
                 ints,
                 scratch,
+                current,
             )
             if local > current:
                 current = local

@@ -186,9 +186,13 @@ def test_bundled_paper_profile_is_the_configs_defaults():
     assert paper.odometry_values() == {name: getattr(defaults.odometry, name) for name in paper.odometry_values()}
 
 
-def test_realistic_is_the_mean_of_the_two_fits_field_by_field():
+def test_realistic_is_the_mean_of_the_two_fits_field_by_field_without_the_persistence():
     mit, fr079, realistic = (BUNDLED_PROFILES[name] for name in ("mit-csail", "fr079", "realistic"))
+    persistence = ("short_lifetime", "short_fleeting_share")
     for name, value in realistic.laser_values().items():
+        if name in persistence:  # fitted on both logs, left out: the explorer takes the things for obstacles
+            assert value == 0.0 and mit.laser_values()[name] > 0.0 and fr079.laser_values()[name] > 0.0
+            continue
         assert value == pytest.approx(0.5 * (mit.laser_values()[name] + fr079.laser_values()[name]), abs=1e-6)
     for name, value in realistic.odometry_values().items():
         expected = np.mean([mit.odometry_values()[name], fr079.odometry_values()[name]], axis=0)

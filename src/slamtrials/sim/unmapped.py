@@ -33,6 +33,8 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
+from slamtrials.sim.shortdistance import short_distance
+
 __all__ = ["UnmappedThings", "UnmappedScan"]
 
 
@@ -90,6 +92,7 @@ def _new_runs(
     min_range,
     lifetime,
     fleeting,
+    gap,
     t,
     ox,
     oy,
@@ -113,7 +116,7 @@ def _new_runs(
             chance = rate if (b == 0 or covered[b - 1]) and not short else (stay if short else start)
             now = whether[b] < chance
         if now and not short:
-            distance = min_range + where[b] * max(r[b] - min_range, 0.0)
+            distance = short_distance(where[b], r[b], min_range, gap)
             first = b
         if short and not now and life[first] >= fleeting:  # the run first .. b - 1 ends: it leaves a thing
             a1 = heading + angles[first] - half
@@ -153,12 +156,13 @@ class UnmappedThings:
         min_range: float,
         lifetime: float,
         fleeting: float = 0.0,
+        gap: float = 0.0,
     ) -> NDArray[np.float64]:
         """The readings float64 ``[B]`` (m) with the things alive at ``scan.t`` and the new ones of this scan.
 
         ``true_ranges`` ``[B]`` the cast ranges (m), ``reading`` ``[B]`` the readings after noise and dropout
         (not changed), ``whether``, ``where``, ``life`` ``[B]`` uniforms in [0, 1); ``fleeting`` the share of new
-        runs that leave no thing.
+        runs that leave no thing; ``gap`` the mean gap (m) of a new thing before the wall (0: anywhere).
         """
         alive = self.deaths > scan.t
         self.segments, self.deaths = self.segments[alive], self.deaths[alive]
@@ -191,6 +195,7 @@ class UnmappedThings:
             min_range,
             lifetime,
             fleeting,
+            gap,
             float(scan.t),
             ox,
             oy,

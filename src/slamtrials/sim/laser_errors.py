@@ -14,7 +14,7 @@ is hit), the reading of beam ``i`` is:
    (a Markov chain along the scan: short after a short beam with probability ``1 - 1 / L``, after
    another with :func:`~slamtrials.sim.config.short_start_chance`, the first beam with ``short_rate``);
    a run is one object at the distance drawn for its first beam, ``d = min_range + u (r_first -
-   min_range)`` (or a gap before the wall with ``short_wall_gap``, :mod:`slamtrials.sim.shortdistance`),
+   min_range)`` (or, for ``short_wall_share`` of them, a gap before the wall: :mod:`slamtrials.sim.shortdistance`),
    and a beam of the run whose true range is not beyond ``d`` keeps its own reading;
 
 4. **things that stay** (``short_lifetime > 0``): a run of short readings is a thing that stays where
@@ -72,23 +72,25 @@ def _incidence(ox, oy, theta, angles, t, out):  # pragma: no cover - compiled
 
 
 @njit(cache=True, fastmath=False, nogil=True)
-def _short_runs(whether, where, r, reading, rate, stay, start, min_range, gap):  # pragma: no cover - compiled
+def _short_runs(
+    whether, where, r, reading, rate, stay, start, min_range, wall_share, gap
+):  # pragma: no cover - compiled
     short = False
     distance = 0.0
     for b in range(r.shape[0]):
         chance = rate if b == 0 else (stay if short else start)
         now = whether[b] < chance
         if now and not short:
-            distance = short_distance(where[b], r[b], min_range, gap)
+            distance = short_distance(where[b], r[b], min_range, wall_share, gap)
         short = now
         if short and distance < r[b]:
             reading[b] = distance
 
 
 @njit(cache=True, fastmath=False, nogil=True)
-def _short_distances(where, r, min_range, gap, out):  # pragma: no cover - compiled
+def _short_distances(where, r, min_range, wall_share, gap, out):  # pragma: no cover - compiled
     for b in range(r.shape[0]):
-        out[b] = short_distance(where[b], r[b], min_range, gap)
+        out[b] = short_distance(where[b], r[b], min_range, wall_share, gap)
 
 
 def incidence_cosines(
@@ -159,6 +161,7 @@ def apply_laser_errors(
             cfg.min_range,
             cfg.short_lifetime,
             cfg.short_fleeting_share,
+            cfg.short_wall_share,
             cfg.short_wall_gap,
         )
     elif cfg.short_rate > 0.0 and cfg.short_run_beams >= 1.0:
@@ -167,14 +170,23 @@ def apply_laser_errors(
         stay = 1.0 - 1.0 / cfg.short_run_beams
         reading = np.array(reading, dtype=np.float64)  # a copy: the kernel writes into it
         _short_runs(
-            whether, where, r, reading, cfg.short_rate, stay, short_start_chance(cfg), cfg.min_range, cfg.short_wall_gap
+            whether,
+            where,
+            r,
+            reading,
+            cfg.short_rate,
+            stay,
+            short_start_chance(cfg),
+            cfg.min_range,
+            cfg.short_wall_share,
+            cfg.short_wall_gap,
         )
     elif cfg.short_rate > 0.0:
         short = rng.random(count) < cfg.short_rate
         where = rng.random(count)
-        if cfg.short_wall_gap > 0.0:
+        if cfg.short_wall_share > 0.0:
             distance = np.empty(count)
-            _short_distances(where, r, cfg.min_range, cfg.short_wall_gap, distance)
+            _short_distances(where, r, cfg.min_range, cfg.short_wall_share, cfg.short_wall_gap, distance)
         else:
             distance = cfg.min_range + where * np.maximum(r - cfg.min_range, 0.0)
         reading = np.where(short, distance, reading)

@@ -92,6 +92,7 @@ def _new_runs(
     min_range,
     lifetime,
     fleeting,
+    wall_share,
     gap,
     t,
     ox,
@@ -116,7 +117,7 @@ def _new_runs(
             chance = rate if (b == 0 or covered[b - 1]) and not short else (stay if short else start)
             now = whether[b] < chance
         if now and not short:
-            distance = short_distance(where[b], r[b], min_range, gap)
+            distance = short_distance(where[b], r[b], min_range, wall_share, gap)
             first = b
         if short and not now and life[first] >= fleeting:  # the run first .. b - 1 ends: it leaves a thing
             a1 = heading + angles[first] - half
@@ -156,13 +157,15 @@ class UnmappedThings:
         min_range: float,
         lifetime: float,
         fleeting: float = 0.0,
+        wall_share: float = 0.0,
         gap: float = 0.0,
     ) -> NDArray[np.float64]:
         """The readings float64 ``[B]`` (m) with the things alive at ``scan.t`` and the new ones of this scan.
 
         ``true_ranges`` ``[B]`` the cast ranges (m), ``reading`` ``[B]`` the readings after noise and dropout
         (not changed), ``whether``, ``where``, ``life`` ``[B]`` uniforms in [0, 1); ``fleeting`` the share of new
-        runs that leave no thing; ``gap`` the mean gap (m) of a new thing before the wall (0: anywhere).
+        runs that leave no thing; ``wall_share`` of the new things stand a gap of mean ``gap`` (m) before the
+        wall, the others anywhere on the beam.
         """
         alive = self.deaths > scan.t
         self.segments, self.deaths = self.segments[alive], self.deaths[alive]
@@ -195,6 +198,7 @@ class UnmappedThings:
             min_range,
             lifetime,
             fleeting,
+            wall_share,
             gap,
             float(scan.t),
             ox,

@@ -60,10 +60,13 @@ def test_takes_returns_near_the_robot_in_free_space_only():
     assert obstacles.add(0.0, np.array([4.6, 2.5, 0.0]), scan_with(three, 0.33), LASER, 0.15, occ) == 0
     # fewer than three returns: more likely a corner the map shows a little off
     assert obstacles.add(0.0, pose, scan_with([AHEAD, AHEAD + 1], 0.3), LASER, 0.15, occ) == 0
-    # returns over more than 60 degrees round the robot: a wall the map misplaced, not a thing
-    assert obstacles.add(0.0, pose, scan_with(range(AHEAD - 70, AHEAD + 71), 0.3), LASER, 0.15, occ) == 0
-    assert obstacles.add(0.0, pose, scan_with(range(AHEAD - 50, AHEAD + 51), 0.3), LASER, 0.15, occ) == 101
-    assert len(obstacles) == 106
+    # returns on more than 50 degrees' worth of beams: a wall the map misplaced, not a thing
+    assert obstacles.add(0.0, pose, scan_with(range(AHEAD - 55, AHEAD + 56), 0.3), LASER, 0.15, occ) == 0
+    assert obstacles.add(0.0, pose, scan_with(range(AHEAD - 45, AHEAD + 46), 0.3), LASER, 0.15, occ) == 91
+    # several small things round the robot, however far apart in bearing
+    sides = [*range(AHEAD - 182, AHEAD - 178), *range(AHEAD + 178, AHEAD + 182)]
+    assert obstacles.add(0.0, pose, scan_with(sides, 0.3), LASER, 0.15, occ) == 8
+    assert len(obstacles) == 104
 
 
 def test_stamped_into_the_map_the_explorer_plans_on():

@@ -11,7 +11,8 @@ What. When the scan has held the robot still for ``blocked_time`` (:mod:`slamtri
 :meth:`TransientObstacles.add` keeps the confirmed returns within ``reach`` m of the robot's edge that
 end on a cell the planning map calls free with no occupied cell within ``clear_cells`` cells (so a
 wall the map shows, or shows a little off, adds nothing), if there are at least ``min_returns`` of
-them and they span at most ``max_angle`` of the scan (else it is the map that is off, see the class). :meth:`TransientObstacles.stamp` marks their
+them and their beams cover at most ``max_angle`` of the scan (else it is the map that is off, see the
+class). :meth:`TransientObstacles.stamp` marks their
 cells occupied in the map the explorer plans on (the costmap inflates them like any wall), so the new
 path goes around them if there is room. Each scan, :meth:`TransientObstacles.forget_seen` drops the
 points that a beam now passes (its return lies more than ``pass_margin`` beyond the point, on the beam
@@ -50,10 +51,11 @@ class TransientObstacles:
     pass_margin:
         A beam whose return lies this far (m) beyond a point passes it (the point is gone).
     min_returns, max_angle:
-        Returns are taken only if at least ``min_returns`` qualify and they span at most ``max_angle``
-        (rad) of the scan: one or two returns are more likely a corner the map shows a little off, and
-        returns all round the robot a stretch of wall the map misplaced (with ``realistic``
-        school_medium_01 held the robot by 66 to 110 degrees of such returns; things by 45 at most).
+        Returns are taken only if at least ``min_returns`` qualify and their beams cover at most
+        ``max_angle`` (rad) of the scan together: one or two returns are more likely a corner the map
+        shows a little off, and that many returns a stretch of wall the map misplaced (with ``realistic``,
+        school_medium_01 held the robot by 66 to 110 degrees of such returns; the things that stay by 46
+        at most, often several small ones round the robot).
     """
 
     def __init__(
@@ -63,7 +65,7 @@ class TransientObstacles:
         clear_cells: int = 2,
         pass_margin: float = 0.1,
         min_returns: int = 3,
-        max_angle: float = math.radians(60.0),
+        max_angle: float = math.radians(50.0),
     ):
         self.min_returns = int(min_returns)
         self.max_angle = float(max_angle)
@@ -118,8 +120,7 @@ class TransientObstacles:
         count = int(keep.sum())
         if count < self.min_returns:
             return 0
-        bearings = stablemath.arctan2(pts[keep, 1], pts[keep, 0])
-        if float(bearings.max() - bearings.min()) > self.max_angle:
+        if count * abs(laser.angle_increment) > self.max_angle:
             return 0  # a wall round the robot that the map does not show: the map is off, not a thing there
         new = world[keep]
         self._set(np.concatenate([self.points, new]), np.concatenate([self.added, np.full(new.shape[0], float(t))]))

@@ -376,6 +376,16 @@ class ExploreConfig(BaseModel):
     max_recoveries_per_goal: int = Field(
         2, ge=1, le=100, description="blacklist a goal after this many recoveries on the way"
     )
+    transient_reach: float = Field(
+        0.25,
+        ge=0.0,
+        le=5.0,
+        description="when the scan held the robot still, plan around the returns this close to its edge that the "
+        "map shows no wall near (m; 0: off; slamtrials.explore.transient)",
+    )
+    transient_lifetime: float = Field(
+        60.0, gt=0.0, le=3600.0, description="forget such a return after this long even if no scan saw it gone (s)"
+    )
 
     @model_validator(mode="before")
     @classmethod

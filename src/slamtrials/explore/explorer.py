@@ -9,7 +9,11 @@ previous scans (:mod:`slamtrials.explore.scanfilter`). Then, in this order:
 
 1. a manoeuvre under way (the initial full turn, a look-around turn, a recovery) gives the command;
 2. stuck, idle, bumped or blocked (:mod:`slamtrials.explore.recovery`): start a recovery; after
-   ``max_recoveries_per_goal`` recoveries on the way to one goal, blacklist the goal;
+   ``max_recoveries_per_goal`` recoveries on the way to one goal, blacklist the goal. A robot held still
+   by returns the map does not show (a thing standing in its way) keeps them as obstacles to plan
+   around until its own scans show them gone (:mod:`slamtrials.explore.transient`), and that recovery
+   does not count against the goal; when they leave no frontier reachable, they are forgotten (the
+   way is tried again) before anything else is given up;
 3. goal bookkeeping: a goal within ``goal_tolerance`` is reached (and remembered, so its frontier
    cells are skipped from now on: a frontier still there once the robot stands on it cannot be seen
    from there); a goal whose remaining path length did not shrink by ``progress_distance`` for
@@ -58,6 +62,7 @@ from slamtrials.explore.goalsearch import Found, GoalSearch
 from slamtrials.explore.gridframe import GridFrame, map_arrays
 from slamtrials.explore.recovery import Recovery, StuckMonitor
 from slamtrials.explore.scanfilter import ScanMemory, confirmed_ranges, inside_footprint
+from slamtrials.explore.transient import TransientObstacles
 from slamtrials.record import LaserGeometry
 
 __all__ = ["ExploreStats", "Explorer"]
@@ -85,6 +90,8 @@ class ExploreStats:
     backing_outs:
         Times the robot backed out along its path instead of turning round
         (:mod:`slamtrials.explore.follower`).
+    transient_obstacles:
+        Returns taken for obstacles the map does not show (:mod:`slamtrials.explore.transient`).
     plan_seconds:
         Wall-clock seconds spent planning (costmaps, frontiers, Dijkstra).
     """
@@ -96,6 +103,7 @@ class ExploreStats:
     blacklist_resets: int = 0
     look_arounds: int = 0
     backing_outs: int = 0
+    transient_obstacles: int = 0
     plan_seconds: float = 0.0
 
 
@@ -129,6 +137,7 @@ class Explorer:
         self._evidence = EvidenceLayer(
             cfg.evidence_min_hits, cfg.evidence_occupied_ratio, cfg.evidence_free_distance, cfg.evidence_no_return_range
         )
+        self._transient = TransientObstacles(cfg.transient_reach, cfg.transient_lifetime)
         self.reset()
 
     # --- state -------------------------------------------------------------------------------------------
@@ -157,6 +166,9 @@ class Explorer:
         self._view_of: Any = None
         self._view: Any = None
         self._evidence.reset()
+        self._transient.reset()
+        self._stamped_for: Any = None
+        self._stamped: Any = None
         self._traced_at: NDArray[np.float64] | None = None
         self._memory.reset()
         self._search.reset()
@@ -255,6 +267,9 @@ class Explorer:
                 ranges, laser, cfg.scan_filter_window, cfg.scan_filter_distance, cfg.scan_filter_range
             )
             ranges = self._memory.persistent(ranges, pose_array, laser)
+        if len(self._transient):
+            self._transient.forget_seen(float(t), pose_array, ranges, laser)
+            occupancy = self._stamped_view(occupancy)
         v, w = self._decide(float(t), pose_array, ranges, laser, occupancy)
         self._follower.remember(v, w)
         self._stuck = self._monitor.update(float(t), pose_array, v, self.robot.control_period, self._following)
@@ -268,6 +283,15 @@ class Explorer:
             self._view_of = occupancy
             self._view = self._evidence.view(occupancy)
         return self._view
+
+    def _stamped_view(self, occupancy: Any) -> Any:
+        """``occupancy`` with the transient obstacles marked, computed once per map object and set of
+        obstacles (so the costmaps cached per map object stay valid in between)."""
+        key = (id(occupancy), self._transient.version)
+        if self._stamped_for != key or self._stamped is None:
+            self._stamped_for = key
+            self._stamped = (occupancy, self._transient.stamp(occupancy))
+        return self._stamped[1]
 
     def _decide(
         self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: LaserGeometry, occupancy: Any
@@ -295,7 +319,7 @@ class Explorer:
         blocked_long = self._blocked_since is not None and t - self._blocked_since >= cfg.blocked_time
         bumped = self._stalls >= cfg.stall_steps and self._follower.has_path
         if self._stuck or blocked_long or bumped:
-            return self._start_recovery(t, pose, ranges, laser, occupancy)
+            return self._start_recovery(t, pose, ranges, laser, occupancy, blocked=blocked_long and not bumped)
         # 3. goal bookkeeping
         if self._goal is not None:
             dist = math.hypot(pose[0] - self._goal.xy[0], pose[1] - self._goal.xy[1])
@@ -353,14 +377,28 @@ class Explorer:
         self._follower.clear()
 
     def _start_recovery(
-        self, t: float, pose: NDArray[np.float64], ranges: ArrayLike, laser: LaserGeometry, occupancy: Any
+        self,
+        t: float,
+        pose: NDArray[np.float64],
+        ranges: ArrayLike,
+        laser: LaserGeometry,
+        occupancy: Any,
+        *,
+        blocked: bool = False,
     ) -> tuple[float, float]:
         self.stats.recoveries += 1
         self._stuck = False
         self._stalls = 0
         self._blocked_since = None
         self._monitor.reset()
-        if self._goal is not None:
+        unmapped = 0
+        if blocked and self.config.transient_reach > 0.0:
+            unmapped = self._transient.add(t, pose, ranges, laser, self.robot.radius, occupancy)
+        if unmapped:
+            # held by something the map does not show: plan around it; the goal is not at fault
+            self.stats.transient_obstacles += unmapped
+            self._want_plan = True
+        elif self._goal is not None:
             self._goal.recoveries += 1
             if self._goal.recoveries >= self.config.max_recoveries_per_goal:
                 self._give_up_goal()
@@ -417,6 +455,13 @@ class Explorer:
                     outcome = self._try(t, pose, occupancy, grid, whole, None)
         if outcome == "none":
             outcome = self._last_resorts(t, pose, occupancy, grid, whole)
+        if outcome in ("none", "lost") and len(self._transient):
+            # the obstacles the map does not show may be all that is in the way: plan without them
+            self._transient.reset()
+            self._goal = None
+            self._follower.clear()
+            self._want_plan = True
+            return
         if outcome == "none" and self._blacklist and self._resets_left > 0:
             self._resets_left -= 1
             self._blacklist.clear()

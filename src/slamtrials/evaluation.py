@@ -77,18 +77,15 @@ class _Source:
 
     trajectory: Trajectory
     path: Path
-    kind: str  # "tum", "carmen" or "run"
+    kind: str  # "tum", "carmen", "carmen-odom" or "run"
     label: str
+    line_name: str = ""  # CARMEN: the line type the poses came from (the laser kind read, or ODOM)
 
     def line_of(self, index: int) -> int | None:
         if self.kind == "tum":
             return _data_line(self.path, index)
-        if self.kind == "carmen":
-            from slamtrials.io.carmen_log import LASER_KINDS
-
-            return _data_line(self.path, index, lambda tokens: tokens[0] in LASER_KINDS)
-        if self.kind == "carmen-odom":
-            return _data_line(self.path, index, lambda tokens: tokens[0] == "ODOM")
+        if self.kind in ("carmen", "carmen-odom"):
+            return _data_line(self.path, index, lambda tokens: tokens[0] == self.line_name)
         return None
 
 
@@ -136,7 +133,8 @@ def _read_trajectory(path: Path, triple: PoseTriple, what: str) -> _Source:
         if what == "odometry" and len(log.odom):
             first = np.concatenate([[True], np.diff(log.odom.t) > 0])
             label = f"{path} (CARMEN, {int(first.sum())} ODOM lines)"
-            return _Source(Trajectory(t=log.odom.t[first], poses=log.odom.pose[first]), path, "carmen-odom", label)
+            trajectory = Trajectory(t=log.odom.t[first], poses=log.odom.pose[first])
+            return _Source(trajectory, path, "carmen-odom", label, "ODOM")
         pose_only = laser.pose_only
         if triple is PoseTriple.auto:
             triple = PoseTriple.second if pose_only else PoseTriple.first
@@ -153,7 +151,7 @@ def _read_trajectory(path: Path, triple: PoseTriple, what: str) -> _Source:
                     )
         poses = laser.pose if triple is PoseTriple.first else laser.odometry
         label = f"{path} (CARMEN, {len(laser)} {laser.kind} lines, {triple.value} pose triple)"
-        return _Source(Trajectory(t=laser.t, poses=poses), path, "carmen", label)
+        return _Source(Trajectory(t=laser.t, poses=poses), path, "carmen", label, laser.kind)
     from slamtrials.io.tum import read_tum
 
     trajectory = read_tum(path)

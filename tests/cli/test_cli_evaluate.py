@@ -289,5 +289,12 @@ def test_pose_indices_map_to_file_lines(tmp_path):
     source = _read_trajectory(clf, PoseTriple.second, "odometry")  # odometry: the ODOM lines, as the Freiburg program
     mapped = _with_lines(MetricError("pose 0 is bad", what="odometry", index=0), {"odometry": source}, None)
     assert (mapped.path, mapped.line) == (clf, 3) and "1 ODOM lines" in source.label
+    robot = "ROBOTLASER1 0 -0.5 1.0 1.0 30 0.01 0 2 1 1 0 0 0 0 0 0 0 0 0 0 0 0 {t} h 0\n"
+    mixed = tmp_path / "mixed.clf"  # the front laser in both formats: the ROBOTLASER1 lines are the poses
+    mixed.write_text(clf.read_text().replace("FLASER 2 1.0 1.0 0 0 0 0 0 0 10.1 h 0\n", "") + robot.format(t=10.0))
+    mixed.write_text(mixed.read_text() + "FLASER 2 1.0 1.0 0 0 0 0 0 0 10.1 h 0\n" + robot.format(t=10.1))
+    source = _read_trajectory(mixed, PoseTriple.first, "estimate")
+    mapped = _with_lines(MetricError("pose 1 is bad", what="estimate", index=1), {"estimate": source}, None)
+    assert (mapped.path, mapped.line) == (mixed, 6) and "2 ROBOTLASER1 lines" in source.label
     unknown = MetricError("no index")
     assert _with_lines(unknown, {}, None) is unknown

@@ -338,7 +338,7 @@ ROBOT = "ROBOTLASER1 0 -1.5 3.0 1.5 30 0.01 0 3 1 2 3 {m} 0 0 0 1 1 1 0 0 0 0 0 
         ("FLASER 1 1 1 2 inf 1.1 2.1 0.6 2.0 host 3.0\n", 1, "every FLASER line has a non-finite pose"),
         ("FLASER 1 1 1 2 0 1 2 0 2.0 host x\n", 1, "logger_timestamp) is not a number"),
         (_flaser(3, 1.0) + _flaser(4, 2.0), 2, "not on the angular grid of line 1"),
-        (_flaser(3, 1.0) + ROBOT.format(m=0, t=2.0), 2, "ROBOTLASER1 line in a log of FLASER lines"),
+        (ROBOT.format(m=0, t=1.0) + "FLASER 3 1 2\n", 2, "FLASER with num_readings 3 needs 14 fields"),
         (ROBOT.format(m=2, t=1.0), 1, "needs 29 fields, got 27"),
         (ROBOT.format(m="x", t=1.0), 1, "num_remissions"),
         (ROBOT.format(m=0, t=1.0).replace(" 30 ", " 0 "), 1, "maximum_range must be positive"),

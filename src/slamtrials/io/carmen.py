@@ -17,8 +17,10 @@ logger's timestamp the seconds since logging started. slamtrials reads and write
 ``PARAM name value [ipc_timestamp ipc_hostname logger_timestamp]``
     a configuration parameter.
 
-Other line types (``RLASER``, ``ROBOTLASER2``, ``RAWLASER1..4``, ``TRUEPOS``, ``SYNC``, ...) are skipped
-and counted. Ranges are written to the millimetre (CARMEN's ``%.3f``), other numbers to 6 decimals.
+A log holding both front-laser line types (CARMEN's logger can write the old FLASER line and the
+ROBOTLASER1 line of the same scans) is read as its ROBOTLASER1 lines; the FLASER lines are skipped and
+counted, with one warning (:mod:`slamtrials.io.carmen_read`). Other line types (``RLASER``,
+``ROBOTLASER2``, ``RAWLASER1..4``, ``TRUEPOS``, ``SYNC``, ...) are skipped and counted. Ranges are written to the millimetre (CARMEN's ``%.3f``), other numbers to 6 decimals.
 Logs may be gzip- or bzip2-compressed. What the reader tolerates in logs of the wild (pose-only
 ``FLASER 0`` lines, ``nan`` poses, timestamps going backwards, beam counts that change, a truncated last
 line, PARAM trailers) is listed in :mod:`slamtrials.io.carmen_read` and docs/real-datasets.md.

@@ -197,7 +197,8 @@ class CarmenLog:
         ``PARAM`` lines, name -> value as written (a later line overrides an earlier one).
     skipped:
         Line types read past without being interpreted (e.g. ``RLASER``, ``RAWLASER1``, ``TRUEPOS``,
-        ``SYNC``) -> number of such lines. Never written back.
+        ``SYNC``, and ``FLASER`` in a log that also holds ``ROBOTLASER1`` lines, which are read instead)
+        -> number of such lines. Never written back.
     tolerated:
         Oddities the reader tolerated -> number of lines (keys and meanings in
         :data:`slamtrials.io.carmen_read.TOLERATED`: lines with non-finite poses skipped, timestamps

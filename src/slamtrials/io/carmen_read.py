@@ -15,6 +15,18 @@ oddity is counted in :attr:`CarmenLog.tolerated` and logged once, as one warning
   readings (what evaluation needs);
 * PARAM lines with any trailing fields (a numeric PARAM is its value's first token).
 
+A log holding both FLASER and ROBOTLASER1 lines (CARMEN's logger can write the front laser in the old
+format and its ``robot_laser`` message of the same scans in the new one) is read as ONE stream, the
+ROBOTLASER1 lines (:data:`PREFERRED_KIND`): they carry the laser's geometry on every line, where FLASER
+lines leave it to PARAMs or to a guess from the beam count. The FLASER lines are still parsed (a broken
+one is a FormatError naming its line, as in a FLASER-only log), then skipped and counted in
+:attr:`CarmenLog.skipped`, and one warning line says how many of their timestamps match a ROBOTLASER1
+line within :data:`SAME_SCAN_TOLERANCE` (all of them: the same scans; fewer: two lasers, or lines
+missing from one stream; only the ROBOTLASER1 stream is read either way). CARMEN's own tools read both
+kinds as the same front laser (``playback`` publishes both as the robot's front-laser message;
+``vasco-tiny`` takes ``-f``/``-r`` to use only the FLASER or only the ROBOTLASER1 lines), and so do
+GMapping's log reader and the Freiburg metricEvaluator; reading both would give every scan twice.
+
 A line broken anywhere else is a FormatError naming the file and the line.
 """
 
@@ -34,6 +46,7 @@ from slamtrials.io.carmen_grid import common_grid
 from slamtrials.io.carmen_lines import (
     CONFIG,
     EXTRA,
+    STAMP_COLUMNS,
     LaserLine,
     param_number,
     parse_flaser,
@@ -51,6 +64,8 @@ __all__ = [
     "PARAM_RESOLUTION",
     "PARAM_MOUNT",
     "PARAM_RANGE_MIN",
+    "PREFERRED_KIND",
+    "SAME_SCAN_TOLERANCE",
     "TOLERATED",
 ]
 
@@ -66,6 +81,11 @@ PARAM_RESOLUTION = "laser_front_laser_resolution"
 PARAM_MOUNT = ("robot_frontlaser_offset", "robot_frontlaser_side_offset", "robot_frontlaser_angular_offset")
 #: Not a CARMEN parameter: the minimum range (m) of a laser simulated by slamtrials.
 PARAM_RANGE_MIN = "slamtrials_laser_range_min"
+
+#: The front-laser line type read from a log holding both: its geometry is on every line.
+PREFERRED_KIND = "ROBOTLASER1"
+#: Two laser lines of the two kinds whose ipc timestamps differ by at most this (s) are the same scan.
+SAME_SCAN_TOLERANCE = 1e-3
 
 #: Keys of :attr:`CarmenLog.tolerated` -> what the warning says about the lines counted ({kind}: the
 #: line type).
@@ -166,8 +186,12 @@ def _order(
 def read_carmen(path: str | Path, *, ranges: bool = True) -> CarmenLog:
     """Read the front laser (FLASER or ROBOTLASER1), ODOM and PARAM lines of a CARMEN log.
 
-    Other line types (``RLASER``, ``ROBOTLASER2``, ``RAWLASER1``, ``TRUEPOS``, ``SYNC``, ...) are
-    skipped and counted in :attr:`CarmenLog.skipped`; ``#`` lines and blank lines are ignored. What is
+    A log holding both FLASER and ROBOTLASER1 lines is read as one stream, its ROBOTLASER1 lines (exact
+    geometry on every line): the FLASER lines are parsed, then skipped, counted in
+    :attr:`CarmenLog.skipped` and reported in one warning line with how many of their timestamps match a
+    ROBOTLASER1 line (module docstring: why, and what CARMEN's own tools do). Other line types
+    (``RLASER``, ``ROBOTLASER2``, ``RAWLASER1``, ``TRUEPOS``, ``SYNC``, ...) are skipped unparsed and
+    counted in :attr:`CarmenLog.skipped`; ``#`` lines and blank lines are ignored. What is
     tolerated (and counted in :attr:`CarmenLog.tolerated`, and logged once per kind) is listed in the
     module docstring.
 
@@ -196,42 +220,34 @@ def read_carmen(path: str | Path, *, ranges: bool = True) -> CarmenLog:
     ------
     FormatError
         Naming the file and line: a wrong field count (``num_readings`` disagreeing with the fields), a
-        field that is not a number, a reading that is negative or not finite, FLASER and ROBOTLASER1
-        lines in one log, lines whose beams are not on one angular grid (with ``ranges``), a
-        non-positive ROBOTLASER1 maximum range, or no usable laser line at all.
+        field that is not a number (in the lines of both front-laser kinds, the skipped one too), a
+        reading that is negative or not finite, lines whose beams are not on one angular grid (with
+        ``ranges``), a non-positive ROBOTLASER1 maximum range, or no usable laser line at all.
     """
     path = Path(path)
     lines = read_lines(path)
     cut_short = bool(lines) and lines[-1].strip() != ""  # no newline after the last line
     final = last_line(lines)
     tally = _Tally(path)
-    laser_lines: list[LaserLine] = []
-    numbers: list[int] = []
-    hosts: list[str] = []
+    laser_lines: dict[str, list[LaserLine]] = {name: [] for name in LASER_KINDS}
+    laser_numbers: dict[str, list[int]] = {name: [] for name in LASER_KINDS}
+    laser_hosts: dict[str, list[str]] = {name: [] for name in LASER_KINDS}
     odom_rows: list[list[float]] = []
     odom_numbers: list[int] = []
     odom_hosts: list[str] = []
     params: dict[str, str] = {}
     param_lines: dict[str, int] = {}
     skipped: Counter[str] = Counter()
-    kind: str | None = None
     for number, tokens in data_lines(lines):
         name = tokens[0]
-        if name in LASER_KINDS and kind is not None and name != kind:
-            raise FormatError(
-                path,
-                f"{name} line in a log of {kind} lines (line {numbers[0]}); slamtrials reads one front laser",
-                line=number,
-            )
         try:
             if name in LASER_KINDS:
                 parsed = (
                     parse_flaser(path, number, tokens) if name == "FLASER" else parse_robotlaser(path, number, tokens)
                 )
-                kind = name
-                laser_lines.append(parsed)
-                numbers.append(number)
-                hosts.append(tokens[-2])
+                laser_lines[name].append(parsed)
+                laser_numbers[name].append(number)
+                laser_hosts[name].append(tokens[-2])
             elif name == "ODOM":
                 odom_rows.append(parse_odom(path, number, tokens))
                 odom_numbers.append(number)
@@ -248,14 +264,26 @@ def read_carmen(path: str | Path, *, ranges: bool = True) -> CarmenLog:
             tally.add("truncated_last_line", [number])
     for key in (*PARAM_MOUNT, PARAM_RANGE_MIN):
         param_number(path, params, param_lines, key, positive=False)
-    if kind is None:
+    present = [name for name in LASER_KINDS if laser_lines[name]]
+    if not present:
         rear = (
             f" ({skipped['RLASER']} RLASER lines: slamtrials reads the front laser, as the Freiburg evaluator does)"
             if skipped["RLASER"]
             else ""
         )
         raise FormatError(path, f"no FLASER or ROBOTLASER1 line: not a CARMEN log with a front laser{rear}", line=final)
-    laser = _laser(path, kind, laser_lines, numbers, hosts, params, param_lines, tally, ranges)
+    kind = PREFERRED_KIND if PREFERRED_KIND in present else present[0]
+    laser = _laser(
+        path,
+        kind,
+        laser_lines[kind],
+        laser_numbers[kind],
+        laser_hosts[kind],
+        params,
+        param_lines,
+        tally,
+        ranges,
+    )
     odom = _odometry(path, odom_rows, odom_numbers, odom_hosts, tally)
     tally.warn(
         kind,
@@ -264,7 +292,57 @@ def read_carmen(path: str | Path, *, ranges: bool = True) -> CarmenLog:
             "laser_range_raised": f" ({laser.range_max:g} m)",
         },
     )
+    for other in present:
+        if other != kind:
+            skipped[other] = len(laser_numbers[other])
+            _warn_other_stream(path, laser, laser_lines[kind], other, laser_lines[other], laser_numbers[other])
     return CarmenLog(laser=laser, odom=odom, params=params, skipped=dict(skipped), tolerated=dict(tally.counts))
+
+
+def _same_scans(t: NDArray[np.float64], other: NDArray[np.float64]) -> int:
+    """How many of the timestamps ``other`` are within :data:`SAME_SCAN_TOLERANCE` of one of ``t``."""
+    t = np.sort(t[np.isfinite(t)], kind="stable")
+    other = other[np.isfinite(other)]
+    if len(t) == 0 or len(other) == 0:
+        return 0
+    right = np.clip(np.searchsorted(t, other), 0, len(t) - 1)
+    left = np.clip(right - 1, 0, len(t) - 1)
+    gap = np.minimum(np.abs(t[right] - other), np.abs(t[left] - other))
+    return int(np.count_nonzero(gap <= SAME_SCAN_TOLERANCE))
+
+
+def _warn_other_stream(
+    path: Path, laser: CarmenLaser, read: list[LaserLine], other: str, parsed: list[LaserLine], numbers: list[int]
+) -> None:
+    """One warning: the lines ``parsed`` of the front-laser kind ``other`` were skipped, and whether they are
+    the same scans as the lines ``read`` (all of them, also those the reader then dropped: same timestamp)."""
+    stamp = STAMP_COLUMNS.index("ipc_timestamp")
+    matched = _same_scans(
+        np.array([line.stamps[stamp] for line in read]), np.array([line.stamps[stamp] for line in parsed])
+    )
+    total = len(parsed)
+    verdict = (
+        "the same scans"
+        if matched == total
+        else f"the two streams differ (two lasers, or lines missing from one): only the {laser.kind} lines are read"
+    )
+    log.warning(
+        "%s: %d %s lines skipped (first: line %d): the log also holds %s lines, the front laser in CARMEN's "
+        "new format with its geometry on every line, read instead (%d frames); %d of %d %s timestamps match "
+        "a %s line within %g ms: %s",
+        path,
+        total,
+        other,
+        numbers[0],
+        laser.kind,
+        len(laser),
+        matched,
+        total,
+        other,
+        laser.kind,
+        SAME_SCAN_TOLERANCE * 1e3,
+        verdict,
+    )
 
 
 def _one_or_all(hosts: list[str]) -> str | list[str]:

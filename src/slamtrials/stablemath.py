@@ -1,9 +1,9 @@
-"""Elementwise sin, cos, exp, arctan2 and hypot that give the same bits on every x86-64 machine.
+"""Elementwise sin, cos, exp, log, power, arctan2 and hypot that give the same bits on every x86-64 machine.
 
 A trial is chaotic: one last-bit difference in a heading moves every later scan, path and map, so
 "the same seed gives the same trial" holds across machines only if every number on the way is computed
 the same way everywhere. numpy does not promise that for its transcendental functions: where the CPU
-has AVX-512 it computes sin, cos, exp, arctan2 and others with its own SIMD code (Intel's SVML), whose
+has AVX-512 it computes sin, cos, exp, log, power, arctan2 and others with its own SIMD code (Intel's SVML), whose
 results differ from the C library's by up to 4 ulp (numpy issue #23523), and which code it takes
 depends on the machine a run lands on. numba's ``math`` functions call the C library's, and so do the
 numba kernels of the simulator, GMapping and the explorer. The computing layers therefore take these
@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["arctan2", "cos", "exp", "hypot", "sin"]
+__all__ = ["arctan2", "cos", "exp", "hypot", "log", "power", "sin"]
 
 
 @njit(cache=True, nogil=True)
@@ -47,6 +47,18 @@ def _cos(x, out):  # pragma: no cover - compiled
 def _exp(x, out):  # pragma: no cover - compiled
     for i in range(x.shape[0]):
         out[i] = math.exp(x[i])
+
+
+@njit(cache=True, nogil=True)
+def _log(x, out):  # pragma: no cover - compiled
+    for i in range(x.shape[0]):
+        out[i] = math.log(x[i])
+
+
+@njit(cache=True, nogil=True)
+def _power(x, y, out):  # pragma: no cover - compiled
+    for i in range(x.shape[0]):
+        out[i] = x[i] ** y[i]
 
 
 @njit(cache=True, nogil=True)
@@ -81,6 +93,16 @@ def _exp1(x):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True)
 def _arctan21(y, x):  # pragma: no cover - compiled
     return math.atan2(y, x)
+
+
+@njit(cache=True, nogil=True)
+def _log1(x):  # pragma: no cover - compiled
+    return math.log(x)
+
+
+@njit(cache=True, nogil=True)
+def _power1(x, y):  # pragma: no cover - compiled
+    return x**y
 
 
 @njit(cache=True, nogil=True)
@@ -141,6 +163,30 @@ def exp(x: ArrayLike) -> float | NDArray[np.float64]: ...
 def exp(x: ArrayLike) -> float | NDArray[np.float64]:
     """``e ** x``, elementwise, from the C library."""
     return _unary(_exp, _exp1, x)
+
+
+@overload
+def log(x: float) -> float: ...
+@overload
+def log(x: NDArray[Any]) -> NDArray[np.float64]: ...
+@overload
+def log(x: ArrayLike) -> float | NDArray[np.float64]: ...
+def log(x: ArrayLike) -> float | NDArray[np.float64]:
+    """Natural logarithm of ``x``, elementwise, from the C library (-inf at 0, nan below 0)."""
+    return _unary(_log, _log1, x)
+
+
+@overload
+def power(x: float, y: float) -> float: ...
+@overload
+def power(x: NDArray[Any], y: ArrayLike) -> NDArray[np.float64]: ...
+@overload
+def power(x: ArrayLike, y: NDArray[Any]) -> NDArray[np.float64]: ...
+@overload
+def power(x: ArrayLike, y: ArrayLike) -> float | NDArray[np.float64]: ...
+def power(x: ArrayLike, y: ArrayLike) -> float | NDArray[np.float64]:
+    """``x ** y``, elementwise, from the C library's ``pow``."""
+    return _binary(_power, _power1, x, y)
 
 
 @overload

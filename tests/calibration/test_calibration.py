@@ -22,6 +22,7 @@ LASER = {
     "range_noise_per_m": 0.01,
     "short_rate": 0.08,
     "short_run_beams": 3.0,
+    "short_position_power": 1.5,
     "dropout_rate": 0.02,
     "dropout_per_m": 0.004,
     "dropout_grazing": 0.1,
@@ -56,8 +57,11 @@ def fitted(simulated):
 def test_fit_recovers_each_known_value_within_its_stated_uncertainty(fitted, name):
     value = fitted.value(name)
     truth = {**LASER, **ODOMETRY}[name]
-    # the stated uncertainty is one bootstrap standard error; the 95 % interval is two
-    assert abs(value.value - truth) <= 2.0 * value.stderr, (value, truth)
+    # the stated uncertainty is one bootstrap standard error; the 95 % interval is two. The one known bias:
+    # short readings that stand within the noise's core at the wall (more of them the larger the position
+    # power) widen the core a little, which the fit cannot tell from noise (here +1.6 %; docs/realism.md)
+    bias = 0.025 * truth if name == "range_noise_std" else 0.0
+    assert abs(value.value - truth) <= 2.0 * value.stderr + bias, (value, truth)
     # and it is an uncertainty worth stating: well below the value itself
     assert 0.0 < value.stderr < 0.25 * abs(truth), value
 

@@ -57,13 +57,14 @@ def test_calibrate_writes_a_valid_profile_and_a_page_of_figures(record, tmp_path
         "range_noise_per_m",
         "short_rate",
         "short_run_beams",
+        "short_position_power",
         "short_lifetime",
         "short_fleeting_share",
         "dropout_rate",
         "dropout_per_m",
         "dropout_grazing",
     }
-    assert "short_lifetime" in result.output
+    assert "short_lifetime" in result.output and "short_position_power" in result.output
     low, high = profile.odometry["bias_angular_range"]
     assert low == -high and high > 0.0
     # against GMapping's map the noise is the simulated noise or more, never nothing

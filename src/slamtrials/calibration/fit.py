@@ -43,6 +43,7 @@ _UNITS = {
     "range_noise_per_m": "m/m",
     "short_rate": "",
     "short_run_beams": "beams",
+    "short_position_power": "",
     "dropout_rate": "",
     "dropout_per_m": "1/m",
     "dropout_grazing": "",

@@ -7,10 +7,15 @@ deviation within ``core_cut`` sigmas of the median); a weighted line through the
 ``n / sigma^2``, the inverse variance of a sigma estimated from ``n`` values, up to a factor) gives
 ``range_noise_std + range_noise_per_m r``, both non-negative.
 
-Short readings: a beam that returned more than ``short_sigmas`` sigmas short of the cast range. The model
-draws a short reading uniformly in ``[min_range, r)``, so it is seen as such with probability
-``(r - k sigma(r) - min_range) / (r - min_range)``; the rate is the count of short beams, less the
-Gaussian tail's expected count, over the sum of those probabilities over all kept beams. Their runs:
+Short readings: a beam that returned more than ``short_sigmas`` (``k``) sigmas short of the cast range
+moved by its bin's median residual (the wall ``w``). Where they stand: the model puts a short reading at
+``min_range + v (w - min_range)`` with ``v`` of density ``(a + 1) v^a`` (:mod:`slamtrials.sim.shortdistance`);
+``a = short_position_power`` is the maximum-likelihood fit to the short readings whose gap before the
+wall is at least ``g0 = max(k sigma(w), position_floor)``, each seen only up to ``t = 1 - g0 / (w -
+min_range)``, which has the closed form ``a + 1 = n / sum(ln(t_i / v_i))`` (clamped to [0, 50]; 0 with
+fewer than ``position_min_short`` readings). A reading is then seen short with probability ``(1 - k
+sigma(w) / (w - min_range))^(a + 1)``; the rate is the count of short beams, less the Gaussian tail's
+expected count, over the sum of those probabilities over all kept beams. Their runs:
 among pairs of neighbouring kept beams of one scan whose first is short, the share whose second is short
 too (counted only where the neighbour's wall is far enough behind the first one's reading for it to be
 seen short: a run is one object at one distance) is the chain's ``q``, and ``short_run_beams = 1 / (1 -
@@ -29,11 +34,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from slamtrials import stablemath
 from slamtrials.calibration.beams import BeamSample
 from slamtrials.calibration.settings import CalibrationSettings
 from slamtrials.calibration.stats import central_sigma, nonnegative_least_squares, robust_sigma
 
-__all__ = ["LaserFit", "LaserBins", "fit_laser", "LASER_VALUES"]
+__all__ = ["LaserFit", "LaserBins", "fit_laser", "position_power", "LASER_VALUES", "POSITION_POWER_BOUNDS"]
 
 #: The fitted laser values, in the order of the profile's fields.
 LASER_VALUES = (
@@ -41,6 +47,7 @@ LASER_VALUES = (
     "range_noise_per_m",
     "short_rate",
     "short_run_beams",
+    "short_position_power",
     "dropout_rate",
     "dropout_per_m",
     "dropout_grazing",
@@ -129,6 +136,35 @@ class LaserFit:
         return cast + offset - short_sigmas * sigma
 
 
+#: Bounds of the fitted position power: 0 is uniform along the beam; 50 puts nearly every thing at the wall.
+POSITION_POWER_BOUNDS = (0.0, 50.0)
+
+
+def position_power(
+    reading: NDArray[np.float64],
+    wall: NDArray[np.float64],
+    cut: NDArray[np.float64],
+    range_min: float,
+    floor: float,
+    min_short: int,
+) -> float:
+    """The maximum-likelihood ``short_position_power`` of short readings ``[N]`` (m) on beams whose walls are
+    at ``wall`` ``[N]`` (m), each counted short below ``wall - cut`` (``cut`` ``[N]``, m): only those at least
+    ``max(cut, floor)`` before the wall, their density truncated there (see the module docstring)."""
+    least = np.maximum(cut, floor)
+    span = wall - range_min
+    used = (wall - reading >= least) & (span > least) & (reading > range_min)
+    n = int(np.count_nonzero(used))
+    if n < min_short:
+        return 0.0
+    v = (reading[used] - range_min) / span[used]
+    top = 1.0 - least[used] / span[used]
+    spread = float(np.sum(stablemath.log(top) - stablemath.log(v)))
+    if spread <= 0.0:
+        return POSITION_POWER_BOUNDS[1]
+    return float(min(max(n / spread - 1.0, POSITION_POWER_BOUNDS[0]), POSITION_POWER_BOUNDS[1]))
+
+
 def _normal_tail(k: float) -> float:
     return 0.5 * math.erfc(k / math.sqrt(2.0))
 
@@ -165,6 +201,16 @@ def fit_laser(sample: BeamSample, settings: CalibrationSettings, range_min: floa
         return None
     second = _fit(sample, settings, range_min, back & ~_next_to(sample, first[1]))
     return None if second is None else second[0]
+
+
+def _run_starts(sample: BeamSample, short: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """``[N]``: short beams whose previous beam in the scan is kept and not short: where a run of short
+    readings starts, which reads the thing's distance as drawn (the run's later beams read the same
+    distance against other walls)."""
+    out = np.zeros(short.size, dtype=bool)
+    follows = (sample.frame[1:] == sample.frame[:-1]) & (sample.beam[1:] == sample.beam[:-1] + 1)
+    out[1:] = follows & short[1:] & ~short[:-1]
+    return out
 
 
 def _next_to(sample: BeamSample, marked: NDArray[np.bool_]) -> NDArray[np.bool_]:
@@ -209,7 +255,19 @@ def _fit(
     for row, b in enumerate(bin_index):
         offset[which == b] = centre[row]
     short = back & (e - offset < -k * beam_sigma)
-    seen = np.clip((r - k * beam_sigma - range_min) / np.maximum(r - range_min, 1e-9), 0.0, 1.0)
+    wall = r + offset
+    starts = _run_starts(sample, short)
+    power = position_power(
+        sample.reading[starts],
+        wall[starts],
+        k * beam_sigma[starts],
+        range_min,
+        settings.position_floor,
+        settings.position_min_short,
+    )
+    seen = stablemath.power(
+        np.clip((wall - k * beam_sigma - range_min) / np.maximum(wall - range_min, 1e-9), 0.0, 1.0), power + 1.0
+    )
     false_alarms = _normal_tail(k) * float(np.count_nonzero(back & ~short))
     short_rate = max(0.0, (float(np.count_nonzero(short)) - false_alarms) / max(float(np.sum(seen)), 1e-9))
     short_rate = min(short_rate, 0.999)
@@ -223,6 +281,7 @@ def _fit(
         "range_noise_per_m": b_,
         "short_rate": short_rate,
         "short_run_beams": run_beams,
+        "short_position_power": power,
         "dropout_rate": d0,
         "dropout_per_m": d1,
         "dropout_grazing": d2,

@@ -20,6 +20,12 @@ class CalibrationSettings(BaseModel):
         The Gaussian core of a bin's residuals is taken within this many sigmas of its median.
     short_sigmas:
         A reading shorter than the cast range by more than this many sigmas (of its bin) is a short reading.
+    position_floor:
+        Least gap before the wall (m) of the short readings whose position along the beam fits
+        ``short_position_power``; nearer the wall lie the reference map's own errors and what stands
+        against the walls, which the power would otherwise follow (docs/realism.md, "Calibration").
+    position_min_short:
+        Fewest such short readings to fit the power (uniform, 0, below).
     max_beams:
         Cap on the beams used (scans are thinned evenly to stay below it), for speed.
     laser_anchors_only:
@@ -73,6 +79,8 @@ class CalibrationSettings(BaseModel):
     min_bin_beams: int = Field(200, ge=20, description="fewest beams per range bin")
     core_cut: float = Field(2.5, gt=1.0, le=5.0, description="Gaussian core cut (sigmas)")
     short_sigmas: float = Field(3.0, gt=1.0, le=10.0, description="short-reading threshold (sigmas)")
+    position_floor: float = Field(0.5, ge=0.0, le=10.0, description="least gap of the position fit's readings (m)")
+    position_min_short: int = Field(100, ge=10, description="fewest short readings to fit the position power")
     max_beams: int = Field(600_000, ge=1000, description="cap on the beams used")
     laser_anchors_only: bool = Field(False, description="cast only the reference's update frames")
     windows: tuple[int, ...] = Field((1, 2, 4, 8, 16, 32), description="odometry window lengths (segments)")
@@ -83,7 +91,7 @@ class CalibrationSettings(BaseModel):
     sim_dt: float = Field(0.1, gt=0.0, le=1.0, description="simulator step the odometry noise is given for (s)")
     lifetime_lags: tuple[float, ...] = Field((0.2, 0.6, 1.0, 2.0, 4.0), description="persistence lags (s)")
     lifetime_grid: tuple[float, ...] = Field(
-        (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0), description="lifetimes replayed (s)"
+        (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0), description="lifetimes replayed (s)"
     )
     fleeting_grid: tuple[float, ...] = Field(
         (0.0, 0.2, 0.4, 0.6, 0.8, 0.9, 0.95), description="fleeting shares replayed"

@@ -61,11 +61,14 @@ def format_calibration(cal: Calibration, log: str) -> str:
         "range_noise_per_m",
         "short_rate",
         "short_run_beams",
+        "short_position_power",
         "dropout_rate",
         "dropout_per_m",
         "dropout_grazing",
     ):
         lines.append(row(name))
+        if name == "short_position_power":
+            lines[-1] += "  (where they stand: density (a + 1) v^a of the beam fraction v; 0 is uniform)"
     life = cal.lifetime
     if life is None:
         lines.append("  short_lifetime, short_fleeting_share: not fitted (too few short readings); 0 in the profile")

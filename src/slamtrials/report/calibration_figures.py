@@ -1,9 +1,11 @@
 """The page of figures of a calibration (``slamtrials calibrate``), drawn on a given matplotlib Figure.
 
-Seven panels and the fitted values: the laser residuals, real against the fitted model drawn for the same
-beams; the noise sigma by range bin with the fitted line; short readings and no-returns by range bin, real
-against fitted; how long short readings persist, real against the replayed model; the odometry's
-arc-length and heading errors by window length against the fitted growth.
+Seven panels and the fitted values: the laser residuals, real against the fitted model drawn for the
+same beams; the noise sigma by range bin with the fitted line; short readings and no-returns by range
+bin, real against fitted; how long short readings persist, real against the replayed model; the
+odometry's arc-length and heading errors by window length against the fitted growth; where short
+readings stand along their beams, real against fitted (every short beam, so also those nearer the wall
+than the position fit's floor and a run's later beams).
 """
 
 from __future__ import annotations
@@ -143,7 +145,25 @@ def draw_calibration_page(fig, calibration: Calibration, title: str = "") -> Non
     ax.set_title("odometry: heading error growth")
     ax.legend(fontsize=8)
 
-    axes[1, 3].axis("off")
+    ax = axes[1, 3]
+    cast = cal.no_return_range
+    real_short = back & (cal.residuals < cal.laser.short_below(cast, 3.0) - cast)
+    edges = np.linspace(0.0, 1.0, 21)
+    for short, residuals, color, label in (
+        (real_short, cal.residuals, "tab:blue", "real"),
+        (model_short, cal.model_residuals, "tab:orange", "fitted model"),
+    ):
+        if short.any():
+            fraction = np.clip((cast[short] + residuals[short]) / cast[short], 0.0, 1.0)
+            ax.hist(fraction, bins=edges, density=True, histtype="step", color=color, label=label)
+    power = values.get("short_position_power", 0.0)
+    v = np.linspace(0.0, 1.0, 101)
+    ax.plot(v, (power + 1.0) * v**power, ":", color="tab:gray", label=f"(a + 1) v^a, a = {power:.3g}")
+    ax.set_xlabel("short reading / cast range")
+    ax.set_ylabel("density")
+    ax.set_title("where short readings stand along the beam")
+    ax.legend(fontsize=8)
+
     ax = axes[1, 2]
     ax.axis("off")
     lines = [f"{v.name} = {v.value:.4g} +- {v.stderr:.2g} {v.unit}".rstrip() for v in cal.fitted]

@@ -37,8 +37,7 @@ LASER_ERROR_FIELDS = (
     "short_run_beams",
     "short_lifetime",
     "short_fleeting_share",
-    "short_wall_share",
-    "short_wall_gap",
+    "short_position_power",
     "dropout_rate",
     "dropout_per_m",
     "dropout_grazing",
@@ -174,11 +173,10 @@ class LaserConfig(BaseModel):
         by the next scan, like the readings of things that move); the others stay for ``short_lifetime``
         on average. 0 (the default): every run leaves a thing. Real logs have both kinds
         (:mod:`slamtrials.calibration.lifetime` fits the two values together).
-    short_wall_share, short_wall_gap:
-        Where a short reading's thing stands (:mod:`slamtrials.sim.shortdistance`): ``short_wall_share`` of
-        them a gap before the wall, exponential with mean ``short_wall_gap`` (m) and cut to the beam, the
-        others anywhere between ``min_range`` and the wall, uniformly. 0 (the default): all uniformly.
-        Real short readings crowd towards the walls.
+    short_position_power:
+        Where a short reading's thing stands (:mod:`slamtrials.sim.shortdistance`): its position as a
+        fraction ``v`` of the beam from ``min_range`` to the wall has density ``(a + 1) v^a``. 0 (the
+        default): anywhere, uniformly. Real short readings stand farther out (fits near 1).
     dropout_rate, dropout_per_m, dropout_grazing:
         Probability per beam of no return (the reading is ``max_range``):
         ``dropout_rate + dropout_per_m * range + dropout_grazing * (1 - |cos(incidence)|)``, capped at 1,
@@ -210,10 +208,9 @@ class LaserConfig(BaseModel):
     short_fleeting_share: float = Field(
         0.0, ge=0.0, lt=1.0, description="share of new short-reading runs that leave no thing (with short_lifetime)"
     )
-    short_wall_share: float = Field(
-        0.0, ge=0.0, lt=1.0, description="share of short readings' things that stand a gap before the wall"
+    short_position_power: float = Field(
+        0.0, ge=0.0, le=50.0, description="power a of the short readings' position density (a + 1) v^a along the beam"
     )
-    short_wall_gap: float = Field(0.0, ge=0.0, le=1000.0, description="mean gap (m) of those things before the wall")
     dropout_rate: float = Field(0.0, ge=0.0, le=1.0, description="probability per beam of no return")
     dropout_per_m: float = Field(
         0.0, ge=0.0, le=1.0, description="added probability of no return per metre of range (1/m)"
@@ -229,8 +226,7 @@ class LaserConfig(BaseModel):
             "short_run_beams",
             "short_lifetime",
             "short_fleeting_share",
-            "short_wall_share",
-            "short_wall_gap",
+            "short_position_power",
         )  # they shape the short readings, add none
         return any(getattr(self, name) > 0.0 for name in LASER_ERROR_FIELDS if name not in shape_only)
 

@@ -9,13 +9,13 @@ is hit), the reading of beam ``i`` is:
    incidence is the angle between the beam and the normal of the cell side it enters (walls are the
    sides of occupied cells, so the normal is along x or y);
 3. **short reading** (any beam): with probability ``short_rate`` something not in the map returns the
-   beam first; the reading is ``min_range + u (r - min_range)``, ``u`` uniform in [0, 1), and neither
-   noise nor dropout applies to it. With ``short_run_beams`` ``L >= 1`` the short beams come in runs
+   beam first; the reading is ``min_range + v (r - min_range)``, ``v = u^(1 / (a + 1))`` for ``u``
+   uniform in [0, 1) and ``a = short_position_power`` (0: ``v = u``, uniform along the beam;
+   :mod:`slamtrials.sim.shortdistance`), and neither noise nor dropout applies to it. With ``short_run_beams`` ``L >= 1`` the short beams come in runs
    (a Markov chain along the scan: short after a short beam with probability ``1 - 1 / L``, after
    another with :func:`~slamtrials.sim.config.short_start_chance`, the first beam with ``short_rate``);
-   a run is one object at the distance drawn for its first beam, ``d = min_range + u (r_first -
-   min_range)`` (or, for ``short_wall_share`` of them, a gap before the wall: :mod:`slamtrials.sim.shortdistance`),
-   and a beam of the run whose true range is not beyond ``d`` keeps its own reading;
+   a run is one object at the distance drawn for its first beam, ``d = min_range + v (r_first -
+   min_range)``, and a beam of the run whose true range is not beyond ``d`` keeps its own reading;
 
 4. **things that stay** (``short_lifetime > 0``): a run of short readings is a thing that stays where
    it was seen for a while, read again by later scans, unless it is one of the ``short_fleeting_share``
@@ -72,25 +72,23 @@ def _incidence(ox, oy, theta, angles, t, out):  # pragma: no cover - compiled
 
 
 @njit(cache=True, fastmath=False, nogil=True)
-def _short_runs(
-    whether, where, r, reading, rate, stay, start, min_range, wall_share, gap
-):  # pragma: no cover - compiled
+def _short_runs(whether, where, r, reading, rate, stay, start, min_range, power):  # pragma: no cover - compiled
     short = False
     distance = 0.0
     for b in range(r.shape[0]):
         chance = rate if b == 0 else (stay if short else start)
         now = whether[b] < chance
         if now and not short:
-            distance = short_distance(where[b], r[b], min_range, wall_share, gap)
+            distance = short_distance(where[b], r[b], min_range, power)
         short = now
         if short and distance < r[b]:
             reading[b] = distance
 
 
 @njit(cache=True, fastmath=False, nogil=True)
-def _short_distances(where, r, min_range, wall_share, gap, out):  # pragma: no cover - compiled
+def _short_distances(where, r, min_range, power, out):  # pragma: no cover - compiled
     for b in range(r.shape[0]):
-        out[b] = short_distance(where[b], r[b], min_range, wall_share, gap)
+        out[b] = short_distance(where[b], r[b], min_range, power)
 
 
 def incidence_cosines(
@@ -161,8 +159,7 @@ def apply_laser_errors(
             cfg.min_range,
             cfg.short_lifetime,
             cfg.short_fleeting_share,
-            cfg.short_wall_share,
-            cfg.short_wall_gap,
+            cfg.short_position_power,
         )
     elif cfg.short_rate > 0.0 and cfg.short_run_beams >= 1.0:
         whether = rng.random(count)
@@ -178,15 +175,14 @@ def apply_laser_errors(
             stay,
             short_start_chance(cfg),
             cfg.min_range,
-            cfg.short_wall_share,
-            cfg.short_wall_gap,
+            cfg.short_position_power,
         )
     elif cfg.short_rate > 0.0:
         short = rng.random(count) < cfg.short_rate
         where = rng.random(count)
-        if cfg.short_wall_share > 0.0:
+        if cfg.short_position_power > 0.0:
             distance = np.empty(count)
-            _short_distances(where, r, cfg.min_range, cfg.short_wall_share, cfg.short_wall_gap, distance)
+            _short_distances(where, r, cfg.min_range, cfg.short_position_power, distance)
         else:
             distance = cfg.min_range + where * np.maximum(r - cfg.min_range, 0.0)
         reading = np.where(short, distance, reading)

@@ -1,14 +1,13 @@
-"""Where a short reading's thing stands along its beam (``short_wall_share``, ``short_wall_gap``).
+"""Where a short reading's thing stands along its beam (``short_position_power``).
 
-Real short readings crowd towards the walls: on the shared logs fewer than 1 % lie in the tenth of the
-beam nearest the sensor and a third in the tenth nearest the wall (furniture, people and doors stand in
-rooms near their walls, and the map's own errors sit at the walls; docs/realism.md, "Assumptions"). The
-model: with probability ``short_wall_share`` the thing stands a gap ``g`` before the wall, exponential
-with mean ``short_wall_gap`` (m) and cut to the beam's length ``L = r - min_range``; otherwise it stands
-anywhere on the beam, uniformly (all of them with share 0, the default). Both take the one uniform ``u``
-the draw order gives a short reading's distance: ``u < share`` picks the wall with ``v = u / share`` and
-``g = -gap ln(1 - v (1 - exp(-L / gap)))`` (the cut exponential's inverse CDF), else ``v = (u - share) /
-(1 - share)`` and the distance ``min_range + v L`` (with share 0: ``v = u``, the uniform draw bit for bit).
+Real short readings stand farther along the beam than a uniform draw puts them: on the shared logs
+fewer than 1 % lie in the tenth of the beam nearest the sensor, and their gaps before the wall grow with
+the wall's range (docs/realism.md, "Assumptions"). The model: the thing's position as a fraction ``v``
+of the beam from ``min_range`` to the wall has density ``(a + 1) v^a`` on [0, 1], ``a =
+short_position_power``; 0 (the default) is uniform. ``v`` is drawn from the one uniform ``u`` the draw
+order gives a short reading's distance, by the inverse CDF ``v = u^(1 / (a + 1))``; with ``a = 0`` it is
+``u`` itself, so the uniform draw is the same bit for bit. The distance is ``min_range + v (r -
+min_range)``.
 """
 
 from __future__ import annotations
@@ -21,10 +20,9 @@ __all__ = ["short_distance"]
 
 
 @njit(cache=True, fastmath=False, nogil=True)
-def short_distance(u: float, r: float, min_range: float, share: float, gap: float) -> float:  # pragma: no cover
-    """The distance (m) of a short reading on a beam whose wall is at ``r`` (m), for a uniform ``u`` in [0, 1)."""
+def short_distance(u: float, r: float, min_range: float, power: float) -> float:  # pragma: no cover
+    """The distance (m) of a short reading on a beam whose wall is at ``r`` (m), for a uniform ``u`` in [0, 1)
+    and the position power ``power`` (>= 0)."""
     span = max(r - min_range, 0.0)
-    if u < share and gap > 0.0:
-        v = u / share
-        return max(r - (-gap * math.log(1.0 - v * (1.0 - math.exp(-span / gap)))), min_range)
-    return min_range + (u - share) / (1.0 - share) * span
+    v = u if power == 0.0 else math.pow(u, 1.0 / (power + 1.0))
+    return min_range + v * span

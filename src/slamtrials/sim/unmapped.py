@@ -92,8 +92,7 @@ def _new_runs(
     min_range,
     lifetime,
     fleeting,
-    wall_share,
-    gap,
+    power,
     t,
     ox,
     oy,
@@ -117,7 +116,7 @@ def _new_runs(
             chance = rate if (b == 0 or covered[b - 1]) and not short else (stay if short else start)
             now = whether[b] < chance
         if now and not short:
-            distance = short_distance(where[b], r[b], min_range, wall_share, gap)
+            distance = short_distance(where[b], r[b], min_range, power)
             first = b
         if short and not now and life[first] >= fleeting:  # the run first .. b - 1 ends: it leaves a thing
             a1 = heading + angles[first] - half
@@ -157,15 +156,14 @@ class UnmappedThings:
         min_range: float,
         lifetime: float,
         fleeting: float = 0.0,
-        wall_share: float = 0.0,
-        gap: float = 0.0,
+        position_power: float = 0.0,
     ) -> NDArray[np.float64]:
         """The readings float64 ``[B]`` (m) with the things alive at ``scan.t`` and the new ones of this scan.
 
         ``true_ranges`` ``[B]`` the cast ranges (m), ``reading`` ``[B]`` the readings after noise and dropout
         (not changed), ``whether``, ``where``, ``life`` ``[B]`` uniforms in [0, 1); ``fleeting`` the share of new
-        runs that leave no thing; ``wall_share`` of the new things stand a gap of mean ``gap`` (m) before the
-        wall, the others anywhere on the beam.
+        runs that leave no thing; ``position_power`` where the new things stand along their beams
+        (:mod:`slamtrials.sim.shortdistance`).
         """
         alive = self.deaths > scan.t
         self.segments, self.deaths = self.segments[alive], self.deaths[alive]
@@ -198,8 +196,7 @@ class UnmappedThings:
             min_range,
             lifetime,
             fleeting,
-            wall_share,
-            gap,
+            position_power,
             float(scan.t),
             ox,
             oy,

@@ -161,7 +161,7 @@ def draw_calibration_page(fig, calibration: Calibration, title: str = "") -> Non
     ax.plot(v, (power + 1.0) * v**power, ":", color="tab:gray", label=f"(a + 1) v^a, a = {power:.3g}")
     ax.set_xlabel("short reading / cast range")
     ax.set_ylabel("density")
-    ax.set_title("where short readings stand along the beam")
+    ax.set_title("short readings along the beam")
     ax.legend(fontsize=8)
 
     ax = axes[1, 2]

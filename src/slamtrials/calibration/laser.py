@@ -10,9 +10,10 @@ deviation within ``core_cut`` sigmas of the median); a weighted line through the
 Short readings: a beam that returned more than ``short_sigmas`` (``k``) sigmas short of the cast range
 moved by its bin's median residual (the wall ``w``). Where they stand: the model puts a short reading at
 ``min_range + v (w - min_range)`` with ``v`` of density ``(a + 1) v^a`` (:mod:`slamtrials.sim.shortdistance`);
-``a = short_position_power`` is the maximum-likelihood fit to the short readings whose gap before the
-wall is at least ``g0 = max(k sigma(w), position_floor)``, each seen only up to ``t = 1 - g0 / (w -
-min_range)``, which has the closed form ``a + 1 = n / sum(ln(t_i / v_i))`` (clamped to [0, 50]; 0 with
+``a = short_position_power`` is the maximum-likelihood fit to the short readings that start a run (the
+beam before them in the scan is kept and not short: the run's later beams read the same distance against
+other walls) and stand at least ``g0 = max(k sigma(w), position_floor)`` before the wall, each seen only
+up to ``t = 1 - g0 / (w - min_range)``, which has the closed form ``a + 1 = n / sum(ln(t_i / v_i))`` (clamped to [0, 50]; 0 with
 fewer than ``position_min_short`` readings). A reading is then seen short with probability ``(1 - k
 sigma(w) / (w - min_range))^(a + 1)``; the rate is the count of short beams, less the Gaussian tail's
 expected count, over the sum of those probabilities over all kept beams. Their runs:

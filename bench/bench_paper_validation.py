@@ -225,11 +225,13 @@ def load_config(path: Path, profile: str | None, overrides: tuple[tuple[str, obj
         One line naming the file and the field (e.g. a ``sim.profile`` this version does not know).
     """
     from slamtrials.campaign.config import CampaignConfig
+    from slamtrials.campaign.profilefile import inline_profile_file
     from slamtrials.io.yamlfile import read_yaml_mapping
 
     data = read_yaml_mapping(path)
     if profile is not None:
         _set(data, "sim.profile", profile)
+        data = inline_profile_file(data, Path.cwd())  # a profile file named on the command line
     for dotted, value in overrides:
         _set(data, dotted, value)
     return CampaignConfig.from_dict(data, source=str(path))

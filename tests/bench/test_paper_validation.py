@@ -81,6 +81,15 @@ def test_profile_option_sets_sim_profile_and_the_configs_keep_their_bias_ranges(
         bench.load_config(HALL, "no_such_profile")
 
 
+def test_profile_option_reads_a_profile_file(tmp_path):
+    from slamtrials.campaign.profilefile import write_profile
+    from slamtrials.sim.profiles import ErrorProfile
+
+    path = write_profile(tmp_path / "fitted.yaml", ErrorProfile(name="fitted", laser={"short_rate": 0.1}, odometry={}))
+    sim = bench.load_config(HALL, str(path)).sim
+    assert sim.profile_name == "fitted" and sim.laser.short_rate == 0.1 and sim.laser.num_beams == 81
+
+
 def _row(world, seed, eps_t, eps_r, profile="(config)", **extra):
     row = {
         "config": "c.yaml",

@@ -20,7 +20,9 @@ from slamtrials.worlds import load_world
 LASER = {
     "range_noise_std": 0.02,
     "range_noise_per_m": 0.01,
-    "short_rate": 0.08,
+    "short_rate": 0.2,
+    "short_range_scale": 2.5,
+    "short_range_shape": 1.5,
     "short_run_beams": 3.0,
     "short_position_power": 1.5,
     "dropout_rate": 0.02,
@@ -59,8 +61,9 @@ def test_fit_recovers_each_known_value_within_its_stated_uncertainty(fitted, nam
     truth = {**LASER, **ODOMETRY}[name]
     # the stated uncertainty is one bootstrap standard error; the 95 % interval is two. The one known bias:
     # short readings that stand within the noise's core at the wall (more of them the larger the position
-    # power) widen the core a little, which the fit cannot tell from noise (here +1.6 %; docs/realism.md)
-    bias = 0.025 * truth if name == "range_noise_std" else 0.0
+    # power, and on the long beams, where most of them are) widen the core a little, which the fit cannot
+    # tell from noise (here +1 to +2.5 %; docs/realism.md)
+    bias = 0.025 * truth if name in ("range_noise_std", "range_noise_per_m") else 0.0
     assert abs(value.value - truth) <= 2.0 * value.stderr + bias, (value, truth)
     # and it is an uncertainty worth stating: well below the value itself
     assert 0.0 < value.stderr < 0.25 * abs(truth), value

@@ -58,6 +58,8 @@ def test_calibrate_writes_a_valid_profile_and_a_page_of_figures(record, tmp_path
         "short_rate",
         "short_run_beams",
         "short_position_power",
+        "short_range_scale",
+        "short_range_shape",
         "short_lifetime",
         "short_fleeting_share",
         "dropout_rate",

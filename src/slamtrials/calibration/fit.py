@@ -44,6 +44,8 @@ _UNITS = {
     "short_rate": "",
     "short_run_beams": "beams",
     "short_position_power": "",
+    "short_range_scale": "m",
+    "short_range_shape": "",
     "dropout_rate": "",
     "dropout_per_m": "1/m",
     "dropout_grazing": "",

@@ -15,16 +15,18 @@ beam before them in the scan is kept and not short: the run's later beams read t
 other walls) and stand at least ``g0 = max(k sigma(w), position_floor)`` before the wall, each seen only
 up to ``t = 1 - g0 / (w - min_range)``, which has the closed form ``a + 1 = n / sum(ln(t_i / v_i))`` (clamped to [0, 50]; 0 with
 fewer than ``position_min_short`` readings). A reading is then seen short with probability ``(1 - k
-sigma(w) / (w - min_range))^(a + 1)``; the rate is the count of short beams, less the Gaussian tail's
-expected count, over the sum of those probabilities over all kept beams. Their runs:
+sigma(w) / (w - min_range))^(a + 1)``; with it, the chance of a short reading by the wall's range
+(``short_rate``, and ``short_range_scale`` and ``short_range_shape`` when it rises with the range) is
+the maximum-likelihood fit of :mod:`slamtrials.calibration.shortchance`, the Gaussian tail's false
+alarms counted in. Their runs:
 among pairs of neighbouring kept beams of one scan whose first is short, the share whose second is short
 too (counted only where the neighbour's wall is far enough behind the first one's reading for it to be
 seen short: a run is one object at one distance) is the chain's ``q``, and ``short_run_beams = 1 / (1 -
 q)`` (the mean run; independent beams give ``1 / (1 - short_rate)``, about 1.1).
 
 Dropouts: the share of kept beams that returned nothing, fitted per beam by non-negative least squares
-as ``(1 - short_rate) (dropout_rate + dropout_per_m r + dropout_grazing (1 - |cos i|))`` (a short
-reading replaces a dropout in the model).
+as ``(1 - p(r)) (dropout_rate + dropout_per_m r + dropout_grazing (1 - |cos i|))``, ``p(r)`` the beam's
+chance of a short reading (a short reading replaces a dropout in the model).
 """
 
 from __future__ import annotations
@@ -38,6 +40,7 @@ from numpy.typing import NDArray
 from slamtrials import stablemath
 from slamtrials.calibration.beams import BeamSample
 from slamtrials.calibration.settings import CalibrationSettings
+from slamtrials.calibration.shortchance import fit_short_chance
 from slamtrials.calibration.stats import central_sigma, nonnegative_least_squares, robust_sigma
 
 __all__ = ["LaserFit", "LaserBins", "fit_laser", "position_power", "LASER_VALUES", "POSITION_POWER_BOUNDS"]
@@ -49,6 +52,8 @@ LASER_VALUES = (
     "short_rate",
     "short_run_beams",
     "short_position_power",
+    "short_range_scale",
+    "short_range_shape",
     "dropout_rate",
     "dropout_per_m",
     "dropout_grazing",
@@ -270,19 +275,21 @@ def _fit(
         np.clip((wall - k * beam_sigma - range_min) / np.maximum(wall - range_min, 1e-9), 0.0, 1.0), power + 1.0
     )
     false_alarms = _normal_tail(k) * float(np.count_nonzero(back & ~short))
-    short_rate = max(0.0, (float(np.count_nonzero(short)) - false_alarms) / max(float(np.sum(seen)), 1e-9))
-    short_rate = min(short_rate, 0.999)
+    chance = fit_short_chance(wall, short, seen, _normal_tail(k))
+    chances = chance.at(wall)
     false_share = min(false_alarms / max(float(np.count_nonzero(short)), 1.0), 1.0)
-    run_beams = _mean_run(sample, short, r + offset - k * beam_sigma, false_share, short_rate)
-    y = sample.no_return.astype(np.float64) / (1.0 - short_rate)
+    run_beams = _mean_run(sample, short, r + offset - k * beam_sigma, false_share, float(np.mean(chances)))
+    y = sample.no_return.astype(np.float64) / (1.0 - chances)
     columns = [np.ones_like(r), r, 1.0 - sample.incidence]
     d0, d1, d2 = nonnegative_least_squares(columns, y)
     values = {
         "range_noise_std": a,
         "range_noise_per_m": b_,
-        "short_rate": short_rate,
+        "short_rate": chance.rate,
         "short_run_beams": run_beams,
         "short_position_power": power,
+        "short_range_scale": chance.scale,
+        "short_range_shape": chance.shape,
         "dropout_rate": d0,
         "dropout_per_m": d1,
         "dropout_grazing": d2,

@@ -152,11 +152,10 @@ class _Counts:
 def model_laser_values(fit: LaserFit) -> dict[str, float]:
     """The laser values the simulator is given for ``fit`` (as :meth:`Calibration.profile` writes them):
     rates capped at 1, a run shorter than one beam taken as none (independent beams), the position power
-    as fitted."""
-    values = {
-        k: float(min(v, 1.0)) for k, v in fit.values.items() if k not in ("short_run_beams", "short_position_power")
-    }
-    values["short_position_power"] = float(fit.values["short_position_power"])
+    and the rise of the short-reading chance with the range as fitted."""
+    as_fitted = ("short_position_power", "short_range_scale", "short_range_shape")
+    values = {k: float(min(v, 1.0)) for k, v in fit.values.items() if k not in ("short_run_beams", *as_fitted)}
+    values.update({k: float(fit.values[k]) for k in as_fitted})
     run = fit.values["short_run_beams"]
     values["short_run_beams"] = float(run) if run >= 1.0 and values["short_rate"] > 0.0 else 0.0
     return values

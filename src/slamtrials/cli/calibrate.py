@@ -60,6 +60,8 @@ def format_calibration(cal: Calibration, log: str) -> str:
         "range_noise_std",
         "range_noise_per_m",
         "short_rate",
+        "short_range_scale",
+        "short_range_shape",
         "short_run_beams",
         "short_position_power",
         "dropout_rate",
@@ -67,6 +69,8 @@ def format_calibration(cal: Calibration, log: str) -> str:
         "dropout_grazing",
     ):
         lines.append(row(name))
+        if name == "short_range_scale":
+            lines[-1] += "  (the chance rises to short_rate as 1 - exp(-(r / scale)^shape); 0: constant)"
         if name == "short_position_power":
             lines[-1] += "  (where they stand: density (a + 1) v^a of the beam fraction v; 0 is uniform)"
     life = cal.lifetime

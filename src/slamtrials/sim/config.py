@@ -38,6 +38,8 @@ LASER_ERROR_FIELDS = (
     "short_lifetime",
     "short_fleeting_share",
     "short_position_power",
+    "short_range_scale",
+    "short_range_shape",
     "dropout_rate",
     "dropout_per_m",
     "dropout_grazing",
@@ -45,13 +47,23 @@ LASER_ERROR_FIELDS = (
 
 
 def short_start_chance(config: LaserConfig) -> float:
-    """Probability that a beam reads short after one that did not, in runs of ``short_run_beams``.
-
-    The chain along the scan stays short with ``q = 1 - 1 / L`` and starts a run with ``s``; its share of
-    short beams is ``s / (s + 1 - q)``, which is ``short_rate = p`` for ``s = p (1 - q) / (1 - p)``.
-    """
+    """Probability that a beam reads short after one that did not, in runs of ``short_run_beams``, for the
+    largest rate, ``short_rate`` (see :func:`start_chances`)."""
     p, length = config.short_rate, config.short_run_beams
     return p / (length * (1.0 - p)) if p < 1.0 else math.inf
+
+
+def start_chances(rates: NDArray[np.float64], run_beams: float) -> NDArray[np.float64]:
+    """float64 ``[B]``: each beam's probability of starting a run of ``run_beams`` short readings after one
+    that did not read short, for its probability ``rates`` ``[B]`` of reading short.
+
+    The chain along the scan stays short with ``q = 1 - 1 / L`` and starts a run with ``s``; its share of
+    short beams is ``s / (s + 1 - q)``, which is ``p`` for ``s = p (1 - q) / (1 - p)``.
+    """
+    out = np.full(rates.shape, math.inf)
+    below = rates < 1.0
+    out[below] = rates[below] / (run_beams * (1.0 - rates[below]))
+    return out
 
 
 #: The odometry's error-model fields: what an error profile sets.
@@ -173,6 +185,10 @@ class LaserConfig(BaseModel):
         by the next scan, like the readings of things that move); the others stay for ``short_lifetime``
         on average. 0 (the default): every run leaves a thing. Real logs have both kinds
         (:mod:`slamtrials.calibration.lifetime` fits the two values together).
+    short_range_scale, short_range_shape:
+        How the chance of a short reading grows with the range ``r`` of the beam's wall
+        (:mod:`slamtrials.sim.shortrate`): ``short_rate (1 - exp(-(r / scale)^shape))``. Scale 0 (the
+        default): ``short_rate`` on every beam. Real logs: a scale of about 4.5 m and a shape of 1.4 to 1.5.
     short_position_power:
         Where a short reading's thing stands (:mod:`slamtrials.sim.shortdistance`): its position as a
         fraction ``v`` of the beam from ``min_range`` to the wall has density ``(a + 1) v^a``. 0 (the
@@ -211,6 +227,12 @@ class LaserConfig(BaseModel):
     short_position_power: float = Field(
         0.0, ge=0.0, le=50.0, description="power a of the short readings' position density (a + 1) v^a along the beam"
     )
+    short_range_scale: float = Field(
+        0.0, ge=0.0, le=1000.0, description="range (m) over which the short-reading chance rises; 0: constant"
+    )
+    short_range_shape: float = Field(
+        1.0, gt=0.0, le=20.0, description="shape of that rise (1 - exp(-(r / scale)^shape))"
+    )
     dropout_rate: float = Field(0.0, ge=0.0, le=1.0, description="probability per beam of no return")
     dropout_per_m: float = Field(
         0.0, ge=0.0, le=1.0, description="added probability of no return per metre of range (1/m)"
@@ -227,6 +249,8 @@ class LaserConfig(BaseModel):
             "short_lifetime",
             "short_fleeting_share",
             "short_position_power",
+            "short_range_scale",
+            "short_range_shape",
         )  # they shape the short readings, add none
         return any(getattr(self, name) > 0.0 for name in LASER_ERROR_FIELDS if name not in shape_only)
 
@@ -397,8 +421,10 @@ class ErrorProfile(BaseModel):
         return {name: getattr(checked, name) for name in sorted(values)}
 
     def laser_values(self) -> dict[str, float]:
-        """Every laser error field's value (0 where the profile gives none)."""
-        return {name: float(self.laser.get(name, 0.0)) for name in LASER_ERROR_FIELDS}
+        """Every laser error field's value (the laser config's default where the profile gives none: 0 for
+        every rate)."""
+        defaults = LaserConfig()
+        return {name: float(self.laser.get(name, getattr(defaults, name))) for name in LASER_ERROR_FIELDS}
 
     def odometry_values(self) -> dict[str, Any]:
         """Every odometry error field's value (the odometry config's default where the profile gives none)."""

@@ -8,12 +8,13 @@ is hit), the reading of beam ``i`` is:
    ``dropout_rate + dropout_per_m r + dropout_grazing (1 - |cos incidence|)``, capped at 1; the
    incidence is the angle between the beam and the normal of the cell side it enters (walls are the
    sides of occupied cells, so the normal is along x or y);
-3. **short reading** (any beam): with probability ``short_rate`` something not in the map returns the
-   beam first; the reading is ``min_range + v (r - min_range)``, ``v = u^(1 / (a + 1))`` for ``u``
+3. **short reading** (any beam): with probability ``short_rate`` (or, with ``short_range_scale > 0``, a
+   probability that rises to it with the beam's range: :mod:`slamtrials.sim.shortrate`) something not
+   in the map returns the beam first; the reading is ``min_range + v (r - min_range)``, ``v = u^(1 / (a + 1))`` for ``u``
    uniform in [0, 1) and ``a = short_position_power`` (0: ``v = u``, uniform along the beam;
    :mod:`slamtrials.sim.shortdistance`), and neither noise nor dropout applies to it. With ``short_run_beams`` ``L >= 1`` the short beams come in runs
    (a Markov chain along the scan: short after a short beam with probability ``1 - 1 / L``, after
-   another with :func:`~slamtrials.sim.config.short_start_chance`, the first beam with ``short_rate``);
+   another with :func:`~slamtrials.sim.config.start_chances`, the first beam with its own chance);
    a run is one object at the distance drawn for its first beam, ``d = min_range + v (r_first -
    min_range)``, and a beam of the run whose true range is not beyond ``d`` keeps its own reading;
 
@@ -37,8 +38,9 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
-from slamtrials.sim.config import LaserConfig, short_start_chance
+from slamtrials.sim.config import LaserConfig, start_chances
 from slamtrials.sim.shortdistance import short_distance
+from slamtrials.sim.shortrate import short_chances
 from slamtrials.sim.unmapped import UnmappedScan
 
 __all__ = ["apply_laser_errors", "incidence_cosines"]
@@ -76,7 +78,7 @@ def _short_runs(whether, where, r, reading, rate, stay, start, min_range, power)
     short = False
     distance = 0.0
     for b in range(r.shape[0]):
-        chance = rate if b == 0 else (stay if short else start)
+        chance = rate[b] if b == 0 else (stay if short else start[b])
         now = whether[b] < chance
         if now and not short:
             distance = short_distance(where[b], r[b], min_range, power)
@@ -143,6 +145,8 @@ def apply_laser_errors(
             chance = chance + cfg.dropout_grazing * (1.0 - incidence)
         dropped = hit & (rng.random(count) < chance)
         reading = np.where(dropped, cfg.max_range, reading)
+    if cfg.short_rate > 0.0:
+        rates = short_chances(r, cfg.short_rate, cfg.short_range_scale, cfg.short_range_shape)
     if cfg.short_rate > 0.0 and cfg.short_lifetime > 0.0:
         if unmapped is None:
             raise ValueError("short_lifetime needs the scan's pose and time (an UnmappedScan)")
@@ -154,7 +158,7 @@ def apply_laser_errors(
             draws[0],
             draws[1],
             draws[2],
-            cfg.short_rate,
+            rates,
             cfg.short_run_beams,
             cfg.min_range,
             cfg.short_lifetime,
@@ -171,14 +175,14 @@ def apply_laser_errors(
             where,
             r,
             reading,
-            cfg.short_rate,
+            rates,
             stay,
-            short_start_chance(cfg),
+            start_chances(rates, cfg.short_run_beams),
             cfg.min_range,
             cfg.short_position_power,
         )
     elif cfg.short_rate > 0.0:
-        short = rng.random(count) < cfg.short_rate
+        short = rng.random(count) < rates
         where = rng.random(count)
         if cfg.short_position_power > 0.0:
             distance = np.empty(count)

@@ -14,9 +14,10 @@ run is one of the ``short_fleeting_share`` that leave nothing (things that move 
 scan casts its beams against the things still alive; a beam that meets one before its wall (and not
 within ``min_range``) reads the distance to it, with neither noise nor dropout (as a short reading).
 New runs are then drawn along the scan as before on the beams no thing covers, at the rate that makes
-``short_rate`` of the beams read short on average whatever the covered share (``(short_rate -
-covered) / (1 - covered)``, at least 0), so ``short_rate`` keeps its meaning and the calibration's
-value. Things never stop the robot (they are in the laser's world only).
+each beam read short with its chance (``short_rate``, or the chance by range of
+:mod:`slamtrials.sim.shortrate`) on average whatever the covered share (``(chance - covered) / (1 -
+covered)``, at least 0, the covered share counted among beams of about the same chance: :func:`_fresh_rates`),
+so ``short_rate`` keeps its meaning and the calibration's value. Things never stop the robot (they are in the laser's world only).
 
 Draws: as without lifetime, then ``B`` more uniforms per scan (each beam's lifetime, used only by the
 first beam of a new run), whatever the beams hit. The one uniform ``u`` of a run decides both: below
@@ -33,6 +34,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
+from slamtrials.sim.config import start_chances
 from slamtrials.sim.shortdistance import short_distance
 
 __all__ = ["UnmappedThings", "UnmappedScan"]
@@ -113,7 +115,7 @@ def _new_runs(
     for b in range(beams + 1):
         now = False
         if b < beams and not covered[b]:
-            chance = rate if (b == 0 or covered[b - 1]) and not short else (stay if short else start)
+            chance = rate[b] if (b == 0 or covered[b - 1]) and not short else (stay[b] if short else start[b])
             now = whether[b] < chance
         if now and not short:
             distance = short_distance(where[b], r[b], min_range, power)
@@ -131,6 +133,35 @@ def _new_runs(
         if short and distance < r[b]:
             reading[b] = distance
     return segments[:count].copy(), deaths[:count].copy()
+
+
+#: Classes of beams by their chance of reading short, within which the covered share is counted.
+CHANCE_CLASSES = 8
+
+
+def _fresh_rates(chances: NDArray[np.float64], covered: NDArray[np.bool_]) -> NDArray[np.float64]:
+    """float64 ``[B]``: the chance of a new short reading on a beam no thing covers, such that each beam reads
+    short with its ``chances`` ``[B]`` on average, given which beams things cover (``covered`` ``[B]``).
+
+    With one chance ``p`` for every beam it is ``(p - c) / (1 - c)`` (at least 0), ``c`` the covered share
+    of the scan. When the chance varies with the range, things stand where beams are likely to read short
+    (far walls), so ``c`` is counted among beams of about the same chance: in :data:`CHANCE_CLASSES`
+    classes of equal width from 0 to the largest chance.
+    """
+    share = float(np.count_nonzero(covered)) / max(chances.shape[0], 1)
+    if chances.size == 0 or bool(np.all(chances == chances[0])):
+        if share >= 1.0:
+            return np.zeros_like(chances)
+        return np.maximum(0.0, (chances - share) / (1.0 - share))
+    top = float(np.max(chances))
+    classes = np.minimum((chances * (CHANCE_CLASSES / top)).astype(np.int64), CHANCE_CLASSES - 1)
+    beams = np.bincount(classes, minlength=CHANCE_CLASSES).astype(np.float64)
+    hit = np.bincount(classes, weights=covered.astype(np.float64), minlength=CHANCE_CLASSES)
+    cover = (hit / np.maximum(beams, 1.0))[classes]
+    out = np.zeros_like(chances)
+    open_ = cover < 1.0
+    out[open_] = np.maximum(0.0, (chances[open_] - cover[open_]) / (1.0 - cover[open_]))
+    return out
 
 
 class UnmappedThings:
@@ -151,7 +182,7 @@ class UnmappedThings:
         whether: NDArray[np.float64],
         where: NDArray[np.float64],
         life: NDArray[np.float64],
-        short_rate: float,
+        short_rates: NDArray[np.float64],
         run_beams: float,
         min_range: float,
         lifetime: float,
@@ -161,8 +192,9 @@ class UnmappedThings:
         """The readings float64 ``[B]`` (m) with the things alive at ``scan.t`` and the new ones of this scan.
 
         ``true_ranges`` ``[B]`` the cast ranges (m), ``reading`` ``[B]`` the readings after noise and dropout
-        (not changed), ``whether``, ``where``, ``life`` ``[B]`` uniforms in [0, 1); ``fleeting`` the share of new
-        runs that leave no thing; ``position_power`` where the new things stand along their beams
+        (not changed), ``whether``, ``where``, ``life`` ``[B]`` uniforms in [0, 1); ``short_rates`` ``[B]`` each
+        beam's chance of reading short (:mod:`slamtrials.sim.shortrate`); ``fleeting`` the share of new runs
+        that leave no thing; ``position_power`` where the new things stand along their beams
         (:mod:`slamtrials.sim.shortdistance`).
         """
         alive = self.deaths > scan.t
@@ -175,12 +207,11 @@ class UnmappedThings:
         )
         covered = at_thing < np.inf
         out = np.where(covered, at_thing, reading)
-        share = float(np.count_nonzero(covered)) / max(angles.shape[0], 1)
-        rate = max(0.0, (short_rate - share) / (1.0 - share)) if share < 1.0 else 0.0
+        rate = _fresh_rates(short_rates, covered)
         if run_beams >= 1.0:
-            rate = min(rate, run_beams / (run_beams + 1.0))  # the most a chain of such runs can make short
-            stay = 1.0 - 1.0 / run_beams
-            start = rate / (run_beams * (1.0 - rate)) if rate < 1.0 else math.inf
+            rate = np.minimum(rate, run_beams / (run_beams + 1.0))  # the most a chain of such runs can make short
+            stay = np.full(rate.shape, 1.0 - 1.0 / run_beams)
+            start = start_chances(rate, run_beams)
         else:
             stay = start = rate
         segments, deaths = _new_runs(

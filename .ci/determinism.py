@@ -11,9 +11,12 @@
 
 ``produce OUT`` writes into OUT: the bundled catalog regenerated (``catalog/``), a generated world that
 is not in the catalog (``generated/``), an exploration trial on office_small_01 (``trial/``: the run
-folder and its sampled relations and errors) and GMapping over the first scans of the MIT CSAIL
-CARMEN log (``gmapping/``, only when the shared data is there: ``SLAMTRIALS_SHARED`` or ``../shared``
-beside the repository). It then writes ``manifest.json``: the sha256 of every file, and of every array
+folder and its sampled relations and errors) with the simulator's defaults (the ``paper`` error
+profile), the same trial with the ``realistic`` profile that campaigns use by default
+(``trial_realistic/``: laser noise, short readings, dropouts and odometry noise drawn, and the
+explorer's handling of noisy scans), and GMapping and karto over the first scans of the MIT CSAIL
+CARMEN log (``gmapping/``, ``karto/``; only when the shared data is there: ``SLAMTRIALS_SHARED`` or
+``../shared`` beside the repository). It then writes ``manifest.json``: the sha256 of every file, and of every array
 of an ``.npz`` file (a zip, whose bytes depend on the zlib that compressed it); JSON files are hashed
 without their wall-clock timings and software versions; ``timing.csv`` is left out.
 
@@ -44,8 +47,11 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 MANIFEST = "manifest.json"
 #: The trial: a bundled world and a seed (it explores office_small_01 in 172 s simulated, about 7 s on one
-#: core once compiled), with a cap on simulated time (s) that bounds the check's run time.
+#: core once compiled; 194 s and about 9 s with the realistic profile), with a cap on simulated time (s)
+#: that bounds the check's run time.
 TRIAL_WORLD, TRIAL_SEED, TRIAL_MAX_TIME = "office_small_01", 1, 300.0
+#: The error profiles of the trials, and the folder each one's run is written to.
+TRIAL_PROFILES = (("paper", "trial"), ("realistic", "trial_realistic"))
 #: A world generated from arguments that no catalog entry uses.
 GENERATED = ("school", 400.0, 5)
 #: GMapping over this many scans of the MIT CSAIL log, with this seed.
@@ -176,21 +182,21 @@ def produce(out: Path) -> dict:
     save_rosmap(world, out / "generated" / f"{world.name}.yaml")
     timings["generated"] = time.perf_counter() - started
 
-    started = time.perf_counter()
     from slamtrials.evaluation import evaluate_run
     from slamtrials.io.runfolder import write_run
     from slamtrials.trial import TrialConfig, run_trial
     from slamtrials.worlds import load_world
 
-    config = TrialConfig.from_dict({"termination": {"max_time": TRIAL_MAX_TIME}})
-    record = run_trial(load_world(TRIAL_WORLD), config, TRIAL_SEED)
-    write_run(out / "trial", record)
-    evaluate_run(out / "trial", seed=TRIAL_SEED)
-    timings["trial"] = time.perf_counter() - started
+    for profile, folder in TRIAL_PROFILES:
+        started = time.perf_counter()
+        config = TrialConfig.from_dict({"sim": {"profile": profile}, "termination": {"max_time": TRIAL_MAX_TIME}})
+        record = run_trial(load_world(TRIAL_WORLD), config, TRIAL_SEED)
+        write_run(out / folder, record)
+        evaluate_run(out / folder, seed=TRIAL_SEED)
+        timings[folder] = time.perf_counter() - started
 
     log = shared_data() / "data" / "mit-csail" / "mit-csail.clf"
     if log.is_file():
-        started = time.perf_counter()
         from dataclasses import replace
 
         from slamtrials.slamrun import load_recording, run_slam, write_slam_outputs
@@ -199,10 +205,12 @@ def produce(out: Path) -> dict:
         n = min(LOG_SCANS, len(full))
         part = replace(full, t=full.t[:n], scans=full.scans[:n], odometry=full.odometry[:n], truth=full.truth[:n],
                        stalled=full.stalled[:n], estimate=None)
-        write_slam_outputs(run_slam(part, "gmapping", seed=LOG_SEED, source=log.name), out / "gmapping")
-        timings["gmapping"] = time.perf_counter() - started
+        for algorithm in ("gmapping", "karto"):
+            started = time.perf_counter()
+            write_slam_outputs(run_slam(part, algorithm, seed=LOG_SEED, source=log.name), out / algorithm)
+            timings[algorithm] = time.perf_counter() - started
     else:
-        notes.append(f"no MIT CSAIL log at {log}: GMapping on a log not checked")
+        notes.append(f"no MIT CSAIL log at {log}: GMapping and karto on a log not checked")
 
     manifest = {"files": manifest_of(out), "notes": notes, "environment": _environment(),
                 "seconds": {k: round(v, 1) for k, v in timings.items()}}

@@ -15,8 +15,9 @@ folder and its sampled relations and errors) with the simulator's defaults (the 
 profile), the same trial with the ``realistic`` profile that campaigns use by default
 (``trial_realistic/``: laser noise, short readings, dropouts and odometry noise drawn, and the
 explorer's handling of noisy scans), and GMapping and karto over the first scans of the MIT CSAIL
-CARMEN log (``gmapping/``, ``karto/``; only when the shared data is there: ``SLAMTRIALS_SHARED`` or
-``../shared`` beside the repository). It then writes ``manifest.json``: the sha256 of every file, and of every array
+CARMEN log (``gmapping/``, ``karto/``), and ``calibrate`` and ``validate`` (``realistic`` profile, one
+replica) over the first scans of that log (``calibration/``, ``validation/``); the log's parts only when
+the shared data is there: ``SLAMTRIALS_SHARED`` or ``../shared`` beside the repository. It then writes ``manifest.json``: the sha256 of every file, and of every array
 of an ``.npz`` file (a zip, whose bytes depend on the zlib that compressed it); JSON files are hashed
 without their wall-clock timings and software versions; ``timing.csv`` is left out.
 
@@ -56,6 +57,9 @@ TRIAL_PROFILES = (("paper", "trial"), ("realistic", "trial_realistic"))
 GENERATED = ("school", 400.0, 5)
 #: GMapping over this many scans of the MIT CSAIL log, with this seed.
 LOG_SCANS, LOG_SEED = 300, 1
+#: The calibration (GMapping's reference, then the fit) over this many scans, with this many bootstrap
+#: replicates, and the validation replicas of the same scans (the relations that fall in them).
+CALIBRATION_SCANS, CALIBRATION_BOOTSTRAP, VALIDATION_RUNS = 600, 10, 1
 #: Keys of JSON outputs that hold wall-clock measurements or software versions, not results.
 _VOLATILE_WORDS = ("versions", "wall", "seconds", "realtime", "ms_per_frame")
 #: Files that hold only wall-clock measurements.
@@ -209,6 +213,7 @@ def produce(out: Path) -> dict:
             started = time.perf_counter()
             write_slam_outputs(run_slam(part, algorithm, seed=LOG_SEED, source=log.name), out / algorithm)
             timings[algorithm] = time.perf_counter() - started
+        _calibrate_and_validate(full, log, out, timings)
     else:
         notes.append(f"no MIT CSAIL log at {log}: GMapping and karto on a log not checked")
 
@@ -216,6 +221,42 @@ def produce(out: Path) -> dict:
                 "seconds": {k: round(v, 1) for k, v in timings.items()}}
     (out / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n", encoding="utf-8")
     return manifest
+
+
+def _calibrate_and_validate(full, log: Path, out: Path, timings: dict[str, float]) -> None:
+    """``calibrate`` and ``validate`` on the first :data:`CALIBRATION_SCANS` scans of the log ``full``: the
+    fitted profile with its standard errors (``calibration/``) and the validation's numbers with the
+    ``realistic`` profile (``validation/``), as JSON."""
+    from dataclasses import replace
+
+    from slamtrials.calibration import CalibrationSettings, calibrate, slam_reference
+    from slamtrials.io.relations import read_relations
+    from slamtrials.sim.profiles import BUNDLED_PROFILES
+    from slamtrials.validation.validate import ValidationSettings, validate
+
+    n = min(CALIBRATION_SCANS, len(full))
+    part = replace(full, t=full.t[:n], scans=full.scans[:n], odometry=full.odometry[:n], truth=full.truth[:n],
+                   stalled=full.stalled[:n], estimate=None)
+    started = time.perf_counter()
+    reference = slam_reference(part, "gmapping", seed=LOG_SEED)
+    fit = calibrate(part, reference, CalibrationSettings(bootstrap=CALIBRATION_BOOTSTRAP), seed=LOG_SEED)
+    doc = {"profile": fit.profile("determinism", "").model_dump(mode="json"),
+           "fitted": [[value.name, value.value, value.stderr] for value in fit.fitted]}
+    (out / "calibration").mkdir()
+    (out / "calibration" / "profile.json").write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
+    timings["calibration"] = time.perf_counter() - started
+
+    started = time.perf_counter()
+    every = read_relations(log.with_suffix(".relations"))
+    inside = (every.t1 <= part.t[-1]) & (every.t2 <= part.t[-1])
+    relations = replace(every, t1=every.t1[inside], t2=every.t2[inside], delta=every.delta[inside])
+    result = validate(part, relations, BUNDLED_PROFILES["realistic"],
+                      ValidationSettings(runs=VALIDATION_RUNS, reference_seed=LOG_SEED), log=log.name,
+                      relations_source=log.with_suffix(".relations").name)
+    (out / "validation").mkdir()
+    (out / "validation" / "validation.json").write_text(json.dumps(result.to_dict(), indent=1) + "\n",
+                                                         encoding="utf-8")
+    timings["validation"] = time.perf_counter() - started
 
 
 # ----------------------------------------------------------------------------------------- two passes

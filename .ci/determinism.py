@@ -17,8 +17,8 @@ profile), the same trial with the ``realistic`` profile that campaigns use by de
 explorer's handling of noisy scans), and GMapping and karto over the first scans of the MIT CSAIL
 CARMEN log (``gmapping/``, ``karto/``), and ``calibrate`` and ``validate`` (``realistic`` profile, one
 replica) over the first scans of that log (``calibration/``, ``validation/``); the log's parts only when
-the shared data is there: ``SLAMTRIALS_SHARED`` or ``../shared`` beside the repository. It then writes ``manifest.json``: the sha256 of every file, and of every array
-of an ``.npz`` file (a zip, whose bytes depend on the zlib that compressed it); JSON files are hashed
+the shared data is there: ``SLAMTRIALS_SHARED`` or ``../shared`` beside the repository. It then writes
+``manifest.json``: the sha256 of every file, and of every array of an ``.npz`` file (a zip, whose bytes depend on the zlib that compressed it); JSON files are hashed
 without their wall-clock timings and software versions; ``timing.csv`` is left out.
 
 ``check`` fails (exit status 1) naming every file that differs between the two passes, or a regenerated
@@ -215,7 +215,7 @@ def produce(out: Path) -> dict:
             timings[algorithm] = time.perf_counter() - started
         _calibrate_and_validate(full, log, out, timings)
     else:
-        notes.append(f"no MIT CSAIL log at {log}: GMapping and karto on a log not checked")
+        notes.append(f"no MIT CSAIL log at {log}: SLAM, calibrate and validate on a log not checked")
 
     manifest = {"files": manifest_of(out), "notes": notes, "environment": _environment(),
                 "seconds": {k: round(v, 1) for k, v in timings.items()}}

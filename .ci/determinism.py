@@ -18,8 +18,9 @@ explorer's handling of noisy scans), and GMapping and karto over the first scans
 CARMEN log (``gmapping/``, ``karto/``), and ``calibrate`` and ``validate`` (``realistic`` profile, one
 replica) over the first scans of that log (``calibration/``, ``validation/``); the log's parts only when
 the shared data is there: ``SLAMTRIALS_SHARED`` or ``../shared`` beside the repository. It then writes
-``manifest.json``: the sha256 of every file, and of every array of an ``.npz`` file (a zip, whose bytes depend on the zlib that compressed it); JSON files are hashed
-without their wall-clock timings and software versions; ``timing.csv`` is left out.
+``manifest.json``: the sha256 of every file, and of every array of an ``.npz`` file (a zip, whose bytes
+depend on the zlib that compressed it); JSON files are hashed without their wall-clock timings and
+software versions; ``timing.csv`` is left out.
 
 ``check`` fails (exit status 1) naming every file that differs between the two passes, or a regenerated
 catalog file that differs from the one bundled in the package. Usage::

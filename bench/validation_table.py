@@ -125,4 +125,12 @@ def _std(value: float | None) -> str:
 
 
 if __name__ == "__main__":
-    main()
+    import sys
+
+    from slamtrials.errors import SlamtrialsError
+
+    try:
+        main()
+    except SlamtrialsError as exc:  # bad input: one line, exit status 2, as the CLI does
+        print(f"error: {exc}", file=sys.stderr)
+        sys.exit(2)

@@ -104,12 +104,12 @@ def main() -> None:
             doc = result.to_dict()
             slam, odometry = doc["slam"], doc["odometry"]
             t, r = slam["translational_m"], slam["rotational_rad"]
-            replicas = ", ".join(f"{v:.3f}" for v in t["per_replica"])
+            replicas = ", ".join(_num(v, 3) for v in t["per_replica"])
+            odo = odometry["translational_m"]
             rows.append(
-                f"| {log_name} | {profile_name} | {t['real']:.4f} | {t['simulated_mean']:.4f} +- "
-                f"{_std(t['simulated_std'])} | {t['simulated_mean'] / t['real']:.2f} | {r['real']:.4f} | "
-                f"{r['simulated_mean']:.4f} +- {_std(r['simulated_std'])} | {r['simulated_mean'] / r['real']:.2f} | "
-                f"{odometry['translational_m']['real']:.2f} / {odometry['translational_m']['simulated_mean']:.2f} | "
+                f"| {log_name} | {profile_name} | {_num(t['real'])} | {_num(t['simulated_mean'])} +- "
+                f"{_num(t['simulated_std'])} | {_ratio(t)} | {_num(r['real'])} | {_num(r['simulated_mean'])} +- "
+                f"{_num(r['simulated_std'])} | {_ratio(r)} | {_num(odo['real'], 2)} / {_num(odo['simulated_mean'], 2)} | "
                 f"{replicas} |"
             )
             print(f"{log_name} / {profile_name}: {time.perf_counter() - started:.0f} s", flush=True)
@@ -120,8 +120,16 @@ def main() -> None:
     print("\n".join(rows))
 
 
-def _std(value: float | None) -> str:
-    return "-" if value is None else f"{value:.4f}"
+def _num(value: float | None, digits: int = 4) -> str:
+    """A number of the validation JSON (None where it was not a number) as table text."""
+    return "-" if value is None else f"{value:.{digits}f}"
+
+
+def _ratio(error: dict) -> str:
+    """Simulated mean over real error, two decimals ("-" when either is missing)."""
+    if error["simulated_mean"] is None or not error["real"]:
+        return "-"
+    return f"{error['simulated_mean'] / error['real']:.2f}"
 
 
 if __name__ == "__main__":

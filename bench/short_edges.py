@@ -11,6 +11,9 @@ to either side differs from its own by more than ``--jump`` metres (a depth disc
 frame, a pillar's side, a corridor opening); it reads *short* when its reading is more than ``--short``
 metres below its cast range. Printed: the share of beams at an edge, the share of short readings at an
 edge, and the ratio of the two (1: short readings stand anywhere, as the simulator's model draws them).
+Then, for the beams on the *far* side of an edge (a beam up to two places away has a cast range more
+than ``--jump`` shorter), the share that reads the nearer surface (within ``--near`` metres of the
+nearest neighbouring cast range): an estimate of how often a beam next to a nearer surface reads it.
 """
 
 from __future__ import annotations
@@ -33,6 +36,15 @@ def at_edges(cast: np.ndarray, jump: float, reach: int = 2) -> np.ndarray:
     return edge
 
 
+def nearest_neighbour_cast(cast: np.ndarray, reach: int = 2) -> np.ndarray:
+    """float64 ``[B]``: the shortest cast range among the beams up to ``reach`` places to either side."""
+    nearest = np.full(cast.shape, np.inf)
+    for step in range(1, reach + 1):
+        nearest[step:] = np.minimum(nearest[step:], cast[:-step])
+        nearest[:-step] = np.minimum(nearest[:-step], cast[step:])
+    return nearest
+
+
 def main() -> None:
     from slamtrials.calibration import slam_reference
     from slamtrials.calibration.beams import FrameCaster
@@ -45,12 +57,13 @@ def main() -> None:
     parser.add_argument("--every", type=int, default=5, help="cast every N-th frame")
     parser.add_argument("--jump", type=float, default=0.3, help="depth step (m) that makes an edge")
     parser.add_argument("--short", type=float, default=0.3, help="shortfall (m) that makes a short reading")
+    parser.add_argument("--near", type=float, default=0.1, help="how close (m) a reading must be to the nearer side")
     args = parser.parse_args()
 
     record = load_recording(args.log)
     reference = slam_reference(record, "gmapping", overrides=parse_settings(args.settings) or None, seed=0)
     caster = FrameCaster(record, reference)
-    beams = shorts = edge_beams = edge_shorts = 0
+    beams = shorts = edge_beams = edge_shorts = far_side = reads_near = 0
     for k in range(0, len(record), args.every):
         frame = caster.cast(k)
         reading = record.scans[k].astype(np.float64)
@@ -62,6 +75,10 @@ def main() -> None:
         shorts += int(short.sum())
         edge_beams += int((usable & edge).sum())
         edge_shorts += int((short & edge).sum())
+        nearer = nearest_neighbour_cast(cast)
+        far = usable & (nearer < cast - args.jump)
+        far_side += int(far.sum())
+        reads_near += int((far & (np.abs(reading - nearer) <= args.near)).sum())
     edge_share = edge_beams / max(beams, 1)
     edge_share_short = edge_shorts / max(shorts, 1)
     print(
@@ -69,6 +86,10 @@ def main() -> None:
         f"{shorts / max(beams, 1):.3f} read more than {args.short} m short; "
         f"at an edge (> {args.jump} m within 2 beams): {edge_share:.3f} of all beams, "
         f"{edge_share_short:.3f} of the short readings ({edge_share_short / max(edge_share, 1e-12):.1f} times)"
+    )
+    print(
+        f"far side of an edge: {far_side} beams ({far_side / max(beams, 1):.3f}); "
+        f"{reads_near / max(far_side, 1):.3f} of them read the nearer side (within {args.near} m)"
     )
 
 

@@ -21,7 +21,8 @@ Default worlds: office_small_01 (small, 153 m^2), mit_building31 and school_medi
 1,000 m^2; the first from ``../shared/worlds/real``), lab_large_01 (large, 3,092 m^2). Names are
 catalog names, real-world folder names under ``$SLAMTRIALS_SHARED/worlds/real``, or map files.
 
-Error profiles (issue 21, item 8): ``--profiles paper realistic --seeds 1 2 3`` runs every world with
+Error profiles (issue 21, item 8): ``--profiles paper realistic --seeds 1 2 3`` (bundled names, or profile
+YAML files such as ``slamtrials calibrate`` writes) runs every world with
 each profile and seed, interleaved (world, seed, then the profiles in turn, so that a change in the
 machine's load hits both alike), and adds a table per world: mean wall and simulated time per
 profile, how the trials ended, the mapped free share of the reachable area, and the ratio of each
@@ -62,10 +63,12 @@ def resolve(name: str) -> str:
 def trial_config(algorithm: str, profile: str = "paper"):
     """The paper's set-up with ``algorithm`` online (GMapping's ``paper`` preset, another's defaults) and the
     simulator's error ``profile``."""
+    from slamtrials.campaign.profilefile import is_profile_path, read_profile
     from slamtrials.trial import TrialConfig
 
     preset = "paper" if algorithm == "gmapping" else None
-    return TrialConfig.from_dict({"slam": {"algorithm": algorithm, "preset": preset}, "sim": {"profile": profile}})
+    chosen = read_profile(profile).model_dump() if is_profile_path(profile) else profile
+    return TrialConfig.from_dict({"slam": {"algorithm": algorithm, "preset": preset}, "sim": {"profile": chosen}})
 
 
 def main() -> None:
@@ -79,7 +82,10 @@ def main() -> None:
         "--algorithms", nargs="+", default=["gmapping"], help="SLAM algorithms to time, interleaved (first: reference)"
     )
     parser.add_argument(
-        "--profiles", nargs="+", default=["paper"], help="simulator error profiles, run interleaved (first: reference)"
+        "--profiles",
+        nargs="+",
+        default=["paper"],
+        help="simulator error profiles (bundled names or profile YAML files), run interleaved (first: reference)",
     )
     args = parser.parse_args()
 

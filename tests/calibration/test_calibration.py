@@ -29,6 +29,8 @@ LASER = {
     "dropout_per_m": 0.004,
     "dropout_grazing": 0.1,
 }
+#: The edge model's reach (rad): a setting of the calibration (its default, 1 degree), written into the profile.
+EDGE_REACH = CalibrationSettings().edge_reach
 ODOMETRY = {
     "bias_linear": 0.03,
     "bias_angular": -0.08,
@@ -67,6 +69,29 @@ def test_fit_recovers_each_known_value_within_its_stated_uncertainty(fitted, nam
     assert abs(value.value - truth) <= 2.0 * value.stderr + bias, (value, truth)
     # and it is an uncertainty worth stating: well below the value itself
     assert 0.0 < value.stderr < 0.25 * abs(truth), value
+
+
+def test_without_edge_readings_the_fit_finds_next_to_none(fitted):
+    # the short readings that land at a nearer wall are expected by the short-reading model and taken off
+    edge = fitted.value("edge_chance")
+    assert edge.value < 0.01 and edge.value <= 2.0 * edge.stderr + 0.002, edge
+    assert fitted.value("edge_reach").value == EDGE_REACH
+    assert fitted.profile("p", "").laser["edge_reach"] == EDGE_REACH
+
+
+@pytest.mark.parametrize("chance", [0.25])
+def test_edge_chance_is_recovered_and_its_readings_are_not_counted_short(chance):
+    world = load_world("office_small_01")
+    laser = {"range_noise_std": 0.02, "short_rate": 0.1, "short_run_beams": 3.0, "dropout_rate": 0.02}
+    config = SimConfig(laser=LaserConfig(**laser, edge_chance=chance, edge_reach=EDGE_REACH))
+    record = simulate_waypoints(world, tour_waypoints(world, num_goals=3), config, seed=7, max_time=300)
+    reference = Reference.from_world(record.truth, world, "simulation truth")
+    fit = calibrate(record, reference, CalibrationSettings(bootstrap=10, min_distance=5.0), seed=2)
+    edge, short = fit.value("edge_chance"), fit.value("short_rate")
+    assert abs(edge.value - chance) <= 3.0 * edge.stderr, edge
+    assert 0.0 < edge.stderr < 0.1 * chance
+    # the short readings of the far wall that land at the nearer wall are the edge fit's: a few per cent of them
+    assert 0.95 * 0.1 - 2.0 * short.stderr <= short.value <= 0.1 + 2.0 * short.stderr, short
 
 
 def test_fit_reports_the_residual_figures_of_the_simulated_laser(fitted):

@@ -49,6 +49,8 @@ _UNITS = {
     "dropout_rate": "",
     "dropout_per_m": "1/m",
     "dropout_grazing": "",
+    "edge_chance": "",
+    "edge_reach": "rad",
     "short_lifetime": "s",
     "short_fleeting_share": "",
     "bias_linear": "m/m",
@@ -140,7 +142,9 @@ def _block_index(frames: NDArray[np.int64], block: int, rng: np.random.Generator
 
 def _laser_model(sample: BeamSample, fit: LaserFit, range_min: float, range_max: float, rng: np.random.Generator):
     config = LaserConfig(max_range=min(range_max, 1000.0), min_range=min(range_min, range_max * 0.5), **fit.values)
-    readings = apply_laser_errors(sample.cast.astype(np.float32), config, rng, sample.incidence).astype(np.float64)
+    readings = apply_laser_errors(
+        sample.cast.astype(np.float32), config, rng, sample.incidence, nearer=sample.nearer
+    ).astype(np.float64)
     return readings - sample.cast, readings >= np.float32(config.max_range)
 
 
@@ -167,7 +171,9 @@ def calibrate(
         )
     rng = np.random.default_rng(np.random.SeedSequence(seed))
     anchors = anchor_frames(reference.poses, record.odometry)
-    sample = beam_sample(record, reference, cfg.max_beams, anchors if cfg.laser_anchors_only else None)
+    sample = beam_sample(
+        record, reference, cfg.max_beams, anchors if cfg.laser_anchors_only else None, edge_reach=cfg.edge_reach
+    )
     laser = fit_laser(sample, cfg, record.laser.range_min)
     if laser is None:
         raise CalibrationError(

@@ -208,7 +208,12 @@ def _replay(
     for k, cast in enumerate(casts):
         scan = UnmappedScan(things, cast.laser_pose, angles, float(laser.angle_increment), float(t[k]))
         out[k] = apply_laser_errors(
-            cast.ranges, config, rng, cast.incidence if grazing else None, scan if lifetime > 0.0 else None
+            cast.ranges,
+            config,
+            rng,
+            cast.incidence if grazing else None,
+            scan if lifetime > 0.0 else None,
+            nearer=cast.nearer,
         )
     return out
 
@@ -259,7 +264,7 @@ def fit_lifetime(
     if usable < 1:
         return None
     base = np.arange(0, usable, max(1, math.ceil(usable / settings.lifetime_base_frames)), dtype=np.int64)
-    caster = FrameCaster(record, reference)
+    caster = FrameCaster(record, reference, settings.edge_reach)
     casts = [caster.cast(k) for k in range(frames)]
     below = [laser.short_below(c.ranges.astype(np.float64), settings.short_sigmas) for c in casts]
     limit = float(record.laser.range_max)

@@ -20,6 +20,11 @@ class CalibrationSettings(BaseModel):
         The Gaussian core of a bin's residuals is taken within this many sigmas of its median.
     short_sigmas:
         A reading shorter than the cast range by more than this many sigmas (of its bin) is a short reading.
+    edge_reach:
+        How far (rad) to either side of a beam a nearer wall is looked for by the edge model
+        (:mod:`slamtrials.sim.edges`); written into the profile as ``edge_reach``, not fitted. 1 degree: two
+        beams of the shared logs' lasers, where the real readings of nearer walls are most frequent
+        (docs/realism.md, "Assumptions").
     position_floor:
         Least gap before the wall (m) of the short readings whose position along the beam fits
         ``short_position_power``; nearer the wall lie the reference map's own errors and what stands
@@ -79,6 +84,9 @@ class CalibrationSettings(BaseModel):
     min_bin_beams: int = Field(200, ge=20, description="fewest beams per range bin")
     core_cut: float = Field(2.5, gt=1.0, le=5.0, description="Gaussian core cut (sigmas)")
     short_sigmas: float = Field(3.0, gt=1.0, le=10.0, description="short-reading threshold (sigmas)")
+    edge_reach: float = Field(
+        0.017453292519943295, ge=0.0, le=0.17453292519943295, description="edge model's reach (rad)"
+    )
     position_floor: float = Field(0.5, ge=0.0, le=10.0, description="least gap of the position fit's readings (m)")
     position_min_short: int = Field(100, ge=10, description="fewest short readings to fit the position power")
     max_beams: int = Field(600_000, ge=1000, description="cap on the beams used")

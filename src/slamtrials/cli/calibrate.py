@@ -67,12 +67,18 @@ def format_calibration(cal: Calibration, log: str) -> str:
         "dropout_rate",
         "dropout_per_m",
         "dropout_grazing",
+        "edge_chance",
     ):
-        lines.append(row(name))
+        lines.append(row(name, " " if name == "edge_chance" else ""))
         if name == "short_range_scale":
             lines[-1] += "  (the chance rises to short_rate as 1 - exp(-(r / scale)^shape); 0: constant)"
         if name == "short_position_power":
             lines[-1] += "  (where they stand: density (a + 1) v^a of the beam fraction v; 0 is uniform)"
+        if name == "edge_chance":
+            lines[-1] += (
+                f"  (of {laser.edge_beams} beams next to a wall more than 0.3 m nearer within "
+                f"edge_reach {value['edge_reach'].value:.4g} rad, {laser.edge_readings} read it)"
+            )
     life = cal.lifetime
     if life is None:
         lines.append("  short_lifetime, short_fleeting_share: not fitted (too few short readings); 0 in the profile")

@@ -43,6 +43,8 @@ LASER_ERROR_FIELDS = (
     "dropout_rate",
     "dropout_per_m",
     "dropout_grazing",
+    "edge_chance",
+    "edge_reach",
 )
 
 
@@ -197,6 +199,12 @@ class LaserConfig(BaseModel):
         Probability per beam of no return (the reading is ``max_range``):
         ``dropout_rate + dropout_per_m * range + dropout_grazing * (1 - |cos(incidence)|)``, capped at 1,
         where the incidence is the angle between the beam and the normal of the wall it hits. Default 0.
+    edge_chance, edge_reach:
+        Readings at depth edges (:mod:`slamtrials.sim.edges`): a beam with a neighbour within ``edge_reach``
+        (rad) to either side whose wall is more than 0.3 m nearer reads that nearer wall with probability
+        ``edge_chance``. Default 0 (off). A laser whose beams are farther apart than ``edge_reach`` has no
+        such neighbours (its spot does not reach the next beam), so the model does nothing there. Real logs:
+        about 0.14 within 1 degree.
 
     See :mod:`slamtrials.sim.laser_errors` for the order of the draws.
     """
@@ -240,6 +248,12 @@ class LaserConfig(BaseModel):
     dropout_grazing: float = Field(
         0.0, ge=0.0, le=1.0, description="added probability of no return times (1 - |cos incidence|)"
     )
+    edge_chance: float = Field(
+        0.0, ge=0.0, le=1.0, description="probability that a beam next to a nearer wall (within edge_reach) reads it"
+    )
+    edge_reach: float = Field(
+        0.0, ge=0.0, le=math.radians(10.0), description="angle (rad) to either side within which edge_chance applies"
+    )
 
     @property
     def has_errors(self) -> bool:
@@ -251,7 +265,8 @@ class LaserConfig(BaseModel):
             "short_position_power",
             "short_range_scale",
             "short_range_shape",
-        )  # they shape the short readings, add none
+            "edge_reach",
+        )  # they shape the errors, add none
         return any(getattr(self, name) > 0.0 for name in LASER_ERROR_FIELDS if name not in shape_only)
 
     @field_validator("mount")

@@ -3,6 +3,9 @@
 For a scan of ``B`` beams with true ranges ``r`` (the exact cast distances, ``max_range`` where nothing
 is hit), the reading of beam ``i`` is:
 
+0. **edges** (``edge_chance > 0``): a beam next to a wall more than 0.3 m nearer (within ``edge_reach``)
+   takes that wall's range for its true range with probability ``edge_chance``
+   (:mod:`slamtrials.sim.edges`); everything below then applies to the range it takes;
 1. **noise** (beams that hit something): ``r + (range_noise_std + range_noise_per_m r) z``;
 2. **dropout** (beams that hit something): no return (``max_range``) with probability
    ``dropout_rate + dropout_per_m r + dropout_grazing (1 - |cos incidence|)``, capped at 1; the
@@ -23,7 +26,7 @@ is hit), the reading of beam ``i`` is:
    that are gone by the next scan (:mod:`slamtrials.sim.unmapped`);
 
 then clipped to ``[min_range, max_range]``. Draws, from the run's stream, in this order and only for
-the models that are on: ``B`` standard normals (noise), ``B`` uniforms (dropout), ``B`` uniforms then
+the models that are on: ``B`` uniforms (edges), ``B`` standard normals (noise), ``B`` uniforms (dropout), ``B`` uniforms then
 ``B`` uniforms (short: whether, where; the same with runs), then ``B`` uniforms (each thing's lifetime,
 with ``short_lifetime > 0``). Their number never depends on what the beams hit, so a run's
 stream is the same whatever the world looks like. With every rate 0 nothing is drawn (the paper's
@@ -39,6 +42,7 @@ from numba import njit
 from numpy.typing import NDArray
 
 from slamtrials.sim.config import LaserConfig, start_chances
+from slamtrials.sim.edges import edge_ranges, nearest_neighbour_range, reach_in_beams
 from slamtrials.sim.shortdistance import short_distance
 from slamtrials.sim.shortrate import short_chances
 from slamtrials.sim.unmapped import UnmappedScan
@@ -121,17 +125,25 @@ def apply_laser_errors(
     rng: np.random.Generator,
     incidence: NDArray[np.float64] | None = None,
     unmapped: UnmappedScan | None = None,
+    nearer: NDArray[np.float64] | None = None,
 ) -> NDArray[np.float32]:
     """The readings float32 ``[B]`` (m) for ``true_ranges`` float32 ``[B]`` (m) (see the module docstring).
 
-    ``incidence`` (``[B]`` ``|cos|``, :func:`incidence_cosines`) is needed when ``dropout_grazing > 0``;
+    ``nearer`` (``[B]`` m): each beam's nearest neighbouring true range for the edge model; by default it is
+    found in ``true_ranges`` itself, as one scan's beams in order (the calibration, whose beams are not a
+    scan, gives it). ``incidence`` (``[B]`` ``|cos|``, :func:`incidence_cosines`) is needed when ``dropout_grazing > 0``;
     ``unmapped`` (the run's things not in the map, and where and when this scan is taken) when
     ``short_lifetime > 0`` (:mod:`slamtrials.sim.unmapped`).
     """
     cfg = config
     r = true_ranges.astype(np.float64)
     count = r.shape[0]
-    hit = true_ranges < np.float32(cfg.max_range)
+    if cfg.edge_chance > 0.0:
+        uniforms = rng.random(count)
+        if nearer is None:
+            nearer = nearest_neighbour_range(r, reach_in_beams(cfg.edge_reach, cfg.angle_increment))
+        r = edge_ranges(r, nearer, uniforms, cfg.edge_chance)
+    hit = r < float(np.float32(cfg.max_range))
     reading = r.copy()
     if cfg.range_noise_std > 0.0 or cfg.range_noise_per_m > 0.0:
         z = rng.standard_normal(count)

@@ -50,22 +50,24 @@ BUNDLED_PROFILES: dict[str, ErrorProfile] = {
     ),
     "mit-csail": ErrorProfile(
         name="mit-csail",
-        description="fitted by slamtrials calibrate (2026-11-25) to the shared MIT CSAIL log against GMapping's "
+        description="fitted by slamtrials calibrate (2026-11-28) to the shared MIT CSAIL log against GMapping's "
         "final path and map (default settings, seed 0); biases +- the measured per-run bias; noise per simulator "
         "step of 0.1 s; no slips (docs/realism.md, Calibration)",
         laser={
-            "range_noise_std": 0.03327,
-            "range_noise_per_m": 0.004496,
-            "short_rate": 0.3665,
-            "short_range_scale": 4.506,
-            "short_range_shape": 1.578,
-            "short_run_beams": 7.388,
-            "short_position_power": 0.6581,
-            "short_lifetime": 6.727,
-            "short_fleeting_share": 0.9175,
-            "dropout_rate": 0.03309,
+            "range_noise_std": 0.033,
+            "range_noise_per_m": 0.0049,
+            "short_rate": 0.2866,
+            "short_range_scale": 3.981,
+            "short_range_shape": 1.573,
+            "short_run_beams": 7.315,
+            "short_position_power": 0.8909,
+            "short_lifetime": 9.012,
+            "short_fleeting_share": 0.92,
+            "dropout_rate": 0.03269,
             "dropout_per_m": 0.0,
             "dropout_grazing": 0.0,
+            "edge_chance": 0.2044,
+            "edge_reach": math.radians(1.0),
         },
         odometry={
             "bias_linear_range": (-0.02207, 0.02207),
@@ -78,24 +80,26 @@ BUNDLED_PROFILES: dict[str, ErrorProfile] = {
     ),
     "fr079": ErrorProfile(
         name="fr079",
-        description="fitted by slamtrials calibrate (2026-11-25) to the shared fr079 log against GMapping's final "
+        description="fitted by slamtrials calibrate (2026-11-28) to the shared fr079 log against GMapping's final "
         "path and map (linearUpdate=0.1, seed 0: GMapping's defaults do not map fr079, docs/real-datasets.md); "
         "the odometry without the 81 segments where the log moves against the reference (reversing logged as "
         "driving forward); biases +- the measured per-run bias; noise per simulator step of 0.1 s; no slips "
         "(docs/realism.md, Calibration)",
         laser={
-            "range_noise_std": 0.03329,
-            "range_noise_per_m": 0.001065,
-            "short_rate": 0.3055,
-            "short_range_scale": 4.256,
-            "short_range_shape": 1.404,
-            "short_run_beams": 5.145,
-            "short_position_power": 1.347,
-            "short_lifetime": 6.8,
-            "short_fleeting_share": 0.88,
-            "dropout_rate": 0.018,
+            "range_noise_std": 0.0323,
+            "range_noise_per_m": 0.001789,
+            "short_rate": 0.2326,
+            "short_range_scale": 3.991,
+            "short_range_shape": 1.241,
+            "short_run_beams": 4.779,
+            "short_position_power": 1.496,
+            "short_lifetime": 8.354,
+            "short_fleeting_share": 0.845,
+            "dropout_rate": 0.01783,
             "dropout_per_m": 0.0,
-            "dropout_grazing": 0.01633,
+            "dropout_grazing": 0.01623,
+            "edge_chance": 0.1525,
+            "edge_reach": math.radians(1.0),
         },
         odometry={
             "bias_linear_range": (-0.006648, 0.006648),

@@ -65,8 +65,12 @@ def test_calibrate_writes_a_valid_profile_and_a_page_of_figures(record, tmp_path
         "dropout_rate",
         "dropout_per_m",
         "dropout_grazing",
+        "edge_chance",
+        "edge_reach",
     }
-    assert "short_lifetime" in result.output and "short_position_power" in result.output
+    assert (
+        "short_lifetime" in result.output and "edge_chance" in result.output and "short_position_power" in result.output
+    )
     low, high = profile.odometry["bias_angular_range"]
     assert low == -high and high > 0.0
     # against GMapping's map the noise is the simulated noise or more, never nothing

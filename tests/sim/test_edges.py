@@ -60,7 +60,9 @@ def test_beams_beside_a_pillar_read_it_with_the_chance_and_others_never():
     scans = np.array([laser.scan(pose, rng) for _ in range(2000)], dtype=np.float64)
     reads_near = np.isclose(scans, nearer.astype(np.float32), atol=1e-5)
     assert reads_near[:, far_side].mean() == pytest.approx(0.3, abs=0.02)
-    np.testing.assert_array_equal(scans[:, ~far_side], np.broadcast_to(true.astype(np.float32), scans.shape)[:, ~far_side])
+    np.testing.assert_array_equal(
+        scans[:, ~far_side], np.broadcast_to(true.astype(np.float32), scans.shape)[:, ~far_side]
+    )
 
 
 def test_edge_readings_take_the_other_errors_as_their_own_range():

@@ -139,7 +139,7 @@ def apply_laser_errors(
     r = true_ranges.astype(np.float64)
     count = r.shape[0]
     if cfg.edge_chance > 0.0:
-        uniforms = rng.random(count)
+        uniforms = np.asarray(rng.random(count), dtype=np.float64)
         if nearer is None:
             nearer = nearest_neighbour_range(r, reach_in_beams(cfg.edge_reach, cfg.angle_increment))
         r = edge_ranges(r, nearer, uniforms, cfg.edge_chance)

@@ -1,18 +1,19 @@
 """What in an error profile makes GMapping's updates cost more: one fixed tour, one error model changed at a time.
 
 Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/slam_cost_by_error.py [--worlds office_small_01
-school_medium_01] [--goals 6] [--seed 1] [--base realistic]``.
+school_medium_01] [--seed 1] [--base realistic]``.
 
 A trial's cost with an error profile mixes two things: the explorer's path (a noisier map can make it
 drive longer) and GMapping's cost per update on noisier data. This script holds the path fixed to see
-the second alone. Each world gets one waypoint tour (:func:`slamtrials.sim.tour.tour_waypoints`, the
-robot driven along it on its true pose, so every variant drives the same path for the same time),
-recorded with ``paper``, with ``--base`` and with ``--base`` with one part of its error models turned off
+the second alone. Each world gets one trial with the ``paper`` profile (GMapping's ``paper`` preset, the
+frontier explorer, ``--seed``); its true path is then sensed again at its own timestamps
+(:func:`slamtrials.sim.pathreplay.simulate_path`, so every variant drives the same path for the same
+time) with ``paper``, with ``--base`` and with ``--base`` with one part of its error models turned off
 (the others as they are), all from the same seed. GMapping's ``paper`` preset (as a trial runs it) then
 runs offline over each recording, one at a time, after a warm-up run. Printed per world and variant:
 the updates, GMapping's CPU seconds and milliseconds per update, the ratio of the latter to ``paper``'s,
-and the final path's mean position error against the truth (m), so a cheaper variant can be told from
-one that simply lost track.
+and the final path's mean position error against the truth (m, the path's first pose put on the
+truth's), so a cheaper variant can be told from one that simply lost track.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ import os
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
+import re  # noqa: E402
 import time  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -45,6 +47,21 @@ VARIANTS: dict[str, tuple[dict[str, float], dict[str, object]]] = {
         {},
         {"bias_linear_range": (-0.005, 0.005), "bias_angular_range": (-0.017453, 0.017453)},
     ),
+    "paper's laser (its odometry only)": (
+        {"range_noise_std": 0.0, "range_noise_per_m": 0.0, "short_rate": 0.0, "edge_chance": 0.0}
+        | {"dropout_rate": 0.0, "dropout_per_m": 0.0, "dropout_grazing": 0.0},
+        {},
+    ),
+    "paper's odometry (its laser only)": (
+        {},
+        {
+            "noise_linear_per_m": 0.0,
+            "noise_angular_per_rad": 0.0,
+            "noise_linear_per_rad": 0.0,
+            "noise_angular_per_m": 0.0,
+        }
+        | {"bias_linear_range": (-0.005, 0.005), "bias_angular_range": (-0.017453, 0.017453)},
+    ),
 }
 
 
@@ -58,7 +75,7 @@ def configs(base: str) -> dict[str, object]:
     for label, (laser, odometry) in VARIANTS.items():
         changed = profile.model_copy(
             update={
-                "name": f"{base}-{label.replace(' ', '-').replace(chr(39), '')}",
+                "name": f"{base}-" + re.sub(r"[^A-Za-z0-9]+", "-", label).strip("-"),
                 "laser": {**profile.laser, **laser},
                 "odometry": {**profile.odometry, **odometry},
             }
@@ -67,28 +84,34 @@ def configs(base: str) -> dict[str, object]:
     return out
 
 
+def mean_position_error(estimate: np.ndarray, truth: np.ndarray) -> float:
+    """Mean distance (m) between the poses ``estimate`` ``[N, 3]`` (SLAM's map frame) and ``truth`` ``[N, 3]``
+    (world frame), the estimate carried into the world frame by the transform that puts its first pose on
+    the truth's first."""
+    turn = truth[0, 2] - estimate[0, 2]
+    c, s = np.cos(turn), np.sin(turn)
+    d = estimate[:, :2] - estimate[0, :2]
+    x = truth[0, 0] + c * d[:, 0] - s * d[:, 1]
+    y = truth[0, 1] + s * d[:, 0] + c * d[:, 1]
+    return float(np.mean(np.hypot(x - truth[:, 0], y - truth[:, 1])))
+
+
 def main() -> None:
-    from slamtrials.sim.tour import tour_waypoints
-    from slamtrials.sim.waypoints import simulate_waypoints
+    from bench_trial import trial_config
+    from slamtrials.sim.pathreplay import simulate_path
     from slamtrials.slamrun import run_slam
+    from slamtrials.trial import run_trial
     from slamtrials.worlds import load_world
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--worlds", nargs="+", default=["office_small_01", "school_medium_01"])
-    parser.add_argument("--goals", type=int, default=6, help="far goals of each tour")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--base", default="realistic", help="the bundled profile taken apart")
     args = parser.parse_args()
 
     variants = configs(args.base)
-    warm = simulate_waypoints(
-        load_world("house_small_01"),
-        tour_waypoints(load_world("house_small_01"), num_goals=2),
-        variants[args.base],
-        seed=0,
-        max_time=120,
-    )
-    run_slam(warm, "gmapping", preset="paper", seed=0)  # compiles every kernel
+    warm = run_trial(load_world("house_small_01"), trial_config("gmapping", args.base), 0)  # compiles every kernel
+    run_slam(warm, "gmapping", preset="paper", seed=0)
     print(f"base profile {args.base}; GMapping preset paper; seed {args.seed}; {time.strftime('%Y-%m-%d')}\n")
     print(
         "| world | variant | simulated s | updates | GMapping CPU s | ms per update | / paper | mean position error (m) |"
@@ -96,17 +119,16 @@ def main() -> None:
     print("|---|---|---:|---:|---:|---:|---:|---:|")
     for name in args.worlds:
         world = load_world(name)
-        waypoints = tour_waypoints(world, num_goals=args.goals)
+        path = run_trial(world, trial_config("gmapping", "paper"), args.seed)
         reference = None
         for label, config in variants.items():
-            record = simulate_waypoints(world, waypoints, config, seed=args.seed, max_time=3600)
+            record = simulate_path(world, path.t, path.truth, config, args.seed)
             cpu = time.process_time()
             result = run_slam(record, "gmapping", preset="paper", seed=args.seed)
             cpu = time.process_time() - cpu
             per_update = 1e3 * cpu / max(result.updates, 1)
             reference = per_update if reference is None else reference
-            estimate = result.trajectory.poses[:, :2]
-            error = float(np.mean(np.hypot(*(estimate - record.truth[:, :2]).T)))
+            error = mean_position_error(result.trajectory.poses, record.truth)
             print(
                 f"| {world.name} | {label} | {record.t[-1]:.0f} | {result.updates} | {cpu:.1f} | {per_update:.1f} | "
                 f"{per_update / reference:.2f} | {error:.3f} |",

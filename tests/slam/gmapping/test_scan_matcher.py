@@ -451,6 +451,29 @@ def test_the_early_stop_never_changes_a_score_that_could_exceed_the_floor(room_m
     assert stopped >= 10  # the early stop happens, so the equalities above were tested on it
 
 
+def test_beams_given_in_another_order_give_the_same_score_bit_for_bit(room_map):
+    """``match_particles`` hands the climbs after the first the beams in another order (those that fit
+    worst first, for the early stop); ``score_3x3`` then sums in the scan's own order: the same number as
+    with the beams in order, and the same early stops only where the score cannot exceed the floor."""
+    lx, ly = scan_endpoints(TRUE_POSE, 360, offset=np.pi / 720)
+    m = room_map
+    directory, mean = m.directories[0], m.mean.reshape(-1)
+    floats, ints = score_scratch(len(lx))
+    order = np.random.default_rng(3).permutation(len(lx))
+    canonical = np.empty_like(order)
+    canonical[order] = np.arange(len(lx))
+    rng = np.random.default_rng(9)
+    for _ in range(20):
+        pose = TRUE_POSE + rng.uniform([-0.1, -0.1, -0.05], [0.1, 0.1, 0.05])
+        args = (directory, mean, m.tile_col0, m.tile_row0, RES, pose[0], pose[1], pose[2])
+        in_order = score_3x3(*args, lx, ly, 0.05, floats, ints)
+        reordered = score_3x3(*args, lx[order], ly[order], 0.05, floats, ints, 2, STOPPED, canonical)
+        assert reordered == in_order and in_order > 1.0
+        for floor in (np.nextafter(in_order, -1.0), in_order):
+            got = score_3x3(*args, lx[order], ly[order], 0.05, floats, ints, 2, floor, canonical)
+            assert got == in_order or (got == STOPPED and in_order <= floor)
+
+
 def test_free_cell_test_skips_a_cell_whose_free_counterpart_holds_endpoints():
     """One beam along +x from (0, 0.0125) ending at x = 1.0125 (cell column 20, row 0); its free point
     lies sqrt(2) cells back, in column 18. The map has endpoints in cell A = (20, 0) (the nearest),

@@ -300,7 +300,22 @@ STOPPED = -1.0
 
 @njit(cache=True, nogil=True, fastmath={"nnan", "ninf", "nsz"})
 def score_3x3(
-    directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats, ints, row=2, floor=-1.0
+    directory,
+    mean,
+    tile_col0,
+    tile_row0,
+    res,
+    x,
+    y,
+    theta,
+    lx,
+    ly,
+    sigma,
+    floats,
+    ints,
+    row=2,
+    floor=-1.0,
+    canonical=None,
 ):  # pragma: no cover - compiled
     """The score of :func:`score_pose` for its default window (``kernel`` 1, no free-cell test), bit for
     bit, in stages that keep each loop short: the hill climbing's hot spot. Blocks of :data:`_BLOCK`
@@ -321,8 +336,14 @@ def score_3x3(
     is taken only when it scores strictly more). The sum is the same sequence of additions either way,
     so a score that is returned is the same number bit for bit.
 
+    Beams in another order: with ``canonical`` (int64 ``[B]``), ``lx`` and ``ly`` hold the scan's beams
+    in another order, beam ``b`` of the scan at position ``canonical[b]``. The blocks and the early stop
+    then go in the given order (:func:`match_particles` puts first the beams that are likely to add
+    nothing, so that the bound falls fast), and the score returned is the sum in the scan's own order,
+    the same number bit for bit as with the beams in that order.
+
     ``floats`` and ``ints`` come from :func:`score_scratch` (at least ``len(lx)`` columns); the window
-    minima are left in ``floats[row]`` (``row`` 2, 3 or 4) for :func:`_likelihood_of`. The arithmetic per
+    minima are left in ``floats[row]`` (in the given order; ``row`` 2, 3 or 4) for :func:`_likelihood_of`. The arithmetic per
     beam is the same as in :func:`score_pose`, and the fast-math flags allowed here (no NaN, no
     infinity, no signed zero; all values are finite) do not change any result.
     """
@@ -345,12 +366,20 @@ def score_3x3(
             terms[b] = _exp_series_minus(best[b] * inv_sigma)
         for b in range(np.uint64(lo), np.uint64(hi)):
             d2 = best[b]
+            term = 0.0
             if d2 < _FOUND_D2:
                 a = d2 * inv_sigma
-                score += terms[b] if a <= _EXP_SERIES_MAX else math.exp(-a)
+                term = terms[b] if a <= _EXP_SERIES_MAX else math.exp(-a)
+            terms[b] = term
+            score += term
         if hi < n and score + (n - hi) + _BOUND_SLACK <= floor:
             return STOPPED
-    return score
+    if canonical is None:
+        return score
+    in_order = 0.0  # the beams were given in another order: the sum in the scan's own order
+    for b in range(n):
+        in_order += terms[canonical[b]]
+    return in_order
 
 
 @njit(cache=True, nogil=True, fastmath={"nnan", "ninf", "nsz"})
@@ -381,17 +410,19 @@ def likelihood_3x3(
         0,
         lx.shape[0],
     )
-    return _likelihood_of(floats[2], lsigma)
+    return _likelihood_of(floats[2], lsigma, np.arange(lx.shape[0]))
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _likelihood_of(best, lsigma):  # pragma: no cover - compiled
-    """The log-likelihood from the beams' window minima ``best`` ``[B]``, summed in beam order."""
+def _likelihood_of(best, lsigma, canonical):  # pragma: no cover - compiled
+    """The log-likelihood from the beams' window minima ``best`` ``[B]``, summed in the scan's beam order
+    (beam ``b`` at ``best[canonical[b]]``, as :func:`score_3x3` takes it)."""
     no_hit = -0.5 / lsigma
     likelihood = 0.0
     for b in range(best.shape[0]):
-        if best[b] < _FOUND_D2:
-            likelihood -= best[b] / lsigma
+        d2 = best[canonical[b]]
+        if d2 < _FOUND_D2:
+            likelihood -= d2 / lsigma
         else:
             likelihood += no_hit
     return likelihood
@@ -419,12 +450,14 @@ def _match_score(
     ints,
     row,
     floor,
+    canonical,
 ):  # pragma: no cover - compiled
     """The scan-matching score at one pose: :func:`score_3x3` for the default window (window minima left
-    in ``floats[row]``; :data:`STOPPED` when the score cannot exceed ``floor``), else :func:`score_pose`."""
+    in ``floats[row]``; :data:`STOPPED` when the score cannot exceed ``floor``; the beams in the order
+    ``canonical`` says), else :func:`score_pose` (the beams in the scan's order)."""
     if kernel == 1 and not free_test:
         return score_3x3(
-            directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats, ints, row, floor
+            directory, mean, tile_col0, tile_row0, res, x, y, theta, lx, ly, sigma, floats, ints, row, floor, canonical
         )
     score, _ = score_pose(
         directory,
@@ -484,11 +517,12 @@ def _hill_climb(
     floats,
     ints,
     seen,
+    canonical,
 ):  # pragma: no cover - compiled
     """GMapping's hill climbing from ``pose`` (spec/gmapping.md, section 3); returns (x, y, theta, score,
     row): with the default window, ``floats[row]`` holds the window minima at the returned pose (for its
-    likelihood). ``floats``, ``ints``: work arrays from :func:`score_scratch`; ``seen``: float64
-    ``[S, 3]`` work array.
+    likelihood, in the order of ``canonical``: see :func:`score_3x3`). ``floats``, ``ints``: work arrays
+    from :func:`score_scratch`; ``seen``: float64 ``[S, 3]`` work array.
 
     Three savings over the original, none of which changes the result:
 
@@ -528,6 +562,7 @@ def _hill_climb(
         ints,
         at,
         STOPPED,
+        canonical,
     )
     ld = lstep
     ad = astep
@@ -585,6 +620,7 @@ def _hill_climb(
                 ints,
                 scratch,
                 current,
+                canonical,
             )
             if local > current:
                 current = local
@@ -647,6 +683,8 @@ def match_particles(
     likelihoods = np.zeros(n)
     floats, ints = score_scratch(lx.shape[0])
     seen = np.empty((_SEEN_CAPACITY, 3))
+    canonical = np.arange(lx.shape[0])
+    given_x, given_y = lx, ly
     for p in range(n):
         directory = directories[p]
         x, y, t, best, row = _hill_climb(
@@ -656,8 +694,8 @@ def match_particles(
             tile_row0,
             res,
             poses[p],
-            lx,
-            ly,
+            given_x,
+            given_y,
             lfx,
             lfy,
             kernel,
@@ -670,14 +708,26 @@ def match_particles(
             floats,
             ints,
             seen,
+            canonical,
         )
         scores[p] = best
         if best > minimum_score:
             matched[p, 0] = x
             matched[p, 1] = y
             matched[p, 2] = math.atan2(math.sin(t), math.cos(t))
+        if p == 0 and kernel == 1 and not free_test:
+            # the beams that fit worst where the first particle's climb ended (things not in the map, walls
+            # not yet mapped) likely add little for every particle: the others score them first, so that
+            # a candidate's bound falls fast (score_3x3); the scores stay the same numbers
+            order = np.argsort(-floats[row], kind="mergesort")
+            canonical = np.empty_like(order)
+            canonical[order] = np.arange(order.shape[0])
+            given_x, given_y = lx[order], ly[order]
+            if best > minimum_score and matched[p, 2] == t:
+                likelihoods[p] = _likelihood_of(floats[row], lsigma, np.arange(lx.shape[0]))
+                continue
         if kernel == 1 and not free_test and best > minimum_score and matched[p, 2] == t:
-            likelihoods[p] = _likelihood_of(floats[row], lsigma)  # the climb scored this very pose last
+            likelihoods[p] = _likelihood_of(floats[row], lsigma, canonical)  # the climb scored this very pose last
         elif kernel == 1 and not free_test:
             likelihoods[p] = likelihood_3x3(
                 directory,

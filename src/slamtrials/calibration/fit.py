@@ -204,6 +204,7 @@ def calibrate(
     laser_se = (
         np.std(np.array(laser_draws), axis=0, ddof=1) if len(laser_draws) > 1 else np.full(len(LASER_VALUES), math.nan)
     )
+    laser_se[LASER_VALUES.index("edge_reach")] = 0.0  # a setting, not fitted: the same in every replicate
     odo_se = np.std(np.array(odo_draws), axis=0, ddof=1) if len(odo_draws) > 1 else np.full(6, math.nan)
     lifetime = fit_lifetime(record, reference, laser, cfg, seed=seed)
     lifetime_values = (

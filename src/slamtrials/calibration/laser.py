@@ -264,8 +264,9 @@ def _short_readings_in_window(
 def edge_readings(
     sample: BeamSample, fit: LaserFit, short_sigmas: float
 ) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
-    """bool ``[N]`` twice: the far-side beams counted for ``edge_chance`` (returned, and not short of the
-    nearer wall's window), and those of them that read the nearer wall (module docstring)."""
+    """bool ``[N]`` twice: the far-side beams counted for ``edge_chance`` (returned, their own wall's window
+    beyond the nearer wall's, and not short of the nearer wall's window), and those of them that read the
+    nearer wall (module docstring)."""
     far_side = np.isfinite(sample.nearer) & (sample.nearer < sample.cast - EDGE_MIN_STEP) & ~sample.no_return
     near = np.where(far_side, sample.nearer, sample.cast)
     centre = fit.short_below(near, 0.0)  # the nearer wall moved by its bin's median residual

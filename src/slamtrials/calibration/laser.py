@@ -258,7 +258,7 @@ def _short_readings_in_window(
     below = stablemath.power(np.clip((low - range_min) / span, 0.0, 1.0), power)
     above = stablemath.power(np.clip((high - range_min) / span, 0.0, 1.0), power)
     chance = short_chances(wall, v["short_rate"], v["short_range_scale"], v["short_range_shape"])
-    return float(np.sum(chance * (above - below)))
+    return math.fsum((chance * (above - below)).tolist())  # exactly rounded: the same on every CPU
 
 
 def edge_readings(

@@ -226,7 +226,8 @@ def _candidates(
     taus, along = [], []  # along the lifetime, for every fleeting share at once: [F, n, L] pieces
     for i in range(grid.size - 1):
         low, high = grid[i], grid[i + 1]
-        taus.append(low + (high - low) * a if low == 0.0 else low * (high / low) ** a)
+        # stablemath, not numpy's power: the same bits on every CPU (numpy's differs with AVX-512)
+        taus.append(low + (high - low) * a if low == 0.0 else low * stablemath.power(high / low, a))
         along.append((1.0 - a)[None, :, None] * model[:, i, None, :] + a[None, :, None] * model[:, i + 1, None, :])
     taus.append(grid[-1:])
     along.append(model[:, -1:, :])

@@ -157,6 +157,41 @@ def test_reproducible_layers_take_transcendental_functions_from_stablemath(path:
             assert not isinstance(node.op, ast.MatMult), (
                 f"{path}:{node.lineno}: '@' runs BLAS, whose kernels differ by CPU"
             )
+        assert not machine_dependent_power(node), (
+            f"{path}:{node.lineno}: '{ast.unparse(node)}': '**' on a numpy array is numpy's power, whose "
+            "AVX-512 code differs from the C library's; use slamtrials.stablemath.power"
+        )
+
+
+def machine_dependent_power(node: ast.AST) -> bool:
+    """Whether ``node`` is ``a ** b`` with an exponent other than a whole number or 0.5. The source does not
+    say whether ``a`` is an array. On an array numpy computes 2, 1, 0, -1 and 0.5 exactly (a square, a copy,
+    a reciprocal, a square root) and every other exponent with a ``pow`` whose AVX-512 code differs; on a
+    float, Python's and numba's ``**`` are the C library's. A fractional exponent is flagged wherever it
+    is (a float in one place is an array in another); other whole ones are let through, as the
+    codebase's few (``2 ** 63``, karto's cube of a scalar quality) are on scalars."""
+    if not (isinstance(node, ast.BinOp) and isinstance(node.op, ast.Pow)):
+        return False
+    exponent = node.right
+    if isinstance(exponent, ast.UnaryOp) and isinstance(exponent.op, ast.USub):
+        exponent = exponent.operand
+    return not (isinstance(exponent, ast.Constant) and (isinstance(exponent.value, int) or exponent.value == 0.5))
+
+
+@pytest.mark.parametrize(
+    ("source", "flagged"),
+    [
+        ("low * (high / low) ** a", True),
+        ("x ** 1.5", True),
+        ("x ** -0.7", True),
+        ("x ** 2", False),
+        ("x ** -1", False),
+        ("x ** 0.5", False),
+        ("np.hypot(x, y)", False),
+    ],
+)
+def test_power_guard_flags_exponents_numpy_computes_with_pow(source: str, flagged: bool) -> None:
+    assert any(machine_dependent_power(node) for node in ast.walk(ast.parse(source))) == flagged
 
 
 #: fast-math flags that let LLVM change results by the CPU it compiles for (vector width, FMA, approximations).

@@ -39,7 +39,8 @@ class Frame:
         Time in seconds since the start of the run.
     ranges:
         float32 ``[B]`` laser ranges in metres, beam 0 at the laser's ``angle_min``, counter-clockwise;
-        a beam that hits nothing within the laser's max range reads exactly ``max_range``.
+        a beam with no return reads ``+inf`` from the simulator (ROS REP 117); readings from real logs
+        may say no return with a value at or above ``range_max``. Every consumer treats both alike.
     odometry:
         float64 ``[3]`` pose of the robot base in the odometry frame.
     truth:
@@ -67,7 +68,8 @@ class LaserGeometry:
     angle_increment:
         Angle (rad) between neighbouring beams, > 0.
     range_min, range_max:
-        Shortest and longest valid reading (m); a reading of ``range_max`` or more is "no return".
+        Shortest and longest valid reading (m); a reading of ``range_max`` or more, or ``+inf``, is "no
+        return" and marks nothing (it says nothing about where the nearest surface is).
     mount:
         Pose (x, y, theta) of the laser in the robot base frame, metres and radians.
     """

@@ -53,7 +53,7 @@ def test_laser_geometry_of_the_paper():
     assert np.allclose(np.diff(angles), math.radians(0.5), atol=1e-12)
     info = cfg.geometry()
     assert (info.angle_min, info.angle_increment) == (cfg.angle_min, cfg.angle_increment)
-    assert info.range_max == 30.0 and info.mount == (0.0, 0.0, 0.0)
+    assert info.range_max == 80.0 and info.mount == (0.0, 0.0, 0.0)  # the seed's Stage laser
 
 
 @pytest.mark.parametrize("origin", [(0.0, 0.0, 0.0), (-3.0, 2.0, 0.0)])
@@ -96,40 +96,30 @@ def test_open_grid_rays_stop_at_the_image_border():
     np.testing.assert_allclose(ranges, expected, atol=1e-4, rtol=0)
 
 
-def test_beams_into_open_space_read_exactly_max_range():
-    # A 100 m x 100 m empty room; from its centre, nothing is within 30 m.
-    world = room_world(size_m=100.0)
+def test_beams_into_open_space_read_exactly_max_range_inside_and_inf_as_a_reading():
+    # A 200 m x 200 m empty room; from its centre, nothing is within 80 m.
+    world = room_world(size_m=200.0)
     laser = LaserModel(world, LaserConfig())
-    ranges = laser.true_ranges([50.0, 50.0, 0.123])
-    assert np.all(ranges == np.float32(30.0))
-    # Near a wall: beams towards the wall hit it, the others read max range exactly.
-    ranges = laser.true_ranges([50.0, 4.0, 0.0])
-    assert ranges.max() == np.float32(30.0)
-    assert np.all((ranges == np.float32(30.0)) | (ranges < 30.0))
+    ranges = laser.true_ranges([100.0, 100.0, 0.123])
+    assert np.all(ranges == np.float32(80.0))  # the raycast's own value
+    assert np.all(np.isposinf(laser.scan([100.0, 100.0, 0.123], np.random.default_rng(0))))  # REP 117
+    # Near a wall: beams towards the wall hit it, the others have no return.
+    pose = [100.0, 4.0, 0.0]
+    ranges = laser.true_ranges(pose)
+    assert ranges.max() == np.float32(80.0)
+    assert np.all((ranges == np.float32(80.0)) | (ranges < 80.0))
     right = np.argmin(np.abs(laser.angles + math.pi / 2))  # pointing down, at the wall y = 0.05
     assert ranges[right] == pytest.approx(3.95, abs=1e-5)
+    reading = laser.scan(pose, np.random.default_rng(0))
+    np.testing.assert_array_equal(np.isposinf(reading), ranges == np.float32(80.0))
+    np.testing.assert_array_equal(reading[ranges < 80.0], ranges[ranges < 80.0])
 
 
-def test_short_max_range():
-    world = room_world()
-    laser = LaserModel(world, LaserConfig(max_range=2.0))
-    ranges = laser.true_ranges([5.0, 1.0, 0.0])
-    down = np.argmin(np.abs(laser.angles + math.pi / 2))
-    assert ranges[down] == pytest.approx(0.95, abs=1e-5)
-    assert ranges.max() == np.float32(2.0)
-    assert np.all(ranges <= 2.0)
-
-
-def test_mount_offset_is_honoured():
-    world = room_world()
-    mount = (0.2, -0.1, math.pi / 2)
-    mounted = LaserModel(world, LaserConfig(mount=mount))
-    centred = LaserModel(world, LaserConfig())
-    pose = np.array([4.0, 6.0, 0.3])
-    np.testing.assert_array_equal(mounted.true_ranges(pose), centred.true_ranges(compose(pose, np.array(mount))))
-    # Known answer: facing +x with the laser 0.2 m ahead, turned to face +y: beam 270 (angle 0) sees y = 9.95.
-    ranges = mounted.true_ranges([4.0, 6.0, 0.0])
-    assert ranges[270] == pytest.approx(9.95 - 5.9, abs=1e-5)
+def test_a_shorter_laser_reports_walls_beyond_its_range_as_no_returns():
+    world = room_world(size_m=100.0)
+    laser = LaserModel(world, LaserConfig(max_range=30.0))
+    reading = laser.scan([50.0, 50.0, 0.123], np.random.default_rng(0))
+    assert np.all(np.isposinf(reading))
 
 
 def test_origin_inside_a_wall_reads_zero_then_min_range():
@@ -142,7 +132,7 @@ def test_origin_inside_a_wall_reads_zero_then_min_range():
 
 def test_range_noise():
     world = room_world(size_m=40.0)
-    cfg = LaserConfig(range_noise_std=0.02)
+    cfg = LaserConfig(range_noise_std=0.02, max_range=30.0)
     laser = LaserModel(world, cfg)
     pose = np.array([5.0, 5.0, 0.0])
     true = laser.true_ranges(pose)
@@ -151,10 +141,10 @@ def test_range_noise():
     np.testing.assert_array_equal(a, b)
     hit = true < 30.0
     assert (~hit).any() and hit.any()
-    np.testing.assert_array_equal(a[~hit], true[~hit])  # no-return readings stay exact
+    assert np.all(np.isposinf(a[~hit]))  # no-return readings stay no-returns
     err = a[hit].astype(float) - true[hit]
     assert 0.01 < err.std() < 0.03 and abs(err.mean()) < 0.01
-    assert np.all(a >= cfg.min_range) and np.all(a <= cfg.max_range)
+    assert np.all(a[hit] >= cfg.min_range) and np.all(a[hit] <= cfg.max_range)
 
 
 def test_no_noise_leaves_the_random_stream_alone():

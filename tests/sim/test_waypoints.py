@@ -37,7 +37,7 @@ def test_route_through_a_door_completes():
     assert rec.t[0] == 0.0 and np.allclose(np.diff(rec.t), 0.1)
     assert rec.scans.shape == (len(rec), 541) and rec.scans.dtype == np.float32
     np.testing.assert_array_equal(rec.odometry[0], [0.0, 0.0, 0.0])
-    assert rec.laser.range_max == 30.0
+    assert rec.laser.range_max == 80.0
     json.dumps(meta)
 
 

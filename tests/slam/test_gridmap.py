@@ -47,34 +47,50 @@ def test_scan_in_square_room_marks_walls_occupied_inside_free_outside_unknown():
     assert grid.grid.dtype == np.int8
 
 
-def test_max_range_and_too_long_beams_mark_only_free_space_up_to_max_urange():
+def test_no_returns_mark_nothing_and_too_long_beams_mark_free_space_only_up_to_max_urange():
     gmap = GridMap(RES)
-    angles = np.array([0.0, np.pi / 2, np.pi, -np.pi / 2, 0.1])
-    ranges = np.array([30.0, np.inf, 5.0, np.nan, 0.0])  # no return, no return (REP 117), too long, nothing, nothing
+    angles = np.array([0.0, np.pi / 2, np.pi, -np.pi / 2, 0.1, 0.8])
+    # no return at range_max, no return (REP 117), too long, nothing, nothing, beyond range_max
+    ranges = np.array([30.0, np.inf, 5.0, np.nan, 0.0, 45.0])
     gmap.integrate(np.array([0.0, 0.0, 0.0]), ranges, angles, range_min=0.0, range_max=30.0, max_urange=2.0)
     grid = gmap.occupancy()
     assert not np.any(grid.grid == 100)
     x, y = _cell_centres(grid)
     free = grid.grid == 0
-    assert np.all(np.hypot(x[free], y[free]) < 2.0 + RES)
-    on_x = np.isclose(y, RES / 2) & (x > 0)
-    assert free[on_x & (x < 1.95)].all() and not free[on_x & (x > 2.05)].any()
     on_minus_x = np.isclose(y, RES / 2) & (x < -RES)
     assert free[on_minus_x & (x > -1.95)].all()  # the 5 m return is cut at 2 m: free, no hit
-    assert not free[np.isclose(x, RES / 2) & (y < -RES)].any()  # the NaN beam marked nothing
+    assert not free[on_minus_x & (x < -2.05)].any()
+    # only that beam marked anything: every free cell lies along the -x axis, within 2 m
+    assert np.all(np.abs(y[free]) < RES) and np.all(x[free] < RES) and np.all(x[free] > -2.0 - RES)
+
+
+def test_a_no_return_beside_walls_draws_no_free_space_through_them():
+    # a laser in the middle of a 4 m room sees its walls; one beam missed a return (+inf) and one read
+    # the sensor's maximum (how Stage reports it): beyond the walls nothing may be free
+    angles = np.linspace(-np.pi, np.pi, 720, endpoint=False)
+    ranges = np.minimum(2.0 / np.maximum(np.abs(np.cos(angles)), np.abs(np.sin(angles))), 30.0)
+    ranges[100], ranges[400] = np.inf, 30.0
+    gmap = GridMap(RES)
+    gmap.integrate(np.zeros(3), ranges, angles, range_min=0.0, range_max=30.0, max_urange=30.0)
+    grid = gmap.occupancy()
+    x, y = _cell_centres(grid)
+    free = grid.grid == 0
+    assert free.sum() > 1000
+    assert np.all(np.maximum(np.abs(x[free]), np.abs(y[free])) < 2.0)
 
 
 def test_endpoints_classify_returns_cuts_and_ignored_beams():
     ends, hit = beam_endpoints(
         [1.0, 2.0, np.pi / 2],
-        [1.0, 0.05, 40.0, 3.0],
-        [0.0, 0.0, 0.0, 0.0],
+        [1.0, 0.05, 40.0, 3.0, np.inf],
+        [0.0, 0.0, 0.0, 0.0, 0.0],
         range_min=0.1,
         range_max=40.0,
         max_urange=2.5,
     )
-    np.testing.assert_allclose(ends, [[1.0, 3.0], [1.0, 4.5], [1.0, 4.5]], atol=1e-12)
-    assert hit.tolist() == [True, False, False]
+    # 1 m: a return; 0.05 m: below range_min; 40 m and inf: no returns; 3 m: cut at 2.5 m
+    np.testing.assert_allclose(ends, [[1.0, 3.0], [1.0, 4.5]], atol=1e-12)
+    assert hit.tolist() == [True, False]
 
 
 def test_growing_keeps_world_coordinates():

@@ -94,7 +94,7 @@ def open_side(ranges: ArrayLike, laser: LaserGeometry) -> float:
     """+1.0 if the scan sees more room to the left (beam angle > 0) than to the right, else -1.0."""
     r = np.asarray(ranges, dtype=np.float64)
     angles = laser.beam_angles(r.shape[0])
-    r = np.where(np.isfinite(r), np.minimum(r, laser.range_max), 0.0)
+    r = np.where(np.isnan(r), 0.0, np.minimum(r, laser.range_max))  # a no-return (+inf) looks into the open
     r = np.minimum(r, 5.0)  # what matters is the room nearby
     left = float(r[angles > 0.0].sum())
     right = float(r[angles < 0.0].sum())

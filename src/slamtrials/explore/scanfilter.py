@@ -85,9 +85,11 @@ def inside_footprint(ranges: ArrayLike, laser: LaserGeometry, radius: float) -> 
     if radius <= 0.0 or r.shape[0] == 0:
         return r
     cos, sin = _beam_directions(r.shape[0], laser)
-    px = laser.mount[0] + r * cos
-    py = laser.mount[1] + r * sin
-    r[px * px + py * py < radius * radius] = np.nan
+    finite = np.isfinite(r)  # a no-return (+inf) ends nowhere
+    reach = np.where(finite, r, 0.0)
+    px = laser.mount[0] + reach * cos
+    py = laser.mount[1] + reach * sin
+    r[finite & (px * px + py * py < radius * radius)] = np.nan
     return r
 
 

@@ -98,6 +98,9 @@ def carmen_from_run(record: RunRecord, *, kind: str = "ROBOTLASER1", hostname: s
         Laser ``t`` = ``record.t``, ``logger_t`` = time since the first frame, first pose triple = ground
         truth of the base (world frame), second = odometry. ODOM lines repeat the odometry with the
         velocities of the step that ended at each frame. PARAMs give the laser mounting and minimum range.
+        A no-return (``+inf``, REP 117) is written as the laser's maximum range, as CARMEN logs and SICK
+        scanners give it (CARMEN text has no infinity); readers take a reading at ``range_max`` for a
+        no-return.
     """
     if kind not in LASER_KINDS:
         raise ValueError(f"kind must be one of {LASER_KINDS}, got {kind!r}")
@@ -118,7 +121,7 @@ def carmen_from_run(record: RunRecord, *, kind: str = "ROBOTLASER1", hostname: s
             t=t.copy(),
             logger_t=logger_t,
             hostname=hostname,
-            ranges=np.asarray(record.scans, dtype=np.float32),
+            ranges=np.minimum(np.asarray(record.scans, dtype=np.float32), np.float32(laser.range_max)),
             pose=np.asarray(record.truth, dtype=np.float64),
             odometry=odometry,
             angle_min=laser.angle_min,

@@ -40,7 +40,7 @@ from slamtrials.sim.config import LaserConfig
 from slamtrials.sim.unmapped import UnmappedScan, UnmappedThings
 from slamtrials.worlds.world import World, world_to_map
 
-__all__ = ["RaycastMap", "LaserModel", "cast_scan", "cast_scan_dda", "SAFETY_CELLS"]
+__all__ = ["RaycastMap", "LaserModel", "cast_scan", "cast_scan_dda", "as_no_returns", "SAFETY_CELLS"]
 
 #: Margin (cells) subtracted from the distance field before a jump: sqrt(2) (a point anywhere in the
 #: current cell, an occupied square anywhere around its centre) plus slack for float32 storage.
@@ -215,6 +215,19 @@ def cast_scan_dda(
     return _run(dist, origin_uv, theta, angles, max_range, resolution, False, out)
 
 
+def as_no_returns(readings: NDArray[np.float32], max_range: float) -> NDArray[np.float32]:
+    """``readings`` float32 ``[B]`` (m) with every reading at or beyond ``max_range`` (m) set to ``+inf``, in place.
+
+    The simulated laser reports a beam with no return as ROS REP 117 asks of a driver: ``+inf``, not a
+    range (Stage reports its maximum, which a mapper cannot tell from a wall at that distance). Inside
+    the simulator (the raycast and :mod:`slamtrials.sim.laser_errors`) a no-return is ``max_range``;
+    this is the one place where it becomes ``+inf``. Every consumer takes a reading ``>= range_max`` or
+    ``+inf`` for a no-return and skips it (:mod:`slamtrials.slam.gridmap`).
+    """
+    readings[readings >= np.float32(max_range)] = np.inf
+    return readings
+
+
 class RaycastMap:
     """A world's grid prepared for ray casting: a float32 distance field, flipped so rows go up.
 
@@ -300,7 +313,8 @@ class LaserModel:
         With any error model on (range noise, dropouts, short readings), the true ranges go through
         :func:`slamtrials.sim.laser_errors.apply_laser_errors`, which draws a fixed number of deviates
         per scan from ``rng``. Otherwise the readings are the true ranges, raised to ``min_range``, and
-        ``rng`` is not used. ``t`` (s), the scan's time, is needed when ``short_lifetime > 0``: the things
+        ``rng`` is not used. A beam with no return (nothing hit within ``max_range``, or a dropout) reads
+        ``+inf``, as ROS REP 117 asks of a laser driver (:func:`as_no_returns`). ``t`` (s), the scan's time, is needed when ``short_lifetime > 0``: the things
         not in the map that earlier scans saw stay in this model (:mod:`slamtrials.sim.unmapped`).
         """
         from slamtrials.sim.laser_errors import apply_laser_errors, incidence_cosines
@@ -320,10 +334,10 @@ class LaserModel:
                 if t is None:
                     raise ValueError("a laser with short_lifetime > 0 needs each scan's time t")
                 unmapped = UnmappedScan(self._things, lp, self.angles, cfg.angular_resolution, float(t))
-            return apply_laser_errors(ranges, cfg, rng, incidence, unmapped)
+            return as_no_returns(apply_laser_errors(ranges, cfg, rng, incidence, unmapped), cfg.max_range)
         if cfg.min_range > 0.0:
             np.maximum(ranges, np.float32(cfg.min_range), out=ranges)
-        return ranges
+        return as_no_returns(ranges, cfg.max_range)
 
     def geometry(self) -> LaserGeometry:
         """The laser's geometry, as :class:`~slamtrials.record.RunRecord` records it."""

@@ -12,12 +12,14 @@ range ``max_urange`` (<= ``range_max``):
 * ``range_min < r < range_max`` and ``r <= max_urange``: a return. Every cell the segment from the
   laser to the endpoint crosses, before the endpoint's cell, gets a visit; the endpoint's cell gets a
   visit and a hit;
-* ``r > max_urange`` (a return too far to trust): cut at ``max_urange``; the cells before the cut
-  point's cell get a visit, nothing is marked occupied;
-* ``r >= range_max`` or ``+inf`` (no return, REP 117): free space up to ``min(range_max, max_urange)``,
-  marked like a cut beam. This is what GMapping does when its ``maxRange`` exceeds the laser's range (as
-  in the seed paper's set-up: maxUrange 30 m, maxRange 60 m); a max-range reading never marks a cell
-  occupied.
+* ``max_urange < r < range_max`` (a return too far to trust): cut at ``max_urange``; the cells before
+  the cut point's cell get a visit, nothing is marked occupied;
+* ``r >= range_max`` or ``+inf`` (no return, ROS REP 117): nothing, like a NaN. A beam without a
+  return says nothing about where the wall is, so it marks no free space either: slam_gmapping skips
+  it (its ``maxRange`` defaults to the laser's ``range_max - 0.01``, and the seed paper's maxRange of
+  60 m lay below its Stage laser's 80 m), as do slam_karto and slam_toolbox (readings at or beyond the
+  sensor's maximum range). Tracing such beams as free space up to ``max_urange`` would draw free space
+  through every wall the laser missed a return from (dark, glossy or glass surfaces).
 
 Cells are traversed exactly (Amanatides and Woo): every cell the segment passes through, in order.
 
@@ -155,10 +157,9 @@ def scan_endpoints(
     r = np.asarray(ranges, dtype=np.float64)
     a = np.asarray(angles, dtype=np.float64)
     pose = np.asarray(laser_poses, dtype=np.float64)
-    no_return = (r >= range_max) | np.isposinf(r)
-    usable = (~np.isnan(r) & (r > range_min)) | no_return
-    length = np.where(usable, np.minimum(np.where(no_return, range_max, r), max_urange), 0.0)
-    hit = usable & ~no_return & (r <= max_urange)
+    usable = (r > range_min) & (r < range_max)  # False for NaN and for no-returns (>= range_max, +inf)
+    length = np.where(usable, np.minimum(r, max_urange), 0.0)
+    hit = usable & (r <= max_urange)
     heading = pose[:, 2:3] + a
     return pose[:, 0:1] + length * stablemath.cos(heading), pose[:, 1:2] + length * stablemath.sin(heading), usable, hit
 

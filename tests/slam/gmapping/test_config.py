@@ -22,7 +22,7 @@ LASER = LaserGeometry.from_dict(
     {"angle_min": -2.35, "angle_increment": 0.0087, "range_min": 0.0, "range_max": 30.0, "mount": [0.0, 0.0, 0.0]}
 )
 
-#: slam_gmapping's defaults (spec table, column 1); maxUrange / maxRange: the laser's range (None).
+#: slam_gmapping's defaults (spec table, column 1); maxUrange / maxRange: from the laser's range (None).
 SLAM_GMAPPING_DEFAULTS = {
     "particles": 30,
     "linearUpdate": 1.0,
@@ -71,9 +71,10 @@ def test_defaults_are_slam_gmappings():
         assert getattr(config, name) == value, name
     assert config.free_cell_test is False  # behaves like the original code by default
     assert config.initial_pose is None
-    # maxUrange / maxRange default to the laser's range
+    # maxUrange defaults to the laser's range, maxRange to slam_gmapping's range_max - 0.01: a reading at
+    # the sensor's maximum (no return) is skipped
     algorithm = make_algorithm("gmapping", LASER)
-    assert algorithm.max_urange == LASER.range_max and algorithm.max_range == LASER.range_max
+    assert algorithm.max_urange == LASER.range_max and algorithm.max_range == LASER.range_max - 0.01
 
 
 def test_paper_preset_has_the_spec_values_and_defaults_elsewhere():

@@ -13,7 +13,7 @@ from typing import Any
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-__all__ = ["GMappingConfig", "PRESETS"]
+__all__ = ["GMappingConfig", "PRESETS", "default_max_range"]
 
 
 class GMappingConfig(BaseModel):
@@ -56,7 +56,8 @@ class GMappingConfig(BaseModel):
         Usable range (m): longer beams are not used by the filter and, in the published map, are cut
         here and mark only free cells. ``None``: the laser's range_max.
     maxRange:
-        Beams longer than this are ignored entirely. ``None``: the laser's range_max.
+        Beams longer than this are ignored entirely. ``None``: the laser's ``range_max - 0.01``, as
+        slam_gmapping sets it, so that a reading at the sensor's maximum (no return) is skipped.
     occ_thresh:
         Published map: occupied where hits / visits exceeds this.
     map_update_interval:
@@ -95,7 +96,7 @@ class GMappingConfig(BaseModel):
         None, gt=0.0, le=1000.0, description="usable range (m); None: the laser's range_max"
     )
     maxRange: float | None = Field(
-        None, gt=0.0, le=1000.0, description="beams beyond are ignored (m); None: the laser's range_max"
+        None, gt=0.0, le=1000.0, description="beams beyond are ignored (m); None: the laser's range_max - 0.01"
     )
     occ_thresh: float = Field(0.25, ge=0.0, lt=1.0, description="published map: occupied when hits/visits exceeds this")
     map_update_interval: float = Field(5.0, ge=0.0, le=1.0e6, description="seconds between published-map rebuilds")
@@ -133,3 +134,10 @@ PRESETS: dict[str, dict[str, Any]] = {
         "maxRange": 60.0,
     },
 }
+
+
+def default_max_range(range_min: float, range_max: float) -> float:
+    """GMapping's ``maxRange`` (m) when the config leaves it unset: slam_gmapping's ``range_max - 0.01``,
+    or ``range_max`` itself for a laser too short for that (``range_max - 0.01 <= range_min``)."""
+    cut = range_max - 0.01
+    return cut if cut > range_min else range_max

@@ -24,9 +24,11 @@ ancestry (GMapping's ``weightSum``, which resampling does not reset), not the la
 last resampling.
 
 Beams. A beam is used by the filter when ``range_min < r < range_max`` (a return), ``r <= maxUrange`` and
-``r <= maxRange``; NaN, zero and no-return readings (``r >= range_max``, REP 117) are not. The published
-map uses every return up to ``maxRange`` (cut at ``maxUrange``) and no-return readings as free space up
-to ``maxUrange`` (:mod:`slamtrials.slam.gridmap`).
+``r <= maxRange``; NaN, zero and no-return readings (``r >= range_max`` or ``+inf``, REP 117) are not. The
+published map uses every return up to ``maxRange`` (cut at ``maxUrange``, marking free space only up to
+the cut) and skips the rest, no-returns included (:mod:`slamtrials.slam.gridmap`). As in slam_gmapping,
+``maxRange`` defaults to the laser's ``range_max - 0.01``, so a reading at the sensor's maximum (how Stage
+and many drivers report no return) is skipped too.
 
 Free-cell test. The original's likelihood is meant to skip a window cell whose "free" cell in front of
 the endpoint holds endpoints, but its free cell lands off the map, so the test never rejects anything.
@@ -52,7 +54,7 @@ from slamtrials import stablemath
 from slamtrials.geometry import compose, compose1, inverse, ominus, wrap_angle1
 from slamtrials.record import Frame, LaserGeometry, Trajectory
 from slamtrials.slam.base import OccupancyGrid, register_algorithm
-from slamtrials.slam.gmapping.config import PRESETS, GMappingConfig
+from slamtrials.slam.gmapping.config import PRESETS, GMappingConfig, default_max_range
 from slamtrials.slam.gmapping.kernels import match_particles
 from slamtrials.slam.gmapping.lineage import Lineage
 from slamtrials.slam.gmapping.motion import sample_motion
@@ -95,7 +97,9 @@ class GMapping:
         self.range_min = laser.range_min
         self.range_max = laser.range_max
         self.max_urange = self.range_max if config.maxUrange is None else float(config.maxUrange)
-        self.max_range = self.range_max if config.maxRange is None else float(config.maxRange)
+        self.max_range = (
+            default_max_range(self.range_min, self.range_max) if config.maxRange is None else float(config.maxRange)
+        )
         self.reset(np.random.default_rng(0))
 
     # ------------------------------------------------------------------ state

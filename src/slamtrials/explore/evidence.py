@@ -1,14 +1,12 @@
 """The explorer's own evidence of free and occupied space, from the laser returns it saw itself.
 
-Why. GMapping (and the seed paper's set-up, ``maxRange`` 60 m beyond the laser's 30 m) draws a beam
-with no return as free space out to ``maxUrange``. A real laser also returns nothing from some surfaces
-in reach (dark, glossy or glass; 3.6 % of the beams in the MIT CSAIL log, and the ``realistic``
-profile's dropouts), so every such beam paints a line of free cells *through* the wall it missed. The
-published map then holds a halo of free space around the building, tens of metres wide and full of
-frontier cells, and walls worn into gaps by these rays. The frontier explorer chases the halo through
-the gaps, the laser shows a wall there, the goal fails, and the next halo cell is chosen: with the
-``realistic`` profile, 57 of the 70 goals of office_small_01 (seed 1) lay outside the building and the
-trial ran until the snapshot rule stopped it at 1,560 s of simulated time (172 s with ``paper``).
+Why. The explorer plans on the map the SLAM algorithm returns, and an algorithm under test may trace
+beams without a return as free space out to its usable range (the built-in ones skip them, as
+slam_gmapping does: :mod:`slamtrials.slam.gridmap`). A real laser returns nothing from some surfaces in
+reach (dark, glossy or glass; 3.6 % of the beams in the MIT CSAIL log, and the ``realistic`` profile's
+dropouts), so every such beam would paint a line of free cells *through* the wall it missed: a halo of
+free space around the building, full of frontier cells, and walls worn into gaps. A frontier explorer
+would chase the halo through the gaps. This layer keeps exploration sane on such maps.
 
 What. :class:`EvidenceLayer` counts, on a grid anchored at the map frame's origin with the map's
 resolution, the cells each *return* of the explorer's scans crossed (passes) and ended in (hits),

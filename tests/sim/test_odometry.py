@@ -117,7 +117,7 @@ def test_odometry_starts_at_zero_and_integrates_a_biased_square():
     assert np.abs(sim.odometry - (sim.truth - world.start)).max() > 1e-3
 
 
-def test_noise_is_zero_mean_proportional_and_seeded():
+def test_noise_is_zero_mean_a_random_walk_in_motion_and_seeded():
     cfg = OdometryConfig(bias_linear=0.0, bias_angular=0.0, noise_linear_per_m=0.05, noise_angular_per_rad=0.1)
     delta = arc_increment(0.5, 0.2, 0.1)
     results = []
@@ -125,11 +125,13 @@ def test_noise_is_zero_mean_proportional_and_seeded():
         odo = Odometry(cfg, draw_bias(cfg, np.random.default_rng(seed)), np.random.default_rng(seed))
         results.append(odo.update(delta).copy())
     results = np.array(results)
-    length = 0.05  # arc length of the step
+    length = 0.05  # arc length of the step; its heading change is 0.02 rad
+    # a random walk per metre and per radian: std 0.05 m/sqrt(m) * sqrt(0.05 m), 0.1 rad/sqrt(rad) * sqrt(0.02 rad)
+    std_length, std_heading = 0.05 * math.sqrt(length), 0.1 * math.sqrt(0.02)
     lengths = np.hypot(results[:, 0], results[:, 1])
-    assert abs(lengths.mean() - length) < 3 * 0.05 * length / math.sqrt(400) + 1e-9
-    assert lengths.std() == pytest.approx(0.05 * length, rel=0.2)
-    assert results[:, 2].std() == pytest.approx(0.1 * 0.02, rel=0.2)
+    assert abs(lengths.mean() - length) < 3 * std_length / math.sqrt(400) + 1e-9
+    assert lengths.std() == pytest.approx(std_length, rel=0.2)
+    assert results[:, 2].std() == pytest.approx(std_heading, rel=0.2)
     # Same seed, same result; no motion, no noise.
     a = Odometry(cfg, {"linear": 0.0, "angular": 0.0}, np.random.default_rng(1)).update(delta)
     b = Odometry(cfg, {"linear": 0.0, "angular": 0.0}, np.random.default_rng(1)).update(delta)
@@ -144,3 +146,38 @@ def test_no_noise_draws_nothing():
     state = rng.bit_generator.state
     Odometry(cfg, {"linear": 0.003, "angular": 0.01}, rng).update([0.05, 0.0, 0.01])
     assert rng.bit_generator.state == state
+
+
+def test_noise_of_a_step_cut_in_pieces_adds_up_to_the_noise_of_the_whole_step():
+    """Cut invariance for a single step: one step of 0.2 m and 0.1 rad, or the same arc in 1, 7 or 400
+    pieces (a zero-motion step among them), gives the same spread of the summed arc-length and heading errors."""
+    cfg = OdometryConfig(
+        bias_linear=0.0, bias_angular=0.0, noise_linear_per_m=0.04, noise_angular_per_rad=0.05,
+        noise_linear_per_rad=0.02, noise_angular_per_m=0.03,
+    )  # fmt: skip
+    expected_length = math.sqrt(0.04**2 * 0.2 + 0.02**2 * 0.1)
+    expected_heading = math.sqrt(0.05**2 * 0.1 + 0.03**2 * 0.2)
+    for pieces in (1, 7, 400):
+        piece = arc_increment(0.2 / pieces, 0.1 / pieces, 1.0)
+        heading_errors, length_errors = [], []
+        for seed in range(300 if pieces == 400 else 1500):
+            odo = Odometry(cfg, {"linear": 0.0, "angular": 0.0}, np.random.default_rng(seed))
+            total_length = total_heading = 0.0
+            for k in range(pieces):
+                before = odo.pose.copy()
+                after = odo.update(piece).copy()
+                if k == 0:
+                    odo.update([0.0, 0.0, 0.0])  # a duplicated stamp: no motion, no noise
+                    np.testing.assert_array_equal(odo.pose, after)
+                phi = after[2] - before[2]
+                half = 0.5 * phi
+                total_heading += phi
+                mean_heading = before[2] + half  # the chord's direction; the arc length is signed
+                chord = math.cos(mean_heading) * (after[0] - before[0]) + math.sin(mean_heading) * (after[1] - before[1])
+                total_length += chord / (math.sin(half) / half)
+            heading_errors.append(total_heading - 0.1)
+            length_errors.append(total_length - 0.2)
+        n = len(heading_errors)
+        allowed = 4.5 * math.sqrt(2.0 / n)
+        assert np.mean(np.square(length_errors)) / expected_length**2 == pytest.approx(1.0, abs=allowed), pieces
+        assert np.mean(np.square(heading_errors)) / expected_heading**2 == pytest.approx(1.0, abs=allowed), pieces

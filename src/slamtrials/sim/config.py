@@ -334,12 +334,16 @@ class OdometryConfig(BaseModel):
     ``bias_angular_range`` (rad/rad). Every step, the odometry measures the true arc length times
     ``1 + e_lin`` and the true heading change times ``1 + e_ang`` (see :mod:`slamtrials.sim.odometry`).
 
-    Optional random noise (off by default, as in the paper): zero-mean Gaussian noise added to each
-    step's measured arc length, with standard deviation ``noise_linear_per_m * |arc length|``, and to
-    each step's heading change, with standard deviation ``noise_angular_per_rad * |heading change|``.
-    The standard deviations are proportional to the step's motion (the "alpha" model of Thrun et al.,
-    Probabilistic Robotics), so a robot that stands still gets no noise; the accumulated noise of a
-    given path therefore depends on the step length ``dt``.
+    Optional random noise (off by default, as in the paper): a random walk per metre driven and per
+    radian turned. A step of arc length ``L`` (m) and heading change ``phi`` (rad) adds zero-mean
+    Gaussian errors to its measured arc length, variance ``noise_linear_per_m^2 |L| +
+    noise_linear_per_rad^2 |phi|`` (m^2), and to its measured heading change, variance
+    ``noise_angular_per_rad^2 |phi| + noise_angular_per_m^2 |L|`` (rad^2). Variances grow linearly with
+    distance and angle, so the noise accumulated along a path does not depend on how it is cut into
+    steps (``dt``, or a log's irregular stamps), and a robot that stands still gets none. The
+    coefficients are therefore square roots of variance per unit of motion: m/sqrt(m), m/sqrt(rad),
+    rad/sqrt(rad), rad/sqrt(m). (Before issue 32 they were stds per unit of a 0.1 s step's motion, m/m
+    etc.; an old value ``k`` for steps of ``l`` metres is about ``k sqrt(l)`` here, 0.22 k for 0.05 m.)
 
     Attributes
     ----------
@@ -351,18 +355,20 @@ class OdometryConfig(BaseModel):
         Fixed values that replace the draws (the draws are still made, so the random stream of the
         rest of the run does not change). ``None`` (default) uses the draw.
     noise_linear_per_m:
-        Arc-length noise std per metre of the step's arc length (m/m). Default 0.
+        Arc-length random walk per metre driven (m/sqrt(m)): the arc-length error's std after 1 m is
+        this, after ``D`` m this times ``sqrt(D)``. Default 0.
     noise_angular_per_rad:
-        Heading noise std per radian of the step's heading change (rad/rad). Default 0.
+        Heading random walk per radian turned (rad/sqrt(rad)). Default 0.
     noise_linear_per_rad:
-        Arc-length noise std per radian of the step's heading change (m/rad): the cross term. With it the
-        arc-length std is ``sqrt((noise_linear_per_m L)^2 + (noise_linear_per_rad phi)^2)``. Default 0.
+        Arc-length random walk per radian turned (m/sqrt(rad)): the cross term, ``noise_linear_per_rad^2
+        |phi|`` added to the arc-length variance. Default 0.
     noise_angular_per_m:
-        Heading noise std per metre of the step's arc length (rad/m): the other cross term. Default 0.
+        Heading random walk per metre driven (rad/sqrt(m)): the other cross term. Default 0.
     slip_per_m:
-        Expected wheel-slip events per metre travelled (1/m). A step of arc length ``L`` slips with
-        probability ``min(1, slip_per_m * L)``; a slip adds ``N(0, slip_linear_std)`` to its measured arc
-        length and ``N(0, slip_angular_std)`` to its measured heading change. Default 0.
+        Expected wheel-slip events per metre travelled (1/m): a Poisson process in distance, so a step of
+        arc length ``L`` slips with probability ``1 - exp(-slip_per_m |L|)`` (whatever the step's length,
+        the slips along a path do not depend on how it is cut); each slip adds ``N(0, slip_linear_std)``
+        to its measured arc length and ``N(0, slip_angular_std)`` to its measured heading change. Default 0.
     slip_linear_std, slip_angular_std:
         Size of a slip's errors (m, rad).
     """
@@ -375,12 +381,18 @@ class OdometryConfig(BaseModel):
     )
     bias_linear: float | None = Field(None, gt=-0.5, lt=0.5, description="fixed e_lin (m/m), overrides the draw")
     bias_angular: float | None = Field(None, gt=-0.5, lt=0.5, description="fixed e_ang (rad/rad), overrides the draw")
-    noise_linear_per_m: float = Field(0.0, ge=0.0, le=1.0, description="arc-length noise std per metre (m/m)")
-    noise_angular_per_rad: float = Field(0.0, ge=0.0, le=1.0, description="heading noise std per radian (rad/rad)")
-    noise_linear_per_rad: float = Field(
-        0.0, ge=0.0, le=1.0, description="arc-length noise std per radian of turning (m/rad)"
+    noise_linear_per_m: float = Field(
+        0.0, ge=0.0, le=1.0, description="arc-length random walk per metre driven (m/sqrt(m))"
     )
-    noise_angular_per_m: float = Field(0.0, ge=0.0, le=1.0, description="heading noise std per metre travelled (rad/m)")
+    noise_angular_per_rad: float = Field(
+        0.0, ge=0.0, le=1.0, description="heading random walk per radian turned (rad/sqrt(rad))"
+    )
+    noise_linear_per_rad: float = Field(
+        0.0, ge=0.0, le=1.0, description="arc-length random walk per radian turned (m/sqrt(rad))"
+    )
+    noise_angular_per_m: float = Field(
+        0.0, ge=0.0, le=1.0, description="heading random walk per metre driven (rad/sqrt(m))"
+    )
     slip_per_m: float = Field(0.0, ge=0.0, le=10.0, description="expected wheel-slip events per metre (1/m)")
     slip_linear_std: float = Field(0.0, ge=0.0, le=10.0, description="arc-length error std of a slip (m)")
     slip_angular_std: float = Field(0.0, ge=0.0, le=math.pi, description="heading error std of a slip (rad)")

@@ -20,6 +20,27 @@ The measured increment is composed onto the odometry pose, which starts at (0, 0
 Consequences: driving straight, the odometry distance is exactly ``(1 + e_lin)`` times the true one;
 turning in place, the odometry rotation is exactly ``(1 + e_ang)`` times the true one (with
 ``e_ang = -1 deg/rad``, 360 deg of true rotation read 353.72 deg).
+
+Random noise: a random walk per metre and per radian
+----------------------------------------------------
+The optional noise is a random walk in distance travelled and angle turned, not in time or in steps: a
+step of arc length ``L`` and heading change ``phi`` adds zero-mean Gaussian errors with variances
+
+    var(arc length)    = a^2 |L| + b^2 |phi|      a = noise_linear_per_m (m/sqrt(m)), b = noise_linear_per_rad (m/sqrt(rad))
+    var(heading change) = c^2 |phi| + d^2 |L|      c = noise_angular_per_rad (rad/sqrt(rad)), d = noise_angular_per_m (rad/sqrt(m))
+
+Variances of independent steps add, and ``|L|`` and ``|phi|`` add along a path, so the error accumulated
+over a stretch of path is the same however the stretch is cut into steps: 0.1 s steps, irregular steps,
+sub-millisecond steps or steps of zero length (a duplicated stamp) alike. Over ``D`` metres driven and
+``R`` radians turned the arc-length error has variance ``a^2 D + b^2 R`` and the heading error ``c^2 R +
+d^2 D``. (The model this replaced had standard deviations proportional to the step, ``k L``, whose
+accumulated variance ``k^2 sum L^2`` shrinks as the steps do; it needed a rescaling by the step's duration,
+which blew up across the near-zero gaps of a log whose stamps were out of order.)
+
+Slips are a Poisson process in distance: a step of arc length ``L`` holds ``k`` slips, ``k`` Poisson of
+mean ``slip_per_m |L|`` (so it slips at all with probability ``1 - exp(-slip_per_m |L|)``), and each slip
+adds ``N(0, slip_linear_std)`` to the arc length and ``N(0, slip_angular_std)`` to the heading change.
+The number of slips along a path, and their summed errors, therefore do not depend on how it is cut.
 """
 
 from __future__ import annotations
@@ -33,7 +54,7 @@ from slamtrials.geometry import compose1
 from slamtrials.sim.config import OdometryConfig
 from slamtrials.sim.robot import sinc
 
-__all__ = ["draw_bias", "measured_increment", "Odometry"]
+__all__ = ["draw_bias", "measured_increment", "step_noise_std", "slip_count", "Odometry"]
 
 
 def draw_bias(config: OdometryConfig, rng: np.random.Generator) -> dict[str, float]:
@@ -88,9 +109,38 @@ def measured_increment(
     return np.array([scale * (c * dx - s * dy), scale * (s * dx + c * dy), phi_m])
 
 
-def _std(main: float, cross: float) -> float:
-    """``sqrt(main^2 + cross^2)``, and ``main`` itself, untouched, without a cross term."""
-    return main if cross == 0.0 else math.hypot(main, cross)
+def step_noise_std(coef_main: float, motion_main: float, coef_cross: float, motion_cross: float) -> float:
+    """Standard deviation of one step's random-walk error: ``sqrt(coef_main^2 |motion_main| +
+    coef_cross^2 |motion_cross|)``.
+
+    For the arc length ``coef_main`` is ``noise_linear_per_m`` (m/sqrt(m)) with ``motion_main`` the
+    step's arc length (m), and ``coef_cross`` ``noise_linear_per_rad`` (m/sqrt(rad)) with its heading
+    change (rad); for the heading change the roles swap (``noise_angular_per_rad`` with the heading
+    change, ``noise_angular_per_m`` with the arc length). Scalars in, a scalar out (``math.sqrt`` is
+    correctly rounded, so the result does not depend on the CPU).
+    """
+    return math.sqrt(coef_main * coef_main * abs(motion_main) + coef_cross * coef_cross * abs(motion_cross))
+
+
+def slip_count(slip_per_m: float, length: float, u: float) -> int:
+    """Slips in a step of arc length ``length`` (m): the Poisson count of mean ``slip_per_m |length|``
+    whose CDF first reaches the uniform ``u`` in [0, 1) (inverse-CDF sampling, so one uniform decides it).
+
+    ``k = 0`` exactly when ``u < exp(-slip_per_m |length|)``: the step slips with chance ``1 -
+    exp(-slip_per_m |length|)``. Scalars through ``math`` (the C library's), so the count does not depend
+    on the CPU.
+    """
+    mean = slip_per_m * abs(length)
+    term = math.exp(-mean)
+    cdf = term
+    k = 0
+    while u >= cdf and k < 10_000:
+        k += 1
+        term *= mean / k
+        if term == 0.0 and cdf > 0.0:
+            break
+        cdf += term
+    return k
 
 
 class Odometry:
@@ -117,20 +167,19 @@ class Odometry:
         self.rng = rng
         self.pose: NDArray[np.float64] = np.zeros(3)
 
-    def update(self, delta: ArrayLike, noise_scale: float = 1.0) -> NDArray[np.float64]:
+    def update(self, delta: ArrayLike) -> NDArray[np.float64]:
         """Add the measurement of the true step ``delta`` (``[3]``, robot frame) and return the new pose.
 
-        ``noise_scale`` multiplies the random noise's standard deviations (not the bias, not the slips):
-        the coefficients hold for a step of the config's ``dt``, and a step of another length ``h`` needs
-        them times ``sqrt(dt / h)`` for the noise to grow alike along the same path
-        (:func:`~slamtrials.sim.pathreplay.simulate_path`).
+        The step may be of any length, zero included: its noise depends on its motion only (arc length
+        ``L`` and heading change ``phi``, see the module docstring), never on its duration.
 
         Draws, in this order and only for the models that are on: one normal deviate for the arc length
-        (``noise_linear_per_m`` or ``noise_linear_per_rad`` > 0; std ``noise_linear_per_m * L``, or
-        ``sqrt((noise_linear_per_m L)^2 + (noise_linear_per_rad phi)^2)`` with the cross term), one for
-        the heading change (``noise_angular_per_rad`` or ``noise_angular_per_m`` > 0, alike), then, with
-        ``slip_per_m > 0``, one uniform (does the step slip?) and two normals (the slip's arc-length and
-        heading errors), drawn whether or not it slips.
+        (``noise_linear_per_m`` or ``noise_linear_per_rad`` > 0; std ``sqrt(a^2 |L| + b^2 |phi|)``), one
+        for the heading change (``noise_angular_per_rad`` or ``noise_angular_per_m`` > 0; std
+        ``sqrt(c^2 |phi| + d^2 |L|)``), then, with ``slip_per_m > 0``, one uniform (how many slips ``k``:
+        :func:`slip_count`, none with chance ``exp(-slip_per_m |L|)``) and two standard normals (the slips'
+        summed arc-length and heading errors, times ``sqrt(k)`` and the slip stds), drawn whether or not
+        it slips.
         """
         delta = np.asarray(delta, dtype=np.float64)
         cfg = self.config
@@ -138,18 +187,19 @@ class Odometry:
         phi = abs(float(delta[2]))
         length = math.hypot(delta[0], delta[1]) / sinc(0.5 * float(delta[2]))
         if cfg.noise_linear_per_m > 0.0 or cfg.noise_linear_per_rad > 0.0:
-            std = _std(cfg.noise_linear_per_m * length, cfg.noise_linear_per_rad * phi)
-            n_lin = float(self.rng.normal(0.0, std * noise_scale))
+            std = step_noise_std(cfg.noise_linear_per_m, length, cfg.noise_linear_per_rad, phi)
+            n_lin = float(self.rng.normal(0.0, std))
         if cfg.noise_angular_per_rad > 0.0 or cfg.noise_angular_per_m > 0.0:
-            std = _std(cfg.noise_angular_per_rad * phi, cfg.noise_angular_per_m * length)
-            n_ang = float(self.rng.normal(0.0, std * noise_scale))
+            std = step_noise_std(cfg.noise_angular_per_rad, phi, cfg.noise_angular_per_m, length)
+            n_ang = float(self.rng.normal(0.0, std))
         if cfg.slip_per_m > 0.0:
-            slips = float(self.rng.random()) < cfg.slip_per_m * length
+            slips = slip_count(cfg.slip_per_m, length, float(self.rng.random()))
             slip_lin = float(self.rng.normal(0.0, cfg.slip_linear_std))
             slip_ang = float(self.rng.normal(0.0, cfg.slip_angular_std))
             if slips:
-                n_lin += slip_lin
-                n_ang += slip_ang
+                root = math.sqrt(slips)  # the sum of k independent slips' errors
+                n_lin += slip_lin * root
+                n_ang += slip_ang * root
         inc = measured_increment(delta, self.bias["linear"], self.bias["angular"], n_lin, n_ang)
         self.pose = compose1(self.pose, inc)
         return self.pose

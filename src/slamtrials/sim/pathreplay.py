@@ -9,8 +9,6 @@ real run is replicated in the simulator (:mod:`slamtrials.validation`).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -24,11 +22,6 @@ from slamtrials.sim.simulator import as_generator
 from slamtrials.worlds.world import World
 
 __all__ = ["simulate_path"]
-
-
-def _noise_scale(dt: float, step: float) -> float:
-    """``sqrt(dt / step)``, exactly 1 for a step within a millionth of ``dt``."""
-    return 1.0 if abs(step - dt) <= 1e-6 * dt else math.sqrt(dt / step)
 
 
 def simulate_path(
@@ -70,11 +63,11 @@ def simulate_path(
     (:meth:`~slamtrials.sim.odometry.Odometry.update`), then frame ``k``'s laser draws
     (:meth:`~slamtrials.sim.raycast.LaserModel.scan`). With every error model off only the bias is drawn.
 
-    The odometry's random noise is given per simulator step of ``config.dt``; a frame-to-frame step of
-    another length ``h`` draws it with standard deviations times ``sqrt(config.dt / h)``, so that the
-    noise accumulated along the path is what the simulator, stepping every ``config.dt``, would give
-    (a real log's frames come every 0.2 s or so). Steps within a millionth of ``config.dt`` are
-    simulator steps (scale 1, which keeps the bit-for-bit replay above).
+    The odometry's random noise is a random walk per metre driven and per radian turned
+    (:mod:`slamtrials.sim.odometry`): each frame-to-frame step draws it from its motion alone, never
+    from its duration, so the noise accumulated along the path is what the simulator, stepping every
+    ``config.dt``, would give, whatever the frames' stamps (a real log's frames come every 0.2 s or so,
+    and a log whose stamps were out of order has gaps of a millisecond across a normal step).
 
     Raises
     ------
@@ -101,7 +94,7 @@ def simulate_path(
     scans[0] = laser.scan(path[0], generator, float(times[0]))
     measured[0] = odometry.pose
     for k in range(1, len(times)):
-        measured[k] = odometry.update(ominus1(path[k - 1], path[k]), _noise_scale(config.dt, times[k] - times[k - 1]))
+        measured[k] = odometry.update(ominus1(path[k - 1], path[k]))
         scans[k] = laser.scan(path[k], generator, float(times[k]))
     metadata = {
         "world": world.name,

@@ -20,8 +20,11 @@ or ``realistic``, or a profile YAML file) in every config, one set of trials per
 profile is refused in one line (exit 2). The configs write the laser geometry and the per-run bias
 ranges explicitly, and those override the profile's, so a profile adds its noise, short readings,
 dropouts, random odometry noise and slips to each setting's own robot. Without ``--profile`` the
-configs run as written, which is the ``paper`` profile (noise-free laser, constant per-run odometry
-bias); the table calls that ``(config)``. ``--set FIELD=VALUE``
+configs run as written: they name no profile, so they get the default of every command, ``realistic``
+(:data:`slamtrials.sim.profiles.DEFAULT_PROFILE`); ``--profile paper`` is the paper's Stage set-up
+(noise-free laser, constant per-run odometry bias). The table's profile column is the profile with its
+overrides (``realistic + 2 overrides``: the two bias ranges), and the script prints it for each config
+(``profile: ...``) before the trials. ``--set FIELD=VALUE``
 (repeatable, VALUE read as YAML) changes a field of every config for a side measurement, e.g.
 ``--set sim.laser.fov=4.71238898038469`` or ``--set "sim.odometry.bias_linear_range=[-0.005, 0.005]"``
 (use another ``--out``: the CSV does not record the change).
@@ -51,8 +54,6 @@ from benchutil import cpu_model  # noqa: E402
 HERE = Path(__file__).resolve().parent
 CONFIGS = HERE / "configs" / "paper_validation"
 DEFAULT_CONFIGS = (CONFIGS / "table2_hall.yaml", CONFIGS / "table3_lab.yaml")
-#: The profile label of trials run with the configs as written (no ``sim.profile``).
-AS_CONFIGURED = "(config)"
 FIELDS = (
     "config",
     "world",
@@ -263,7 +264,7 @@ def one_trial(
     row: dict = {
         "config": Path(config_path).name,
         "world": world_name,
-        "profile": profile or AS_CONFIGURED,
+        "profile": config.sim.profile_label,
         "seed": seed,
     }
     started = time.perf_counter()
@@ -328,6 +329,8 @@ def main() -> None:
     profiles: list[str | None] = list(args.profile) if args.profile else [None]
     overrides = tuple(args.overrides)
     jobs = []
+    labels = {}  # (config, profile option) -> the profile label of its rows
+    lines = []
     for path in args.configs:
         for profile in profiles:
             try:
@@ -335,14 +338,19 @@ def main() -> None:
             except SlamtrialsError as exc:
                 print(f"error: {exc}", file=sys.stderr)
                 sys.exit(2)
+            labels[(str(path), profile)] = config.sim.profile_label
+            keys = ", ".join(o.key for o in config.sim.profile_overrides)
+            lines.append(f"{path.name}: profile: {config.sim.profile_label}" + (f" ({keys})" if keys else ""))
             jobs += [
                 (str(path), world, profile, seed, overrides) for world in config.worlds for seed in range(args.seeds)
             ]
+    for line in lines:
+        print(line)
 
     args.out.mkdir(parents=True, exist_ok=True)
     rows = _read_rows(csv_path) if args.resume and csv_path.is_file() else []
     done = {(r["config"], r["world"], r["profile"], int(r["seed"])) for r in rows}
-    jobs = [j for j in jobs if (Path(j[0]).name, j[1], j[2] or AS_CONFIGURED, j[3]) not in done]
+    jobs = [j for j in jobs if (Path(j[0]).name, j[1], labels[(j[0], j[2])], j[3]) not in done]
     if not rows:
         with csv_path.open("w", newline="") as handle:
             csv.DictWriter(handle, FIELDS).writeheader()

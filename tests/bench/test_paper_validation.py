@@ -11,6 +11,7 @@ import pytest
 
 from slamtrials.campaign.config import CampaignConfig
 from slamtrials.errors import ConfigError
+from slamtrials.sim.profiles import DEFAULT_PROFILE
 from slamtrials.worlds.catalog import catalog_entry
 
 BENCH = Path(__file__).resolve().parents[2] / "bench"
@@ -39,7 +40,7 @@ def test_hall_config_is_table_ii_s_robot():
     laser, odometry = config.sim.laser, config.sim.odometry
     assert math.degrees(laser.fov) == pytest.approx(80.0)
     assert math.degrees(laser.angle_increment) == pytest.approx(1.0)
-    assert laser.num_beams == 81 and laser.max_range == 30.0 and laser.range_noise_std == 0.0
+    assert laser.num_beams == 81 and laser.max_range == 30.0
     assert odometry.bias_linear_range == (-0.01, 0.01)
     assert [math.degrees(v) for v in odometry.bias_angular_range] == pytest.approx([-2.0, 2.0])
     assert config.sim.dt == pytest.approx(0.1)  # 10 Hz
@@ -68,10 +69,20 @@ def test_every_configured_world_is_bundled_and_has_the_paper_s_figures():
     assert bench.PAPER["paper_hall_empty"].real_t == 0.189 and bench.PAPER["paper_lab"].sim_sr == 0.004
 
 
+def test_the_replicas_follow_the_one_default_profile_and_their_bias_ranges_override_it():
+    for path in bench.DEFAULT_CONFIGS:
+        sim = bench.load_config(path, None).sim
+        assert sim.profile_name == DEFAULT_PROFILE == "realistic" and sim.laser.range_noise_std > 0.0
+        assert [o.key for o in sim.profile_overrides] == ["odometry.bias_linear_range", "odometry.bias_angular_range"]
+        assert sim.profile_label == "realistic + 2 overrides"
+        paper = bench.load_config(path, "paper").sim
+        assert paper.profile_label == "paper + 2 overrides" and not paper.laser.has_errors
+
+
 def test_profile_option_sets_sim_profile_and_the_configs_keep_their_bias_ranges():
     as_written = bench.load_config(HALL, None)
-    assert as_written == CampaignConfig.from_yaml(HALL) and as_written.sim.profile_name == "paper"
-    assert bench.load_config(HALL, "paper") == as_written  # paper is what a config without a profile gets
+    assert as_written == CampaignConfig.from_yaml(HALL) and as_written.sim.profile_name == DEFAULT_PROFILE
+    assert bench.load_config(HALL, DEFAULT_PROFILE) == as_written  # what a config without a profile gets
     inline = {"name": "noisy", "laser": {"range_noise_std": 0.02}, "odometry": {"bias_linear_range": [-0.2, 0.2]}}
     noisy = bench.load_config(HALL, inline).sim
     assert noisy.profile_name == "noisy" and noisy.laser.range_noise_std == 0.02
@@ -136,7 +147,7 @@ def test_summary_takes_mean_and_sample_std_and_leaves_failed_trials_out():
 @pytest.mark.slow
 def test_one_trial_runs_and_scores_a_replica():
     row = bench.one_trial(str(HALL), "paper_hall_furnished", None, 0)
-    assert row["error"] == "" and row["profile"] == "(config)"
+    assert row["error"] == "" and row["profile"] == "realistic + 2 overrides"
     assert row["reason"] in ("map_converged", "no_frontiers") and row["mapped"] > 0.9
     assert 0.0 < float(row["eps_t"]) < 1.0 and 0.0 < float(row["eps_r"]) < 0.5
 

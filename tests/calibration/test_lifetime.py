@@ -22,7 +22,9 @@ SETTINGS = CalibrationSettings(bootstrap=30)
 def _fit(lifetime: float, fleeting: float):
     world = load_world("office_small_01")
     laser = LaserConfig(**LASER, short_lifetime=lifetime, short_fleeting_share=fleeting)
-    record = simulate_waypoints(world, tour_waypoints(world, num_goals=6), SimConfig(laser=laser), seed=5, max_time=600)
+    record = simulate_waypoints(
+        world, tour_waypoints(world, num_goals=6), SimConfig(profile="paper", laser=laser), seed=5, max_time=600
+    )
     reference = Reference.from_world(record.truth, world, "simulation truth")
     fit = fit_laser(beam_sample(record, reference, SETTINGS.max_beams), SETTINGS, record.laser.range_min)
     assert fit is not None

@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+import logging
+
 import pytest
 import yaml
 
 from slamtrials.campaign import CampaignConfig, dump_default_yaml, small_campaign_config
 from slamtrials.campaign.dump import EXAMPLE_WORLDS, dump_config_yaml
 from slamtrials.errors import ConfigError, FormatError
+from slamtrials.sim import SimConfig
+from slamtrials.sim.config import LASER_ERROR_FIELDS, ODOMETRY_ERROR_FIELDS
+from slamtrials.sim.profiles import BUNDLED_PROFILES, DEFAULT_PROFILE
 from slamtrials.trial import TrialConfig
 
 
@@ -21,11 +26,14 @@ def test_defaults_are_the_papers_but_the_error_profile():
     paper = CampaignConfig.from_dict({"worlds": ["office_small_01"], "metric": {"rule": "paper"}}).metric
     assert paper.margin_t == 0.02 and paper.margin_r == 0.02 and paper.relative_margin is None
     assert config.runs.margin_t == 0.02 and config.runs.margin_r == 0.02
-    # the simulated sensors: the realistic error profile (docs/realism.md), everything else the paper's
-    assert config.sim.profile_name == "realistic" and config.sim.laser.short_rate > 0
-    assert config.trial_config().model_copy(update={"sim": TrialConfig().sim}) == TrialConfig()
+    # the simulated sensors: the one default error profile (realistic, docs/realism.md) of every command,
+    # the trial's own; everything else the paper's
+    assert config.sim.profile_name == DEFAULT_PROFILE == "realistic" and config.sim.laser.short_rate > 0
+    assert config.trial_config() == TrialConfig() and config.sim == SimConfig()
     paper = CampaignConfig.from_dict({"worlds": ["office_small_01"], "sim": {"profile": "paper"}})
-    assert paper.trial_config() == TrialConfig()
+    assert paper.trial_config() == TrialConfig(sim=SimConfig.paper())
+    # a campaign stored before profiles existed was simulated with paper, and is read so
+    assert CampaignConfig.from_stored({"worlds": ["w"], "sim": {"dt": 0.1}}).sim == SimConfig.paper()
     assert config.seed == 0 and config.output is None
 
 
@@ -64,6 +72,68 @@ def test_a_changed_config_dumps_and_loads_back_equal():
         }
     )
     assert CampaignConfig.from_dict(yaml.safe_load(dump_config_yaml(config))) == config
+
+
+def test_dump_names_the_profile_and_no_error_value_so_editing_the_name_changes_every_value():
+    text = dump_default_yaml()
+    sim = yaml.safe_load(text)["sim"]
+    assert sim["profile"] == DEFAULT_PROFILE
+    error_fields = {*LASER_ERROR_FIELDS, *ODOMETRY_ERROR_FIELDS}
+    assert not error_fields & set(sim["laser"]) and not error_fields & set(sim["odometry"])
+    edited = CampaignConfig.from_dict(yaml.safe_load(text.replace(f"profile: {DEFAULT_PROFILE}", "profile: paper")))
+    assert edited.sim == SimConfig.paper() and not edited.sim.laser.has_errors
+    assert edited.model_copy(update={"sim": SimConfig()}) == CampaignConfig(worlds=list(EXAMPLE_WORLDS))
+
+
+def test_dump_of_a_changed_config_writes_only_the_overrides():
+    config = CampaignConfig.from_dict({"worlds": ["w"], "sim": {"profile": "paper", "laser": {"short_rate": 0.1}}})
+    sim = yaml.safe_load(dump_config_yaml(config))["sim"]
+    assert sim["profile"] == "paper" and sim["laser"]["short_rate"] == 0.1
+    assert "dropout_rate" not in sim["laser"] and "bias_linear_range" not in sim["odometry"]
+    # a campaign folder's config.yaml holds every value, as the campaign ran it
+    resolved = yaml.safe_load(dump_config_yaml(config, resolved=True))["sim"]
+    assert resolved["laser"]["dropout_rate"] == 0.0 and resolved["odometry"]["bias_linear_range"] == [-0.005, 0.005]
+    assert CampaignConfig.from_dict(yaml.safe_load(dump_config_yaml(config, resolved=True))) == config
+
+
+def test_a_file_that_contradicts_its_profile_is_accepted_with_one_warning(tmp_path, caplog):
+    same = BUNDLED_PROFILES["realistic"].laser_values()["short_rate"]
+    path = tmp_path / "c.yaml"
+    path.write_text(
+        "worlds: [office_small_01]\nsim:\n  profile: realistic\n"
+        f"  laser:\n    short_rate: {same!r}\n    dropout_rate: 0.0\n"
+        "  odometry:\n    bias_linear_range: [-0.01, 0.01]\n"
+    )
+    with caplog.at_level(logging.WARNING):
+        config = CampaignConfig.from_yaml(path)
+    assert config.sim.laser.dropout_rate == 0.0 and config.sim.profile_label == "realistic + 2 overrides"
+    warnings = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
+    assert warnings == [
+        f"{path}: keys that override profile realistic: sim.laser.dropout_rate, sim.odometry.bias_linear_range"
+    ]
+    caplog.clear()
+    path.write_text("worlds: [office_small_01]\nsim:\n  profile: realistic\n")
+    with caplog.at_level(logging.WARNING):
+        CampaignConfig.from_yaml(path)
+    assert not [r for r in caplog.records if r.levelno == logging.WARNING]
+
+
+@pytest.mark.parametrize(
+    ("sim", "expected"),
+    [
+        ({"profile": {"name": "x", "laser": {"shrt": 0.1}}}, "unknown laser error field 'shrt'"),
+        ({"profile": {"name": "x", "laser": {"dropout_rate": -0.1}}}, "dropout_rate"),
+        ({"profile": {"name": "x", "odometry": {"noise_linear_per_m": -1}}}, "noise_linear_per_m"),
+        ({"profile": {"name": "x", "lazer": {}}}, "lazer"),
+        ({"profile": "realstic"}, "unknown error profile 'realstic'"),
+        ({"laser": {"dropout_rate": -0.5}}, "sim.laser.dropout_rate"),
+    ],
+)
+def test_a_bad_profile_is_one_line_naming_the_key(sim, expected):
+    with pytest.raises(ConfigError) as info:
+        CampaignConfig.from_dict({"worlds": ["w"], "sim": sim}, source="c.yaml")
+    message = str(info.value)
+    assert message.startswith("c.yaml: ") and expected in message and "\n" not in message
 
 
 @pytest.mark.parametrize(

@@ -24,6 +24,7 @@ runner = CliRunner()
 def record():
     world = load_world("office_small_01")
     config = SimConfig(
+        profile="paper",  # the errors below, nothing else
         laser=LaserConfig(range_noise_std=0.02, short_rate=0.05, dropout_rate=0.02),
         odometry=OdometryConfig(
             bias_linear=0.02, bias_angular=-0.05, noise_linear_per_m=0.03, noise_angular_per_rad=0.05

@@ -17,6 +17,7 @@ from slamtrials.campaign.demo import DEMO_INITIAL_RUNS, DEMO_MAX_RUNS
 from slamtrials.campaign.testing import FakeTrial
 from slamtrials.cli.main import app
 from slamtrials.demo import demo_config, run_demo
+from slamtrials.sim.profiles import DEFAULT_PROFILE
 
 runner = CliRunner()
 
@@ -76,7 +77,8 @@ def test_demo_command_prints_the_summary_and_the_report(tmp_path, client, monkey
     )
     assert f"Report: {out.absolute() / 'report' / 'index.html'}" in result.output
     assert "runs done" in result.output and (out / "report" / "index.html").is_file()
-    assert result.output.startswith(f"Demo campaign in {out}")
+    assert result.stdout.startswith(f"Demo campaign in {out}")
+    assert result.stderr.splitlines()[0] == f"profile: {DEFAULT_PROFILE}"  # the demo's runs: the one default
 
 
 def test_demo_command_bad_input_is_one_line(tmp_path):

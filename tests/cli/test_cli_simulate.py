@@ -63,7 +63,7 @@ def test_config_file_sets_the_laser(tmp_path):
     world_file = _corridor_world(tmp_path)
     (tmp_path / "w.yaml").write_text("waypoints:\n  - [3.0, 1.5]\n")
     (tmp_path / "sim.yaml").write_text(
-        "laser:\n  fov: 1.3962634\n  angular_resolution: 0.017453293\n  max_range: 20.0\n"
+        "profile: paper\nlaser:\n  fov: 1.3962634\n  angular_resolution: 0.017453293\n  max_range: 20.0\n"
     )
     out = tmp_path / "run"
     args = [

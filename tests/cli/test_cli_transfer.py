@@ -27,7 +27,7 @@ def _simulated() -> RunRecord:
     occ = np.ones((60, 200), bool)
     occ[10:50, 10:190] = False  # a 9 m x 2 m room
     world = World(occ, 0.05, name="corridor", start=np.array([1.0, 1.5, 0.0]))
-    config = SimConfig.from_dict({"laser": {"mount": [0.1, 0.0, 0.0]}})
+    config = SimConfig.from_dict({"profile": "paper", "laser": {"mount": [0.1, 0.0, 0.0]}})
     return simulate_waypoints(world, [[2.5, 1.5], [2.5, 2.2]], config, seed=5, max_time=15.0)
 
 

@@ -15,6 +15,7 @@ from slamtrials.io.runfolder import write_run
 from slamtrials.metric.sampling import relations_between
 from slamtrials.record import Relations, Trajectory
 from slamtrials.sim import SimConfig, simulate_waypoints
+from slamtrials.sim.profiles import DEFAULT_PROFILE
 from slamtrials.worlds import World
 
 runner = CliRunner()
@@ -35,6 +36,8 @@ def inputs(tmp_path_factory):
     shifted = Relations(t1=relations.t1 + 5000.0, t2=relations.t2 + 5000.0, delta=relations.delta)
     write_relations(base / "other.relations", shifted)
     (base / "bad_profile.yaml").write_text("name: bad\nlaser:\n  range_noise_std: -0.1\n", encoding="utf-8")
+    (base / "unknown_key.yaml").write_text("name: bad\nlaser:\n  dropout_chance: 0.1\n", encoding="utf-8")
+    (base / "unknown_section.yaml").write_text("name: bad\nlazer:\n  dropout_rate: 0.1\n", encoding="utf-8")
     return base, record, len(relations)
 
 
@@ -55,10 +58,13 @@ def test_validate_prints_the_table_and_writes_json_and_figure(inputs, tmp_path):
     out, fig = tmp_path / "v.json", tmp_path / "v.png"
     result = runner.invoke(app, _args(base, "--runs", "3", "--json", str(out), "--figure", str(fig)))
     assert result.exit_code == 0, result.output
-    assert "real log" in result.output and "simulation" in result.output and "profile paper" in result.output
+    # no --profile: the one default of every command, said first on stderr and named in the table and the JSON
+    assert result.stderr.splitlines()[0] == f"profile: {DEFAULT_PROFILE}"
+    assert "real log" in result.output and "simulation" in result.output
+    assert f"profile {DEFAULT_PROFILE}" in result.stdout
     doc = json.loads(out.read_text())
     assert doc["runs"] == 3 and doc["seeds"] == [0, 1, 2] and doc["frames"] == len(record)
-    assert doc["profile"]["name"] == "paper" and doc["algorithm"] == "odometry"
+    assert doc["profile"]["name"] == DEFAULT_PROFILE == "realistic" and doc["algorithm"] == "odometry"
     assert doc["relations"] == {"given": count, "replica": count}
     assert doc["replica_world"]["unknown_cells"] == "walls"
     for source in ("slam", "odometry"):
@@ -88,7 +94,12 @@ def test_relations_of_another_log_are_one_line_and_nothing_is_written(inputs, tm
 
 @pytest.mark.parametrize(
     ("profile", "expected"),
-    [("no_such_profile", "unknown profile 'no_such_profile'"), ("bad_profile.yaml", "range_noise_std")],
+    [
+        ("no_such_profile", "unknown profile 'no_such_profile'"),
+        ("bad_profile.yaml", "range_noise_std"),
+        ("unknown_key.yaml", "unknown laser error field 'dropout_chance'"),
+        ("unknown_section.yaml", "lazer"),
+    ],
 )
 def test_a_bad_profile_is_one_line_and_nothing_is_written(inputs, tmp_path, profile, expected):
     base, _, _ = inputs

@@ -77,7 +77,7 @@ def run(
     termination: TerminationConfig | None = None,
 ) -> HarnessResult:
     started = time.perf_counter()
-    sim = Simulator(world, SimConfig(), np.random.default_rng(seed))
+    sim = Simulator(world, SimConfig.paper(), np.random.default_rng(seed))  # the paper's noise-free laser
     laser = sim.laser
     gridmap = GridMap(0.05)
     frame = sim.observe()

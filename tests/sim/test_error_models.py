@@ -11,7 +11,7 @@ from pydantic import ValidationError
 
 from slamtrials.sim.config import LaserConfig, OdometryConfig, SimConfig
 from slamtrials.sim.odometry import Odometry
-from slamtrials.sim.profiles import BUNDLED_PROFILES
+from slamtrials.sim.profiles import BUNDLED_PROFILES, DEFAULT_PROFILE
 from slamtrials.sim.raycast import LaserModel
 from slamtrials.sim.simulator import Simulator
 
@@ -146,11 +146,20 @@ def _frames(config: SimConfig, seed: int = 4, steps: int = 60):
     return [sim.observe()] + [sim.step((0.3, 0.2)) for _ in range(steps)]
 
 
-def test_paper_profile_is_the_default_bit_for_bit():
-    assert SimConfig() == SimConfig(profile="paper") == SimConfig.model_validate({"profile": "paper"})
-    assert SimConfig().profile_name == "paper" and not SimConfig().laser.has_errors
-    for a, b in zip(_frames(SimConfig()), _frames(SimConfig(profile="paper")), strict=True):
+def test_paper_profile_is_the_error_fields_defaults_bit_for_bit():
+    assert SimConfig.paper() == SimConfig(profile="paper") == SimConfig.model_validate({"profile": "paper"})
+    assert SimConfig.paper().profile_name == "paper" and not SimConfig.paper().laser.has_errors
+    explicit = SimConfig(profile="paper", laser=LaserConfig(), odometry=OdometryConfig())  # the fields' defaults
+    assert explicit == SimConfig.paper() and explicit.profile_overrides == ()
+    for a, b in zip(_frames(SimConfig.paper()), _frames(explicit), strict=True):
         assert np.array_equal(a.ranges, b.ranges) and np.array_equal(a.odometry, b.odometry)
+
+
+def test_the_default_profile_is_realistic_and_a_config_that_names_none_gets_it():
+    assert DEFAULT_PROFILE == "realistic"
+    for config in (SimConfig(), SimConfig.model_validate({}), SimConfig.from_dict({"dt": 0.1})):
+        assert config == SimConfig(profile="realistic") and config.profile_label == "realistic"
+    assert SimConfig().laser.dropout_rate == BUNDLED_PROFILES["realistic"].laser["dropout_rate"] > 0.0
 
 
 def test_a_profile_fills_the_error_fields_and_explicit_values_win():
@@ -161,7 +170,7 @@ def test_a_profile_fills_the_error_fields_and_explicit_values_win():
     assert config.odometry.slip_per_m == 0.01 and config.odometry.bias_linear_range == (-0.005, 0.005)
     assert SimConfig.model_validate(config.model_dump(mode="json")) == config  # stored and read back
     noisy = _frames(config)
-    assert not all(np.array_equal(a.ranges, b.ranges) for a, b in zip(noisy, _frames(SimConfig()), strict=True))
+    assert not all(np.array_equal(a.ranges, b.ranges) for a, b in zip(noisy, _frames(SimConfig.paper()), strict=True))
     assert all(np.array_equal(a.ranges, b.ranges) for a, b in zip(noisy, _frames(config), strict=True))  # seeded
 
 
@@ -182,7 +191,7 @@ def test_bad_profiles_are_refused_with_the_field(profile, message):
 
 def test_bundled_paper_profile_is_the_configs_defaults():
     paper = BUNDLED_PROFILES["paper"]
-    defaults = SimConfig()
+    defaults = SimConfig.paper()
     assert paper.laser_values() == {name: getattr(defaults.laser, name) for name in paper.laser_values()}
     assert paper.odometry_values() == {name: getattr(defaults.odometry, name) for name in paper.odometry_values()}
 

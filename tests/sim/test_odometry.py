@@ -23,7 +23,7 @@ def corridor_world() -> World:
 
 
 def config_with_bias(linear: float, angular: float, **odo) -> SimConfig:
-    return SimConfig(odometry=OdometryConfig(bias_linear=linear, bias_angular=angular, **odo))
+    return SimConfig(profile="paper", odometry=OdometryConfig(bias_linear=linear, bias_angular=angular, **odo))
 
 
 def test_bias_draw_ranges_and_paper_values():

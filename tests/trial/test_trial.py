@@ -35,8 +35,11 @@ def world() -> World:
 
 @pytest.fixture(scope="module")
 def config() -> TrialConfig:
+    # the paper's noise-free set-up (the default profile is realistic: see the realistic test below);
     # a small world: snapshots every 60 s and a 15-minute cap keep the test short either way
-    return TrialConfig.from_dict({"termination": {"small_period": 60.0, "max_time": 900.0}})
+    return TrialConfig.from_dict(
+        {"sim": {"profile": "paper"}, "termination": {"small_period": 60.0, "max_time": 900.0}}
+    )
 
 
 @pytest.fixture(scope="module")
@@ -189,3 +192,11 @@ def test_a_realistic_trial_ends_because_no_frontier_is_left(world):
     assert info["termination_reason"] == "no_frontiers"
     assert info["duration_s"] < 60.0  # 21.5 s (paper: 21.7 s); without the scan filter and the evidence layer 840 s
     assert info["mapped_fraction"] >= 0.95
+
+
+def test_the_default_trial_follows_the_one_default_profile_and_the_record_names_its_profile(record):
+    from slamtrials.sim.profiles import DEFAULT_PROFILE
+
+    assert TrialConfig().sim.profile_name == DEFAULT_PROFILE == "realistic" and TrialConfig().sim.laser.has_errors
+    assert record.metadata["profile"] == {"name": "paper", "label": "paper", "overrides": {}}
+    assert record.metadata["sim_config"]["profile"] == "paper"

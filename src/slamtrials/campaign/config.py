@@ -27,6 +27,8 @@ from slamtrials.metric.matching import RUN_TOLERANCE
 from slamtrials.metric.rule import SamplingRule
 from slamtrials.metric.runcount import DEFAULT_MIN_RUNS
 from slamtrials.sim import SimConfig
+from slamtrials.sim.overrides import warn_overrides
+from slamtrials.sim.profiles import DEFAULT_PROFILE
 from slamtrials.trial import SlamSettings, TrialConfig
 
 __all__ = [
@@ -43,9 +45,10 @@ _MODEL_CONFIG = ConfigDict(extra="forbid", frozen=True)
 
 #: Smallest ``runs.initial`` of a new campaign (a stored one of an earlier version keeps its own).
 MIN_INITIAL_RUNS = 5
-#: Error profile of a new campaign that names none (docs/realism.md: validated against real logs); the
-#: simulator's own default, and that of campaigns stored by earlier versions, stays ``paper``.
-CAMPAIGN_PROFILE = "realistic"
+#: Error profile of a campaign that names none: the simulator's one default
+#: (:data:`slamtrials.sim.profiles.DEFAULT_PROFILE`). Campaigns stored by versions that had no profiles
+#: were simulated with ``paper``, and :func:`upgrade_stored_config` says so.
+CAMPAIGN_PROFILE = DEFAULT_PROFILE
 #: Default cap on the runs of one world.
 DEFAULT_MAX_RUNS = 60
 #: Largest root seed (seeds are stored as SQLite 64-bit signed integers).
@@ -160,6 +163,18 @@ def upgrade_stored_config(doc: dict[str, Any]) -> dict[str, Any]:
     return doc
 
 
+def stored_sim_config(sim: dict[str, Any]) -> SimConfig:
+    """The simulation config of a stored campaign's ``sim`` section (one stored before error profiles
+    existed names none and was simulated with ``paper``).
+
+    Raises
+    ------
+    pydantic.ValidationError
+        A section this version cannot read (e.g. a profile it does not know).
+    """
+    return SimConfig.model_validate(upgrade_stored_config({"sim": sim})["sim"])
+
+
 class CampaignConfig(BaseModel):
     """Everything a campaign needs: worlds, trial settings, metric, run-count rule, root seed, output.
 
@@ -186,8 +201,8 @@ class CampaignConfig(BaseModel):
 
     worlds: list[str] = Field(min_length=1, description="bundled world names, floor-plan files or folders of them")
     sim: SimConfig = Field(
-        default_factory=lambda: SimConfig(profile=CAMPAIGN_PROFILE),
-        description="simulated robot, laser and odometry (error profile realistic unless named)",
+        default_factory=SimConfig,
+        description=f"simulated robot, laser and odometry (error profile {DEFAULT_PROFILE} unless named)",
     )
     slam: SlamSettings = Field(default_factory=SlamSettings, description="the SLAM algorithm under test")
     explore: ExploreConfig = Field(
@@ -206,16 +221,6 @@ class CampaignConfig(BaseModel):
     replay_of: str | None = Field(
         None, description="set by 'campaign replay': the campaign whose recorded runs are re-evaluated"
     )
-
-    @model_validator(mode="before")
-    @classmethod
-    def _realistic_unless_named(cls, data: Any, info: ValidationInfo) -> Any:
-        # a new campaign's sim section without a profile gets the campaign default; a stored one was
-        # made with the simulator's own default (paper) and upgrade_stored_config says so explicitly
-        if isinstance(data, dict) and isinstance(data.get("sim"), dict) and "profile" not in data["sim"]:
-            if not (info.context or {}).get("stored"):
-                data = {**data, "sim": {**data["sim"], "profile": CAMPAIGN_PROFILE}}
-        return data
 
     @model_validator(mode="after")
     def _worlds_not_blank(self) -> CampaignConfig:
@@ -288,7 +293,9 @@ class CampaignConfig(BaseModel):
         relative to the config file's folder (and stored as an absolute path), so a config and its
         floor plans can move together; other entries (catalog names, paths relative to the working
         directory) are kept as written. A ``sim.profile`` that is a YAML file's path (relative to the
-        config's folder) is read and held inline (:mod:`slamtrials.campaign.profilefile`).
+        config's folder) is read and held inline (:mod:`slamtrials.campaign.profilefile`). Error-model
+        values in ``sim.laser`` / ``sim.odometry`` that differ from the profile's override it; they are
+        accepted, with one logged warning naming them (:func:`slamtrials.sim.overrides.warn_overrides`).
 
         Raises
         ------
@@ -309,4 +316,6 @@ class CampaignConfig(BaseModel):
         if isinstance(worlds, list):
             data["worlds"] = [_beside(path.parent, entry) for entry in worlds]
         data = inline_profile_file(data, path.parent)
-        return cls.from_dict(data, source=str(path))
+        config = cls.from_dict(data, source=str(path))
+        warn_overrides(config.sim, str(path))
+        return config

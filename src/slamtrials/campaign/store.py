@@ -380,7 +380,9 @@ class CampaignStore:
             f"# slamtrials {self.kind}: the resolved config of this campaign folder (also in {DB_FILE}).\n"
             f"# Resume with: slamtrials campaign {'run' if self.kind == 'campaign' else 'replay'} ... --out {self.folder}\n"
         )
-        return atomic_write_text(self.folder / CONFIG_FILE, dump_config_yaml(self.config(), header=header))
+        return atomic_write_text(
+            self.folder / CONFIG_FILE, dump_config_yaml(self.config(), header=header, resolved=True)
+        )
 
     def prepare_resume(self) -> int:
         """Put back what an interrupted driver left unfinished: runs ``running`` or ``failed`` become

@@ -21,7 +21,7 @@ from typing import Annotated
 
 import typer
 
-from slamtrials.cli.common import fmt_number, make_app, make_console, quiet_dask, table_one
+from slamtrials.cli.common import fmt_number, make_app, make_console, quiet_dask, sim_profile_line, table_one
 from slamtrials.errors import ConfigError
 
 __all__ = ["app", "register", "summary_table", "print_differences", "EXIT_INTERRUPTED"]
@@ -78,9 +78,13 @@ def metric_share_line(rows) -> str | None:
 
 
 class _Progress:
-    """Progress bars per world, fed by campaign events; a line per finished world when not a terminal."""
+    """Progress bars per world, fed by campaign events; a line per finished world when not a terminal.
 
-    def __init__(self, console):
+    ``first`` (e.g. the :func:`~slamtrials.cli.common.profile_line`) is printed on stderr with the first
+    event, which comes after every check of the input, so that bad input stays a one-line error.
+    """
+
+    def __init__(self, console, first: str | None = None):
         from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
         self.console = console
@@ -94,6 +98,7 @@ class _Progress:
             disable=not console.is_terminal,
         )
         self.tasks: dict[str, int] = {}
+        self.first = first
 
     def __enter__(self):
         self.progress.__enter__()
@@ -103,6 +108,9 @@ class _Progress:
         self.progress.__exit__(*exc)
 
     def __call__(self, event) -> None:
+        if self.first is not None:
+            typer.echo(self.first, err=True)
+            self.first = None
         task = self.tasks.get(event.world)
         if task is None:
             task = self.tasks[event.world] = self.progress.add_task(
@@ -156,7 +164,11 @@ def run(
     scheduler: SchedulerOpt = None,
     workers: WorkersOpt = None,
 ) -> None:
-    """Run a campaign: per world, repeat runs until its mean errors are known (or resume one)."""
+    """Run a campaign: per world, repeat runs until its mean errors are known (or resume one).
+
+    Prints the error profile of its runs (``profile: realistic`` unless the config names another) on
+    stderr when the runs start.
+    """
     from slamtrials.campaign import CampaignConfig, run_campaign
     from slamtrials.campaign.store import CampaignStore, is_campaign
 
@@ -167,14 +179,16 @@ def run(
         raise ConfigError(f"{out}: not a campaign folder (campaign.sqlite missing); give a config to start one")
     if campaign_config is None:
         with CampaignStore.open(out) as store:
+            sim = store.config().sim
             confidence = store.config().runs.confidence
     else:
+        sim = campaign_config.sim
         confidence = campaign_config.runs.confidence
     quiet_dask()
     console = make_console()
     folder = out or (Path(campaign_config.output) if campaign_config and campaign_config.output else None)
     try:
-        with _Progress(console) as progress:
+        with _Progress(console, first=sim_profile_line(sim)) as progress:
             result = run_campaign(campaign_config, out, scheduler=scheduler, workers=workers, on_event=progress)
     except KeyboardInterrupt:
         typer.echo(f"interrupted; resume with: slamtrials campaign run --out {folder}", err=True)

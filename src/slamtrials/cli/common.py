@@ -19,7 +19,16 @@ except ImportError:  # pragma: no cover - older typer on click
 
 from slamtrials.errors import SlamtrialsError
 
-__all__ = ["EXIT_BAD_INPUT", "ErrorReportingGroup", "make_app", "make_console", "quiet_dask"]
+__all__ = [
+    "EXIT_BAD_INPUT",
+    "ErrorReportingGroup",
+    "make_app",
+    "make_console",
+    "quiet_dask",
+    "profile_line",
+    "sim_profile_line",
+    "say_profile",
+]
 
 EXIT_BAD_INPUT = 2
 
@@ -103,6 +112,27 @@ def table_one(title: str, confidence: float, last_column: str, last_justify: str
         table.add_column(column, justify="right", no_wrap=True)
     table.add_column(last_column, justify=last_justify)
     return table
+
+
+def profile_line(label: str, keys: tuple[str, ...] = ()) -> str:
+    """``profile: realistic``, or ``profile: realistic + 2 overrides (laser.dropout_rate, ...)``: the line
+    every command that simulates prints (``label`` from :attr:`slamtrials.sim.SimConfig.profile_label`)."""
+    return f"profile: {label}" + (f" ({', '.join(keys)})" if keys else "")
+
+
+def sim_profile_line(sim) -> str:
+    """:func:`profile_line` of the simulation config ``sim`` (a :class:`~slamtrials.sim.SimConfig`, or an
+    :class:`~slamtrials.sim.profiles.ErrorProfile` used as it is)."""
+    from slamtrials.sim import SimConfig
+
+    if isinstance(sim, SimConfig):
+        return profile_line(sim.profile_label, tuple(o.key for o in sim.profile_overrides))
+    return profile_line(sim.name)
+
+
+def say_profile(sim) -> None:
+    """Print :func:`sim_profile_line` of ``sim`` on stderr (before the work starts)."""
+    typer.echo(sim_profile_line(sim), err=True)
 
 
 def quiet_dask() -> None:

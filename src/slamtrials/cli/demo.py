@@ -31,13 +31,16 @@ def demo(
     ] = None,
     seed: Annotated[int, typer.Option("--seed", "-s", help="Root seed of the campaign.")] = 0,
 ) -> None:
-    """Run a small campaign (online GMapping, autonomous exploration) on bundled worlds and write its HTML report."""
+    """Run a small campaign (online GMapping, autonomous exploration) on bundled worlds and write its HTML report.
+
+    Its runs simulate with the default error profile (``profile: realistic`` is printed on stderr).
+    """
     import matplotlib
 
     from slamtrials.campaign.cluster import check_workers
     from slamtrials.cli.campaign import EXIT_INTERRUPTED, _Progress, metric_share_line, summary_table
-    from slamtrials.cli.common import quiet_dask
-    from slamtrials.demo import DEMO_WORLDS, run_demo
+    from slamtrials.cli.common import quiet_dask, sim_profile_line
+    from slamtrials.demo import DEMO_WORLDS, demo_config, run_demo
 
     matplotlib.use("Agg")
     check_workers(workers)  # a bad --workers is one line before anything starts
@@ -49,8 +52,11 @@ def demo(
         "(99 % confidence, +-0.02 m / +-0.02 rad) or the cap of 10 runs."
     ]
 
+    profile = sim_profile_line(demo_config(out, worlds, seed=seed).sim)
+
     def on_event(event, progress) -> None:
         if intro:  # the first event comes after every check, so bad input stays a one-line error
+            typer.echo(profile, err=True)
             console.print(intro.pop(), highlight=False, soft_wrap=True)
         progress(event)
 

@@ -8,7 +8,7 @@ from typing import Annotated
 
 import typer
 
-from slamtrials.cli.common import make_console
+from slamtrials.cli.common import make_console, say_profile
 from slamtrials.errors import ConfigError
 
 
@@ -33,16 +33,23 @@ def simulate(
     config: Annotated[
         Path | None,
         typer.Option(
-            "--config", "-c", help="YAML with robot/laser/odometry/dt settings (SI units); default: the paper's."
+            "--config",
+            "-c",
+            help="YAML with profile/robot/laser/odometry/dt settings (SI units); default: the paper's robot and "
+            "laser with the realistic error profile (profile: paper for the paper's noise-free one).",
         ),
     ] = None,
 ) -> None:
-    """Simulate the robot driving through WAYPOINTS (or a --tour) and record laser, odometry and ground truth."""
+    """Simulate the robot driving through WAYPOINTS (or a --tour) and record laser, odometry and ground truth.
+
+    Prints the error profile it simulates with (``profile: realistic`` by default) on stderr first.
+    """
     from slamtrials.io.runfolder import RunFolder, write_run
     from slamtrials.io.waypoints import read_waypoints
     from slamtrials.io.yamlfile import read_yaml_mapping
     from slamtrials.report.runplot import save_run_figure
     from slamtrials.sim import SimConfig, simulate_waypoints
+    from slamtrials.sim.overrides import warn_overrides
     from slamtrials.sim.tour import tour_waypoints
     from slamtrials.worlds import load_world
 
@@ -56,16 +63,18 @@ def simulate(
         raise ConfigError(f"{out}: already holds a run; choose another --out or pass --overwrite")
     from slamtrials.campaign.profilefile import inline_profile_file
 
-    sim_config = SimConfig.paper()
+    sim_config = SimConfig()
     if config is not None:
         try:
             data = inline_profile_file({"sim": read_yaml_mapping(config)}, config.parent)["sim"]
             sim_config = SimConfig.from_dict(data)
         except ConfigError as exc:
             raise ConfigError(f"{config}: {exc}") from None
+        warn_overrides(sim_config, str(config), prefix="")
     options = {} if resolution is None else {"resolution": resolution}
     the_world = load_world(world, **options)
     waypoints = read_waypoints(path) if path is not None else tour_waypoints(the_world)
+    say_profile(sim_config)
     started = time.perf_counter()
     record = simulate_waypoints(the_world, waypoints, sim_config, seed=seed, max_time=max_time)
     wall = time.perf_counter() - started

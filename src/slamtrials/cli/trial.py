@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from slamtrials.cli.common import make_console
+from slamtrials.cli.common import make_console, say_profile
 from slamtrials.errors import ConfigError
 
 __all__ = ["trial", "register"]
@@ -27,7 +27,10 @@ def trial(
     config: Annotated[
         Path | None,
         typer.Option(
-            "--config", "-c", help="YAML with sim/slam/explore/termination settings; default: the paper's set-up."
+            "--config",
+            "-c",
+            help="YAML with sim/slam/explore/termination settings; default: the paper's set-up with the "
+            "realistic error profile (sim: {profile: paper} for the paper's noise-free one).",
         ),
     ] = None,
     resolution: Annotated[
@@ -35,7 +38,10 @@ def trial(
     ] = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace a run already stored in --out.")] = False,
 ) -> None:
-    """Let the robot explore WORLD on its own, mapped online by SLAM, until the map stops changing."""
+    """Let the robot explore WORLD on its own, mapped online by SLAM, until the map stops changing.
+
+    Prints the error profile it simulates with (``profile: realistic`` by default) on stderr first.
+    """
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from slamtrials.campaign.config import MetricSettings
@@ -45,6 +51,7 @@ def trial(
     from slamtrials.io.runfolder import RunFolder
     from slamtrials.io.yamlfile import read_yaml_mapping
     from slamtrials.report.runplot import save_run_figure
+    from slamtrials.sim.overrides import warn_overrides
     from slamtrials.trial import TrialConfig, TrialSummary, run_trial
     from slamtrials.worlds import load_world
 
@@ -58,7 +65,9 @@ def trial(
             trial_config = TrialConfig.from_dict(inline_profile_file(read_yaml_mapping(config), config.parent))
         except ConfigError as exc:
             raise ConfigError(f"{config}: {exc}") from None
+        warn_overrides(trial_config.sim, str(config))
     the_world = load_world(world, **({} if resolution is None else {"resolution": resolution}))
+    say_profile(trial_config.sim)
     console = make_console()
     columns = (TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[status]}"), TimeElapsedColumn())
     with Progress(*columns, console=console, transient=True, disable=not console.is_terminal) as progress:

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from slamtrials.cli.common import fmt_number, make_console, quiet_dask
+from slamtrials.cli.common import fmt_number, make_console, quiet_dask, say_profile
 from slamtrials.cli.slam import parse_settings
 from slamtrials.errors import ConfigError
 
@@ -68,8 +68,13 @@ def validate(
     log: Annotated[Path, typer.Argument(help="The real log (CARMEN .clf/.log, .gz, .bz2, or a ROS bag).")],
     relations: Annotated[Path, typer.Option("--relations", "-r", help="The log's relations file (Freiburg form).")],
     profile: Annotated[
-        str, typer.Option("--profile", help="Error profile of the replicas: a bundled name or a profile YAML file.")
-    ] = "paper",
+        str | None,
+        typer.Option(
+            "--profile",
+            help="Error profile of the replicas: a bundled name or a profile YAML file; default: realistic, the "
+            "default of every command.",
+        ),
+    ] = None,
     runs: Annotated[int, typer.Option("--runs", "-n", help="Number of replicas (seeds 0..N-1).")] = 5,
     algorithm: Annotated[
         str, typer.Option("--algorithm", "-a", help="Registered SLAM algorithm (built-in: gmapping, karto, odometry).")
@@ -102,7 +107,8 @@ def validate(
     The algorithm runs once on LOG (--seed): its final path and map are the replica's true path and
     world (unknown map cells are walls), recorded at the log's timestamps with the log's laser geometry
     and the profile's errors, --runs times (replica i has seed i). Every replica is scored on the real
-    relations' time pairs with relations from its own ground truth; the raw odometry too.
+    relations' time pairs with relations from its own ground truth; the raw odometry too. Prints the
+    error profile (``profile: realistic`` by default) on stderr before the reference run.
     """
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
@@ -123,11 +129,14 @@ def validate(
             raise ConfigError(f"{what} {path}: is a folder; give a file name")
     if figure is not None and figure.suffix.lower() not in (".png", ".pdf", ".svg"):
         raise ConfigError(f"--figure {figure}: the name must end in .png, .pdf or .svg")
-    chosen = resolve_profile_option(profile)
+    from slamtrials.sim.profiles import DEFAULT_PROFILE
+
+    chosen = resolve_profile_option(DEFAULT_PROFILE if profile is None else profile)
     resolve_config(get_algorithm(algorithm), preset=preset, overrides=overrides)  # fail before reading the log
     record = load_recording(log)
     rel = read_relations(relations)
     check_belong(record, rel, tolerance, log=str(log), relations_source=str(relations))
+    say_profile(chosen)
     runner = None
     if workers > 1 or scheduler is not None:
         quiet_dask()

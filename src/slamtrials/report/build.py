@@ -273,12 +273,34 @@ def _overview(data: CampaignData, done: pd.DataFrame) -> str:
 
 
 def _profile_text(sim: dict[str, Any]) -> str:
-    """The error profile the runs were simulated with (``paper`` for configs that name none)."""
+    """The error profile the runs were simulated with, and whether the config overrode it: ``error profile
+    realistic + 2 overrides (laser.dropout_rate 0.01 instead of 0.02526, ...)``, then where the profile's
+    values come from. A stored config that names none is ``paper`` (versions before profiles)."""
+    from pydantic import ValidationError
+
+    from slamtrials.campaign.config import stored_sim_config
+
+    sim = sim if isinstance(sim, dict) else {}
     profile = sim.get("profile", "paper")
     name = profile.get("name", "?") if isinstance(profile, dict) else str(profile)
+    try:
+        config = stored_sim_config(sim)
+    except ValidationError:  # a profile this version does not know: its name as stored
+        return f"error profile {name}"
+    label, overrides = config.profile_label, config.profile_overrides
+    changed = ", ".join(f"{o.key} {_value_text(o.value)} instead of {_value_text(o.profile_value)}" for o in overrides)
+    text = f"error profile {label}" + (f" ({changed})" if changed else "")
     if name == "paper":
-        return "error profile paper: the IROS 2018 Stage set-up (noise-free laser, per-run odometry scale bias)"
-    return f"error profile {name}" + (f": {profile.get('description')}" if isinstance(profile, dict) else "")
+        return text + ": the IROS 2018 Stage set-up (noise-free laser, per-run odometry scale bias)"
+    description = config.error_profile.description
+    return text + (f": {description}" if description else "")
+
+
+def _value_text(value: Any) -> str:
+    """A field's value, short: ``0.01``, ``[-0.01, 0.01]``."""
+    if isinstance(value, (tuple, list)):
+        return "[" + ", ".join(_value_text(v) for v in value) + "]"
+    return f"{value:.4g}" if isinstance(value, float) else str(value)
 
 
 def _relations_text(metric: dict[str, Any]) -> str:

@@ -46,7 +46,8 @@ class Simulator:
     world:
         The world to drive in. The robot starts at ``world.start`` (or ``start``).
     config:
-        Robot, laser, odometry and step settings; ``None`` means :meth:`SimConfig.paper`.
+        Robot, laser, odometry and step settings; ``None`` means ``SimConfig()`` (the default error
+        profile, ``realistic``; :meth:`SimConfig.paper` for the paper's set-up).
     rng:
         The run's random stream (a Generator, or a seed turned into one; required, there is no default
         seed). The odometry bias is drawn from it here.
@@ -73,7 +74,7 @@ class Simulator:
         start: ArrayLike | None = None,
     ):
         self.world = world
-        self.config = SimConfig.paper() if config is None else config
+        self.config = SimConfig() if config is None else config
         self.rng = as_generator(rng)
         self._bias = draw_bias(self.config.odometry, self.rng)
         pose = np.asarray(world.start if start is None else start, dtype=np.float64).reshape(-1)
@@ -136,11 +137,15 @@ class Simulator:
 
     @property
     def metadata(self) -> dict[str, Any]:
-        """JSON-serialisable facts of the run: world name, bias, start pose and the full config."""
+        """JSON-serialisable facts of the run: world name, bias, start pose, the error profile (its name,
+        label and overrides, :func:`~slamtrials.sim.overrides.profile_summary`) and the full config."""
+        from slamtrials.sim.overrides import profile_summary
+
         return {
             "world": self.world.name,
             "bias": self.bias,
             "start": [float(v) for v in self._initial],
+            "profile": profile_summary(self.config),
             "sim_config": self.config.model_dump(mode="json"),
         }
 

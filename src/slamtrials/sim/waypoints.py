@@ -71,7 +71,8 @@ def simulate_waypoints(
     waypoints:
         float ``[N, 2]`` waypoint positions (m, world frame).
     config:
-        Simulation settings; ``None`` means :meth:`SimConfig.paper`.
+        Simulation settings; ``None`` means ``SimConfig()``: the default error profile, ``realistic``
+        (:meth:`SimConfig.paper` for the paper's set-up).
     seed:
         Seed (or Generator) of the run's random stream (odometry bias, optional noise).
     max_time:

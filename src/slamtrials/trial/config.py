@@ -1,7 +1,9 @@
 """Configuration of one trial: simulator, SLAM algorithm, explorer and termination rule (pydantic).
 
-``TrialConfig()`` is the paper's set-up: the paper's robot and laser (:class:`~slamtrials.sim.SimConfig`),
-``gmapping`` with the ``paper`` preset, frontier exploration and the snapshot termination rule. The
+``TrialConfig()`` is the paper's set-up with the default error profile: the paper's robot and laser with
+the ``realistic`` profile's errors (:class:`~slamtrials.sim.SimConfig`; ``{"sim": {"profile": "paper"}}``
+for the paper's noise-free Stage set-up), ``gmapping`` with the ``paper`` preset, frontier exploration and
+the snapshot termination rule. The
 explorer drives the simulated robot, so its motion limits, footprint and control period are those of
 ``sim`` (:meth:`TrialConfig.robot_limits`); the ``explore`` section holds the rest and refuses robot fields.
 """
@@ -52,7 +54,7 @@ class TrialConfig(BaseModel):
     Attributes
     ----------
     sim:
-        Robot, laser, odometry and time step.
+        Robot, laser, odometry and time step (error profile ``realistic`` unless named).
     slam:
         The online SLAM algorithm.
     explore:

@@ -93,7 +93,8 @@ def run_trial(
     world:
         The world; the robot starts at ``world.start``.
     config:
-        The trial's settings; ``None`` means :class:`TrialConfig` defaults (the paper's set-up).
+        The trial's settings; ``None`` means :class:`TrialConfig` defaults (the paper's set-up
+        with the default error profile, ``realistic``).
     seed:
         Non-negative seed of every random draw of the trial.
     on_progress:

@@ -42,6 +42,7 @@ from slamtrials.record import Relations, RunRecord, Trajectory
 from slamtrials.seeding import check_seed, run_streams
 from slamtrials.sim.config import ErrorProfile, SimConfig
 from slamtrials.sim.pathreplay import simulate_path
+from slamtrials.sim.profiles import DEFAULT_PROFILE, resolve_profile
 from slamtrials.slam.base import get_algorithm, resolve_config
 from slamtrials.slam.offline import SlamRun, run_over_recording
 from slamtrials.validation.replica import UNKNOWN_AS_WALL, Replica, blocked_frames, laser_config_for, world_from_map
@@ -397,8 +398,8 @@ def check_belong(record: RunRecord, relations: Relations, tolerance: float, *, l
 def validate(
     record: RunRecord,
     relations: Relations,
-    profile: ErrorProfile,
-    settings: ValidationSettings,
+    profile: ErrorProfile | str = DEFAULT_PROFILE,
+    settings: ValidationSettings | None = None,
     *,
     reference: SlamRun | None = None,
     replica: Replica | None = None,
@@ -416,9 +417,10 @@ def validate(
     relations:
         The log's relations (true relative poses between pairs of its timestamps).
     profile:
-        The replicas' error profile.
+        The replicas' error profile, or a bundled profile's name; by default
+        :data:`~slamtrials.sim.profiles.DEFAULT_PROFILE` (``realistic``), the default of every simulation.
     settings:
-        Algorithm, replica count, seeds, tolerance.
+        Algorithm, replica count, seeds, tolerance; ``ValidationSettings()`` by default.
     reference:
         The reference SLAM run on ``record``; by default the algorithm is run with ``reference_seed``.
     replica:
@@ -434,10 +436,16 @@ def validate(
     Raises
     ------
     ConfigError
-        Bad settings, a log without frames, relations that do not belong to the log (no timestamp near a
-        frame), an unknown algorithm or parameter, or a reference run that gives nothing to replicate.
+        Bad settings, an unknown profile name, a log without frames, relations that do not belong to the
+        log (no timestamp near a frame), an unknown algorithm or parameter, or a reference run that gives
+        nothing to replicate.
     """
-    s = settings
+    s = ValidationSettings() if settings is None else settings
+    if not isinstance(profile, ErrorProfile):
+        try:
+            profile = resolve_profile(profile)
+        except ValueError as exc:
+            raise ConfigError(str(exc)) from None
     check_belong(record, relations, s.tolerance, log=log, relations_source=relations_source)
     resolve_config(get_algorithm(s.algorithm), preset=s.preset, overrides=s.overrides)
     if reference is None:

@@ -35,6 +35,7 @@ def world_and_record():
     world = load_world("office_small_01")
     waypoints = tour_waypoints(world, num_goals=3)
     config = SimConfig(
+        profile="paper",  # the errors below, nothing else
         odometry=OdometryConfig(bias_linear=0.03, bias_angular=0.05),
         laser=LaserConfig(mount=(0.1, 0.0, 0.0), range_noise_std=0.01),
     )

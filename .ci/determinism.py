@@ -11,10 +11,10 @@
 
 ``produce OUT`` writes into OUT: the bundled catalog regenerated (``catalog/``), a generated world that
 is not in the catalog (``generated/``), an exploration trial on office_small_01 (``trial/``: the run
-folder and its sampled relations and errors) with the simulator's defaults (the ``paper`` error
-profile), the same trial with the ``realistic`` profile that campaigns use by default
-(``trial_realistic/``: laser noise, short readings, dropouts and odometry noise drawn, and the
-explorer's handling of noisy scans), and GMapping and karto over the first scans of the MIT CSAIL
+folder and its sampled relations and errors) with the ``paper`` error profile (named: the noise-free
+laser and the per-run bias alone), the same trial with ``realistic``, the default profile of every
+command (``trial_realistic/``: laser noise, short readings, dropouts and odometry noise drawn, and the
+explorer's handling of noisy scans); both name their profile, so a change of the default changes neither, and GMapping and karto over the first scans of the MIT CSAIL
 CARMEN log (``gmapping/``, ``karto/``), and ``calibrate`` and ``validate`` (``realistic`` profile, one
 replica) over the first scans of that log (``calibration/``, ``validation/``); the log's parts only when
 the shared data is there: ``SLAMTRIALS_SHARED`` or ``../shared`` beside the repository. It then writes

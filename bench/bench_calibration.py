@@ -69,7 +69,7 @@ def show(title: str, cal: Calibration, compare: dict[str, object]) -> None:
 
 def known() -> None:
     truth = {**LASER, **ODOMETRY}
-    config = SimConfig(laser=LaserConfig(**LASER), odometry=OdometryConfig(**ODOMETRY))
+    config = SimConfig(profile="paper", laser=LaserConfig(**LASER), odometry=OdometryConfig(**ODOMETRY))
     for name in ("office_small_01", "school_medium_01"):
         world = load_world(name)
         record = simulate_waypoints(world, tour_waypoints(world, num_goals=8), config, seed=7, max_time=1500)

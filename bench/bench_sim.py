@@ -169,7 +169,7 @@ def time_steps(world: World, n_steps: int, seed: int = 0, config: SimConfig | No
     best = math.inf
     stalls = 0
     for _ in range(3):
-        sim = Simulator(world, config or SimConfig(), np.random.default_rng(seed))
+        sim = Simulator(world, config or SimConfig.paper(), np.random.default_rng(seed))
         sim.observe()
         robot = sim.config.robot
         goal_idx = 0
@@ -212,7 +212,7 @@ def main() -> None:
     print("| world | scans/s (accelerated) | scans/s (plain DDA) | speed-up | mean range (m) | x real time at 10 Hz |")
     print("|---|---:|---:|---:|---:|---:|")
     for name, world, poses in worlds:
-        laser = LaserModel(world, SimConfig().laser)
+        laser = LaserModel(world, SimConfig.paper().laser)
         fast, mean_range = time_scans(laser, poses)
         plain, _ = time_scans(laser, poses[:500], plain=True)
         print(f"| {name} | {fast:,.0f} | {plain:,.0f} | {fast / plain:.1f} | {mean_range:.2f} | {fast / 10:,.0f} |")
@@ -241,7 +241,7 @@ def main() -> None:
     )
     for name, world in step_worlds:
         poses = free_poses(world, 2000, np.random.default_rng(3))
-        scans_paper = time_laser_model(world, SimConfig(), poses)
+        scans_paper = time_laser_model(world, SimConfig.paper(), poses)
         scans_every = time_laser_model(world, EVERY_ERROR, poses)
         scans_staying = time_laser_model(world, staying, poses)
         scans_realistic = time_laser_model(world, realistic, poses)

@@ -94,11 +94,12 @@ def world_list(max_area: float | None, names: list[str] | None = None) -> list[t
 def one_trial(world_ref: str, source: str, seed: int, out: str) -> dict:
     """Run one trial in a worker process and return its CSV row."""
     from slamtrials.report.runplot import save_run_figure
-    from slamtrials.trial import run_trial
+    from slamtrials.sim import SimConfig
+    from slamtrials.trial import TrialConfig, run_trial
     from slamtrials.worlds import load_world
 
     world = load_world(world_ref)
-    record = run_trial(world, None, seed)
+    record = run_trial(world, TrialConfig(sim=SimConfig.paper()), seed)  # the paper set-up, named
     info = record.metadata["trial"]
     passed = info["termination_reason"] in PASSING_REASONS and info["mapped_fraction"] >= 0.9
     if not passed:

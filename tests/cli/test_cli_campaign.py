@@ -250,6 +250,7 @@ def test_status_of_an_interrupted_campaign_and_resuming_a_complete_one(fake_camp
         conn.execute("UPDATE worlds SET status = 'running'")
     status = runner.invoke(app, ["campaign", "status", str(folder)])
     assert status.exit_code == 0, status.output
+    assert "profile realistic, seed" in status.output  # the campaign names no profile: the default
     assert "interrupted" in status.output and "running" not in status.output.replace("campaign run", "")
     assert f"not finished, no driver alive (interrupted; resume with 'slamtrials campaign run --out {folder}')" in (
         status.output.replace("\n", "")

@@ -221,7 +221,8 @@ def status(folder: Annotated[Path, typer.Argument(help="Campaign folder.")]) -> 
     what = f"replay of {config.replay_of}" if state.kind == "replay" else "campaign"
     interrupted = state.interrupted
     console.print(
-        f"{folder}: {what}, algorithm {config.slam.algorithm} (preset {config.slam.preset}), seed {config.seed}, "
+        f"{folder}: {what}, algorithm {config.slam.algorithm} (preset {config.slam.preset}), "
+        f"profile {config.sim.profile_label}, seed {config.seed}, "
         f"runs: initial {config.runs.initial}, cap {config.runs.max_runs}, margins {config.runs.margin_t:g} m / "
         f"{config.runs.margin_r:g} rad at {100 * config.runs.confidence:g} %; relations: "
         f"{config.metric.sampling.describe()}; created {state.created}",

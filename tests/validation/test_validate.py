@@ -186,3 +186,19 @@ def test_relations_of_another_log_are_refused(drive):
     far = Relations(t1=driven.t[:3] + 1e4, t2=driven.t[3:6] + 1e4, delta=np.zeros((3, 3)))
     with pytest.raises(ConfigError, match="does not belong to"):
         validate(driven, far, NOISY, ValidationSettings(algorithm="odometry", runs=1))
+
+
+def test_validate_without_a_profile_takes_the_one_default_and_a_name_resolves(drive):
+    from slamtrials.sim.profiles import BUNDLED_PROFILES, DEFAULT_PROFILE
+
+    world, _, driven = drive
+    replica = Replica(world, driven.t, driven.truth, laser_config_for(driven.laser, driven.scans.shape[1]))
+    relations = relations_between(Trajectory(t=driven.t, poses=driven.truth), np.array([0, 10]), np.array([40, 90]))
+    settings = ValidationSettings(algorithm="odometry", runs=1)
+    default = validate(driven, relations, settings=settings, replica=replica)
+    assert default.profile == BUNDLED_PROFILES[DEFAULT_PROFILE] and default.profile.name == "realistic"
+    assert default.to_dict()["profile"]["name"] == "realistic"
+    paper = validate(driven, relations, "paper", settings, replica=replica)
+    assert paper.profile == BUNDLED_PROFILES["paper"]
+    with pytest.raises(ConfigError, match="unknown error profile 'realstic'"):
+        validate(driven, relations, "realstic", settings, replica=replica)

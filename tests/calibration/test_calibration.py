@@ -31,20 +31,23 @@ LASER = {
 }
 #: The edge model's reach (rad): a setting of the calibration (its default, 1 degree), written into the profile.
 EDGE_REACH = CalibrationSettings().edge_reach
+#: The odometry noise is a random walk per metre and per radian (m/sqrt(m), rad/sqrt(rad), m/sqrt(rad),
+#: rad/sqrt(m)): the values before issue 32 (0.05 m/m, 0.1 rad/rad, 0.01 m/rad, 0.02 rad/m per 0.1 s step)
+#: carried over to this tour's steps (0.055 m and 0.03 rad on average), rounded.
 ODOMETRY = {
     "bias_linear": 0.03,
     "bias_angular": -0.08,
-    "noise_linear_per_m": 0.05,
-    "noise_angular_per_rad": 0.1,
-    "noise_linear_per_rad": 0.01,
-    "noise_angular_per_m": 0.02,
+    "noise_linear_per_m": 0.012,
+    "noise_angular_per_rad": 0.02,
+    "noise_linear_per_rad": 0.006,
+    "noise_angular_per_m": 0.005,
 }
 
 
 @pytest.fixture(scope="module")
 def simulated():
     world = load_world("office_small_01")
-    config = SimConfig(laser=LaserConfig(**LASER), odometry=OdometryConfig(**ODOMETRY))
+    config = SimConfig(profile="paper", laser=LaserConfig(**LASER), odometry=OdometryConfig(**ODOMETRY))
     record = simulate_waypoints(world, tour_waypoints(world, num_goals=6), config, seed=5, max_time=600)
     assert record.metadata["outcome"] == "completed"
     return world, record
@@ -66,7 +69,12 @@ def test_fit_recovers_each_known_value_within_its_stated_uncertainty(fitted, nam
     # power, and on the long beams, where most of them are) widen the core a little, which the fit cannot
     # tell from noise (here +1 to +2.5 %; docs/realism.md)
     bias = 0.025 * truth if name in ("range_noise_std", "range_noise_per_m") else 0.0
-    assert abs(value.value - truth) <= 2.0 * value.stderr + bias, (value, truth)
+    # The odometry's scale biases: their block-bootstrap error is about half their spread over seeds (12
+    # seeds of this tour, issue 32: bias_angular spreads 0.0035 rad/rad where the bootstrap says 0.0018;
+    # a few long turns decide the slope, and resampling blocks does not vary them enough), so they are
+    # held to twice their stated error (docs/realism.md, "Calibration")
+    stated = value.stderr * (2.0 if name.startswith("bias_") else 1.0)
+    assert abs(value.value - truth) <= 2.0 * stated + bias, (value, truth)
     # and it is an uncertainty worth stating: well below the value itself
     assert 0.0 < value.stderr < 0.25 * abs(truth), value
 
@@ -83,7 +91,7 @@ def test_without_edge_readings_the_fit_finds_next_to_none(fitted):
 def test_edge_chance_is_recovered_and_its_readings_are_not_counted_short(chance):
     world = load_world("office_small_01")
     laser = {"range_noise_std": 0.02, "short_rate": 0.1, "short_run_beams": 3.0, "dropout_rate": 0.02}
-    config = SimConfig(laser=LaserConfig(**laser, edge_chance=chance, edge_reach=EDGE_REACH))
+    config = SimConfig(profile="paper", laser=LaserConfig(**laser, edge_chance=chance, edge_reach=EDGE_REACH))
     record = simulate_waypoints(world, tour_waypoints(world, num_goals=3), config, seed=7, max_time=300)
     reference = Reference.from_world(record.truth, world, "simulation truth")
     fit = calibrate(record, reference, CalibrationSettings(bootstrap=10, min_distance=5.0), seed=2)

@@ -26,8 +26,10 @@ def record():
     config = SimConfig(
         profile="paper",  # the errors below, nothing else
         laser=LaserConfig(range_noise_std=0.02, short_rate=0.05, dropout_rate=0.02),
+        # random walks per metre and per radian: the values before issue 32 (0.03 m/m and 0.05 rad/rad per
+        # 0.1 s step) carried over to this tour's steps of about 0.05 m and 0.03 rad
         odometry=OdometryConfig(
-            bias_linear=0.02, bias_angular=-0.05, noise_linear_per_m=0.03, noise_angular_per_rad=0.05
+            bias_linear=0.02, bias_angular=-0.05, noise_linear_per_m=0.007, noise_angular_per_rad=0.009
         ),
     )
     rec = simulate_waypoints(world, tour_waypoints(world, num_goals=4), config, seed=11, max_time=400)
@@ -96,7 +98,9 @@ def test_a_too_short_log_is_one_line_exit_2_and_nothing_written(record, tmp_path
     )
     log = write_carmen(tmp_path / "short.clf", carmen_from_run(short))
     out = tmp_path / "short.yaml"
-    _one_line_error(runner.invoke(app, ["calibrate", str(log), "--out", str(out)]), "short.clf", "at least 200")
+    _one_line_error(
+        runner.invoke(app, ["calibrate", str(log), "--out", str(out)]), "short.clf", "too short", "at least 200"
+    )
     assert not out.exists() and not (tmp_path / "short.png").exists()
 
 
@@ -137,3 +141,55 @@ def test_a_missing_log_is_one_line_exit_2(tmp_path):
 )
 def test_the_profile_is_named_after_the_log(name, expected, tmp_path):
     assert profile_name(tmp_path / name) == expected
+
+
+def _relations_file(record, path, shift: float = 0.0):
+    """Relations of the simulated tour as the Freiburg benchmark gives them: chained ones every two frames
+    and a few long ones, from the true path (stamps moved by ``shift`` seconds)."""
+    from slamtrials.io.relations import write_relations
+    from slamtrials.metric.sampling import relations_between
+    from slamtrials.record import Relations, Trajectory
+
+    n = len(record)
+    first = np.concatenate([np.arange(0, n - 2, 2), np.arange(10, n - 400, 300)])
+    second = np.concatenate(
+        [np.arange(2, n, 2)[: first.size - len(np.arange(10, n - 400, 300))], np.arange(10, n - 400, 300) + 350]
+    )
+    rel = relations_between(Trajectory(record.t, record.truth), first, second)
+    return write_relations(path, Relations(t1=rel.t1 + shift, t2=rel.t2 + shift, delta=rel.delta))
+
+
+def test_calibrate_fits_the_odometry_against_the_logs_relations_and_says_so(record, tmp_path):
+    log = write_carmen(tmp_path / "office.clf", carmen_from_run(record))
+    relations = _relations_file(record, tmp_path / "office.relations")
+    out = tmp_path / "office.yaml"
+    args = ["calibrate", str(log), "--out", str(out), "--set", "particles=5", "--bootstrap", "10"]
+    result = runner.invoke(app, [*args, "--relations", str(relations)])
+    assert result.exit_code == 0, result.output
+    assert "odometry against benchmark relations:" in result.output
+    assert "used in 1 chains" in result.output and "long ones not used" in result.output
+    assert "excluded: no relations where the odometry moves against the reference" in result.output
+    assert "benchmark relations of office.relations" in read_profile(out).description
+    # without relations the printout says the odometry was fitted against the SLAM path
+    plain = runner.invoke(app, [*args, "--out", str(tmp_path / "plain.yaml")])
+    assert plain.exit_code == 0, plain.output
+    assert "odometry against the SLAM path" in plain.output and "give --relations" in plain.output
+
+
+def test_relations_of_another_log_are_one_line_exit_2_and_nothing_written(record, tmp_path):
+    log = write_carmen(tmp_path / "office.clf", carmen_from_run(record))
+    relations = _relations_file(record, tmp_path / "other.relations", shift=1e5)
+    out = tmp_path / "office.yaml"
+    result = runner.invoke(app, ["calibrate", str(log), "--out", str(out), "--relations", str(relations)])
+    _one_line_error(result, "other.relations", "outside the log's span", "not this log's")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["office.clf", "other.relations"]
+
+
+def test_a_too_irregular_log_is_one_line_exit_2_saying_which(record, tmp_path):
+    t = record.t.copy()
+    t[1::3] = t[0::3][: t[1::3].size] + 0.004  # two of three frames 4 and 8 ms after the one before
+    t[2::3] = t[0::3][: t[2::3].size] + 0.008
+    log = write_carmen(tmp_path / "dup.clf", carmen_from_run(replace(record, t=t)))
+    out = tmp_path / "dup.yaml"
+    _one_line_error(runner.invoke(app, ["calibrate", str(log), "--out", str(out)]), "dup.clf", "too irregular")
+    assert not out.exists()

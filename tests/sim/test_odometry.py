@@ -173,7 +173,9 @@ def test_noise_of_a_step_cut_in_pieces_adds_up_to_the_noise_of_the_whole_step():
                 half = 0.5 * phi
                 total_heading += phi
                 mean_heading = before[2] + half  # the chord's direction; the arc length is signed
-                chord = math.cos(mean_heading) * (after[0] - before[0]) + math.sin(mean_heading) * (after[1] - before[1])
+                chord = math.cos(mean_heading) * (after[0] - before[0]) + math.sin(mean_heading) * (
+                    after[1] - before[1]
+                )
                 total_length += chord / (math.sin(half) / half)
             heading_errors.append(total_heading - 0.1)
             length_errors.append(total_length - 0.2)

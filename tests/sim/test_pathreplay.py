@@ -149,7 +149,12 @@ def test_slips_along_a_path_do_not_depend_on_the_stamps():
     ``slip_per_m D slip_angular_std^2`` on every stamp pattern."""
     profile = ErrorProfile(
         name="slips",
-        odometry={"slip_per_m": 0.5, "slip_angular_std": 0.05, "bias_linear_range": (0.0, 0.0), "bias_angular_range": (0.0, 0.0)},
+        odometry={
+            "slip_per_m": 0.5,
+            "slip_angular_std": 0.05,
+            "bias_linear_range": (0.0, 0.0),
+            "bias_angular_range": (0.0, 0.0),
+        },
     )
     config = SimConfig.from_dict({"profile": profile, "laser": {"fov": 0.1, "angular_resolution": 0.1}})
     world = _world()
@@ -157,7 +162,10 @@ def test_slips_along_a_path_do_not_depend_on_the_stamps():
         t, path = make()
         true_l, true_phi = _arcs(path)
         errors = np.array(
-            [np.sum(_arcs(simulate_path(world, t, path, config, seed).odometry)[1]) - np.sum(true_phi) for seed in range(SEEDS)]
+            [
+                np.sum(_arcs(simulate_path(world, t, path, config, seed).odometry)[1]) - np.sum(true_phi)
+                for seed in range(SEEDS)
+            ]
         )
         expected = 0.5 * float(np.sum(np.abs(true_l))) * 0.05**2
         # a compound Poisson sum is not normal: its variance estimate has std sqrt((3 / (lambda D) + 2) / N) of it

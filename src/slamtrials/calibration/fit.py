@@ -17,11 +17,21 @@ from numpy.typing import NDArray
 from slamtrials.calibration.beams import BeamSample, beam_sample
 from slamtrials.calibration.laser import LASER_VALUES, LaserFit, fit_laser
 from slamtrials.calibration.lifetime import LifetimeFit, fit_lifetime, model_laser_values
-from slamtrials.calibration.odometry import ODOMETRY_VALUES, OdometryFit, anchor_frames, fit_odometry, step_motion
+from slamtrials.calibration.odometry import (
+    ODOMETRY_VALUES,
+    OdometryFit,
+    anchor_frames,
+    check_relations_belong,
+    fit_segments,
+    motion_chunks,
+    relation_segments,
+    slam_segments,
+    step_motion,
+)
 from slamtrials.calibration.reference import Reference, check_calibratable
 from slamtrials.calibration.settings import CalibrationSettings
 from slamtrials.errors import CalibrationError
-from slamtrials.record import RunRecord
+from slamtrials.record import Relations, RunRecord
 from slamtrials.sim.config import ErrorProfile, LaserConfig
 from slamtrials.sim.laser_errors import apply_laser_errors
 
@@ -55,10 +65,10 @@ _UNITS = {
     "short_fleeting_share": "",
     "bias_linear": "m/m",
     "bias_angular": "rad/rad",
-    "noise_linear_per_m": "m/m",
-    "noise_linear_per_rad": "m/rad",
-    "noise_angular_per_rad": "rad/rad",
-    "noise_angular_per_m": "rad/m",
+    "noise_linear_per_m": "m/sqrt(m)",
+    "noise_linear_per_rad": "m/sqrt(rad)",
+    "noise_angular_per_rad": "rad/sqrt(rad)",
+    "noise_angular_per_m": "rad/sqrt(m)",
 }
 
 
@@ -78,7 +88,10 @@ class Calibration:
         Every value of :data:`LASER_VALUES`, ``short_lifetime`` and ``short_fleeting_share`` (0 when not
         fitted), then :data:`ODOMETRY_VALUES`, with its standard error.
     reference:
-        What the reference is.
+        What the reference is (the laser's: a SLAM path and map, or a known world).
+    odometry_reference:
+        What the odometry was fitted against: the benchmark relations (``"N benchmark relations of
+        FILE"``), else the same as ``reference``.
     frames:
         Frames of the log.
     residuals:
@@ -108,6 +121,7 @@ class Calibration:
     model_no_return: NDArray[np.bool_]
     bootstrap: int
     laser_frames: int = 0
+    odometry_reference: str = ""
 
     def value(self, name: str) -> FittedValue:
         """The fitted value called ``name``."""
@@ -154,17 +168,34 @@ def calibrate(
     settings: CalibrationSettings | None = None,
     *,
     seed: int = 0,
+    relations: Relations | None = None,
+    relations_source: str = "relations",
 ) -> Calibration:
     """Fit the laser and odometry error models of ``record`` against ``reference``.
+
+    With ``relations`` (the log's benchmark relations, human-checked relative poses) the odometry is
+    fitted against them instead of the reference path (:func:`~slamtrials.calibration.odometry.relation_segments`),
+    independent of any SLAM run; the laser is fitted against ``reference`` either way.
+    ``relations_source`` names them in :attr:`Calibration.odometry_reference`.
 
     Raises
     ------
     CalibrationError
-        The log is too short or has no odometry, the reference does not hold one pose per frame, or too
-        few beams hit a mapped wall to fit the laser.
+        The log is too short, too irregular or has no odometry, the reference does not hold one pose per
+        frame, the relations are not the log's, or too few beams hit a mapped wall to fit the laser, or
+        too few segments are left for the odometry fit.
     """
     cfg = settings or CalibrationSettings()
-    check_calibratable(record, min_frames=cfg.min_frames, min_distance=cfg.min_distance, min_rotation=cfg.min_rotation)
+    check_calibratable(
+        record,
+        min_frames=cfg.min_frames,
+        min_distance=cfg.min_distance,
+        min_rotation=cfg.min_rotation,
+        min_gap=cfg.min_gap,
+        max_tiny_share=cfg.min_step_share,
+    )
+    if relations is not None:
+        check_relations_belong(record.t, relations, cfg.relation_tolerance)
     if reference.poses.shape != (len(record), 3):
         raise CalibrationError(
             f"the reference holds {reference.poses.shape[0]} poses for {len(record)} frames; it needs one per frame"
@@ -182,11 +213,38 @@ def calibrate(
         )
     steps = step_motion(reference.poses, record.odometry)
     log_step = float(np.median(np.diff(record.t)))
-    odometry = fit_odometry(steps, anchors, cfg, log_step)
+    use = None
+    if relations is None:
+        segments = slam_segments(steps, anchors)
+        source, odometry_reference = "slam", reference.source
+    else:
+        segments, use = relation_segments(record.t, record.odometry, relations, cfg)
+        source = "relations"
+        odometry_reference = f"{use.used} benchmark relations of {relations_source}"
+    chunks = motion_chunks(steps.odo_length, steps.odo_turn, cfg)
+
+    def fit_odo(weight: NDArray[np.float64] | None) -> OdometryFit | None:
+        return fit_segments(
+            segments,
+            steps.odo_length,
+            steps.odo_turn,
+            cfg,
+            source=source,
+            log_step=log_step,
+            frame_weight=weight,
+            chunks=chunks,
+            relations=use,
+        )
+
+    odometry = fit_odo(None)
     if odometry is None:
+        what = (
+            f"the reference has {anchors.size} frames that are more than odometry carried on"
+            if use is None
+            else f"{use.used} of the {use.total} relations are short ones on two frames of the log ({use.chains} chains)"
+        )
         raise CalibrationError(
-            f"the reference has {anchors.size} frames that are more than odometry carried on; the odometry fit "
-            f"needs at least {4 * cfg.windows[2] + 1}"
+            f"{what}; the odometry fit needs windows of at least three lengths of {cfg.windows}, four of each"
         )
     frames = len(record)
     blocks = math.ceil(frames / cfg.block_frames)
@@ -198,7 +256,7 @@ def calibrate(
         if again is not None:
             laser_draws.append([again.values[k] for k in LASER_VALUES])
         counts = np.bincount(rng.integers(0, blocks, size=blocks), minlength=blocks).astype(np.float64)
-        refit = fit_odometry(steps, anchors, cfg, log_step, counts[frame_blocks])
+        refit = fit_odo(counts[frame_blocks])
         if refit is not None:
             odo_draws.append([refit.values[k] for k in ODOMETRY_VALUES])
     laser_se = (
@@ -237,4 +295,5 @@ def calibrate(
         model_no_return=model_drop,
         bootstrap=cfg.bootstrap,
         laser_frames=sample.frames_used,
+        odometry_reference=odometry_reference,
     )

@@ -98,11 +98,41 @@ class Reference:
         )
 
 
-def check_calibratable(record: RunRecord, *, min_frames: int, min_distance: float, min_rotation: float) -> None:
-    """Raise :class:`CalibrationError` (one line) when ``record`` is too short or has no odometry."""
+def check_calibratable(
+    record: RunRecord,
+    *,
+    min_frames: int,
+    min_distance: float,
+    min_rotation: float,
+    min_gap: float = 0.01,
+    max_tiny_share: float = 0.5,
+) -> None:
+    """Raise :class:`CalibrationError` (one line, saying which) when ``record`` is too short, too irregular
+    or has no odometry.
+
+    Too irregular: frame times that are not finite or do not increase (lines out of order), or more than
+    ``max_tiny_share`` of the frame gaps shorter than ``min_gap`` seconds (duplicated stamps): such a log's
+    frames do not sample its motion in time, and its relations would not find their frames.
+    """
     n = len(record)
     if n < min_frames:
-        raise CalibrationError(f"the log has {n} laser frames; calibration needs at least {min_frames}")
+        raise CalibrationError(f"the log is too short: {n} laser frames; calibration needs at least {min_frames}")
+    t = np.asarray(record.t, dtype=np.float64)
+    if not np.all(np.isfinite(t)):
+        raise CalibrationError("the log is too irregular: some frame times are not finite")
+    gaps = np.diff(t)
+    back = np.flatnonzero(gaps < 0.0)
+    if back.size:
+        raise CalibrationError(
+            f"the log is too irregular: its frame times go back {back.size} times (first at frame {int(back[0]) + 1}, "
+            f"t = {t[back[0] + 1]:.3f} s); sort its lines by time"
+        )
+    tiny = int(np.count_nonzero(gaps < min_gap))
+    if gaps.size and tiny > max_tiny_share * gaps.size:
+        raise CalibrationError(
+            f"the log is too irregular: {tiny} of its {gaps.size} frame gaps are shorter than {min_gap:g} s "
+            f"(duplicated stamps); calibration allows at most {100 * max_tiny_share:g} %"
+        )
     odo = record.odometry
     if not np.all(np.isfinite(odo)):
         raise CalibrationError("the log's odometry holds non-finite poses (no odometry to calibrate from)")
@@ -113,11 +143,12 @@ def check_calibratable(record: RunRecord, *, min_frames: int, min_distance: floa
         raise CalibrationError("the log has no odometry: its odometry pose never changes")
     if moved < min_distance:
         raise CalibrationError(
-            f"the log's odometry travels {moved:.2f} m; calibration needs at least {min_distance:g} m"
+            f"the log is too short: its odometry travels {moved:.2f} m; calibration needs at least {min_distance:g} m"
         )
     if turned < min_rotation:
         raise CalibrationError(
-            f"the log's odometry turns {turned:.2f} rad in all; calibration needs at least {min_rotation:g} rad"
+            f"the log is too short: its odometry turns {turned:.2f} rad in all; calibration needs at least "
+            f"{min_rotation:g} rad"
         )
 
 

@@ -47,9 +47,22 @@ class CalibrationSettings(BaseModel):
         Odometry segments where the odometry and the reference move at least this far (m) in opposite
         directions are a recording defect, not noise; every window holding one is left out
         (:func:`~slamtrials.calibration.odometry.direction_conflicts`).
-    sim_dt:
-        The simulator step (s) the odometry noise coefficients are given for (the model's noise is per
-        step, so its coefficients depend on the step: see docs/realism.md, "Calibration").
+    chunk_distance, chunk_turn:
+        The odometry's true motion (the ``D`` and ``R`` the noise grows with) is measured over chunks of
+        its path that end after this many metres or radians of travel, where the motion outgrows the
+        noise (:func:`~slamtrials.calibration.odometry.step_magnitudes`); GMapping's update distances.
+    relation_tolerance:
+        Largest gap (s) between a relation's stamp and a frame (the Freiburg evaluator's 0.1 s).
+    relation_max_distance, relation_max_turn:
+        Relations whose span drives farther (m) or turns more (rad) by the odometry are not used by the
+        odometry fit: a span that long (a loop closure) is not one arc.
+    min_step_share:
+        A log is too irregular to calibrate from when more than this share of its frame gaps are shorter
+        than ``min_gap`` (duplicated stamps, or lines out of order).
+    min_gap:
+        See ``min_step_share`` (s). 0.01 s: no laser scanner of the logs scans at 100 Hz, so gaps that short
+        are stamping artefacts (the Intel Research Lab log has 30 % of them after sorting its lines; it
+        is accepted: the odometry noise follows the motion, not the stamps).
     lifetime_lags:
         Lags (s, rounded to whole frames) of the persistence curve the short readings' lifetime is fitted to
         (:mod:`~slamtrials.calibration.lifetime`).
@@ -96,7 +109,13 @@ class CalibrationSettings(BaseModel):
     direction_min_step: float = Field(
         0.02, gt=0.0, le=1.0, description="least opposite travel of a direction conflict (m)"
     )
-    sim_dt: float = Field(0.1, gt=0.0, le=1.0, description="simulator step the odometry noise is given for (s)")
+    chunk_distance: float = Field(1.0, gt=0.0, le=100.0, description="chunk length of the motion estimate (m)")
+    chunk_turn: float = Field(0.5, gt=0.0, le=10.0, description="chunk turn of the motion estimate (rad)")
+    relation_tolerance: float = Field(0.1, gt=0.0, le=10.0, description="relation stamp tolerance (s)")
+    relation_max_distance: float = Field(3.0, gt=0.0, le=1000.0, description="longest relation span used (m)")
+    relation_max_turn: float = Field(1.5, gt=0.0, le=100.0, description="largest relation turn used (rad)")
+    min_step_share: float = Field(0.5, gt=0.0, le=1.0, description="largest share of tiny frame gaps")
+    min_gap: float = Field(0.01, ge=0.0, le=1.0, description="a frame gap shorter than this is tiny (s)")
     lifetime_lags: tuple[float, ...] = Field((0.2, 0.6, 1.0, 2.0, 4.0), description="persistence lags (s)")
     lifetime_grid: tuple[float, ...] = Field(
         (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0), description="lifetimes replayed (s)"

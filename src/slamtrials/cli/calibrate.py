@@ -1,14 +1,17 @@
 """``slamtrials calibrate``: fit the simulator's error models to a real log and write the profile.
 
-A thin wrapper over :mod:`slamtrials.calibration`: it reads the log, checks that it can be calibrated
-from (before anything runs), runs the SLAM algorithm for the reference, fits, prints the values with
-their uncertainty, and writes the profile YAML (:func:`slamtrials.campaign.profilefile.write_profile`)
-and a PNG page of figures next to it.
+A thin wrapper over :mod:`slamtrials.calibration`: it reads the log (and its benchmark relations, with
+``--relations``), checks that it can be calibrated from and that the relations are the log's (before
+anything runs), runs the SLAM algorithm for the reference, fits, prints the values with their
+uncertainty, and writes the profile YAML (:func:`slamtrials.campaign.profilefile.write_profile`) and a
+PNG page of figures next to it. Relations are given explicitly, as to ``validate``: none is picked up
+from beside the log.
 """
 
 from __future__ import annotations
 
 import datetime as _dt
+import math
 import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
@@ -40,6 +43,8 @@ def format_calibration(cal: Calibration, log: str) -> str:
     """The printed fit: the log's residual figures, then every value +- its standard error."""
     laser, odo = cal.laser, cal.odometry
     lines = [f"{log}: {cal.frames} frames; reference: {cal.reference}"]
+    if cal.odometry_reference and cal.odometry_reference != cal.reference:
+        lines[-1] += f"; odometry against {cal.odometry_reference}"
     lines.append(
         f"laser: {laser.beams} beams of {cal.laser_frames} frames hit a mapped wall through known free space; "
         "robust sigma of their residuals "
@@ -91,26 +96,41 @@ def format_calibration(cal: Calibration, log: str) -> str:
             f"  short readings still read short within the radius after (real / fitted; {life.short_readings} "
             f"short readings of {life.base_frames} frames): {curve}"
         )
-    lines.append(
-        f"odometry: {odo.anchors} reference frames beyond odometry, {odo.distance:.1f} m, {odo.rotation:.1f} rad; "
-        f"noise per simulator step of {odo.log_step / odo.step_scale**2:.3g} s (log step {odo.log_step:.3f} s)"
-    )
+    rel = odo.relations
+    if rel is None:
+        lines.append(
+            f"odometry against the SLAM path: {odo.anchors} reference frames beyond odometry, {odo.distance:.1f} m, "
+            f"{odo.rotation:.1f} rad (the fit holds the reference's own errors; give --relations where the log "
+            "has benchmark relations)"
+        )
+    else:
+        lines.append(
+            f"odometry against benchmark relations: {rel.total} in the file, {rel.matched} on two frames of the log, "
+            f"{rel.long} long ones not used (loop closures: a span that long is not one arc), {rel.used} used in "
+            f"{rel.chains} chains, {odo.distance:.1f} m, {odo.rotation:.1f} rad"
+        )
+    lines[-1] += f"; noise as a random walk per metre and per radian (no step length; log step {odo.log_step:.3f} s)"
+    what = "segments" if rel is None else "relations"
     if odo.conflicts:
         lines.append(
-            f"  left out: {odo.conflicts} segments ({odo.conflict_distance:.1f} m) where the odometry moves against "
-            "the reference (a recording defect, e.g. reversing logged as driving forward), and every window holding one"
+            f"  excluded: {odo.conflicts} {what} ({odo.conflict_distance:.1f} m) where the odometry moves against "
+            f"the reference (a recording defect, e.g. reversing logged as driving forward), {odo.conflict_neighbours} "
+            f"next to them (where a reversal starts or ends), and the {odo.excluded_windows} windows holding one"
         )
+    else:
+        lines.append(f"  excluded: no {what} where the odometry moves against the reference")
     lines.append(row("bias_linear", "  -> bias_linear_range +-|value| (one log is one draw)"))
     lines.append(row("bias_angular", "  -> bias_angular_range +-|value|"))
     for name in ("noise_linear_per_m", "noise_linear_per_rad", "noise_angular_per_rad", "noise_angular_per_m"):
         lines.append(row(name))
     lines.append(
-        f"  reference's own error at a window's ends (not in the profile): {odo.reference_linear**0.5:.4f} m, "
-        f"{odo.reference_angular**0.5:.4f} rad"
+        f"  error at a window's ends, not growing with it (not in the profile): {math.sqrt(odo.reference_linear):.4f} m, "
+        f"{math.sqrt(odo.reference_angular):.4f} rad"
     )
+    outliers = int(sum(odo.windows.outliers.tolist()))
     lines.append(
-        f"  slips: not fitted; {odo.heavy_tail} single segments beyond the noise (cannot be told from jumps of the "
-        "reference)"
+        f"  slips: not fitted; {odo.heavy_tail} single {what} beyond the noise, {outliers} windows in all left out "
+        f"as outliers (beyond the outlier cut; cannot be told from jumps of the reference)"
     )
     lines.append(f"+- is one block-bootstrap standard error ({cal.bootstrap} replicates)")
     return "\n".join(lines)
@@ -133,9 +153,24 @@ def calibrate(
     ] = None,
     name: Annotated[str | None, typer.Option("--name", help="Profile name (default: the log's file stem).")] = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace an existing profile file.")] = False,
+    relations: Annotated[
+        Path | None,
+        typer.Option(
+            "--relations",
+            "-r",
+            help="The log's benchmark relations (Freiburg form): the odometry is fitted against them, not the SLAM path.",
+        ),
+    ] = None,
+    tolerance: Annotated[
+        float,
+        typer.Option("--tolerance", help="Largest gap (s) between a relation timestamp and a frame (Freiburg: 0.1)."),
+    ] = 0.1,
 ) -> None:
     """Fit the simulator's error models (laser noise, short readings, dropouts; odometry biases and noise)
-    to the real log LOG, against a SLAM run's path and map, and write them as an error profile."""
+    to the real log LOG, against a SLAM run's path and map, and write them as an error profile.
+
+    With --relations the odometry is fitted against the log's benchmark relations (human-checked relative
+    poses, independent of any SLAM run); without, against the SLAM path, which the printout says."""
     from pydantic import ValidationError
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
@@ -155,8 +190,10 @@ def calibrate(
         raise ConfigError(f"--figures {figure_path}: the page of figures is a PNG; give a path ending in .png")
     if seed < 0:
         raise ConfigError(f"--seed must be a non-negative integer, got {seed}")
+    if not (math.isfinite(tolerance) and 0.0 < tolerance <= 10.0):
+        raise ConfigError(f"--tolerance must be in (0, 10] s, got {tolerance}")
     try:
-        cfg = CalibrationSettings(bootstrap=bootstrap)
+        cfg = CalibrationSettings(bootstrap=bootstrap, relation_tolerance=tolerance)
     except ValidationError as exc:
         raise ConfigError("--bootstrap: " + validation_problems(exc)) from None
     overrides = parse_settings(settings or [])
@@ -164,10 +201,25 @@ def calibrate(
     record = load_recording(log)
     try:
         check_calibratable(
-            record, min_frames=cfg.min_frames, min_distance=cfg.min_distance, min_rotation=cfg.min_rotation
+            record,
+            min_frames=cfg.min_frames,
+            min_distance=cfg.min_distance,
+            min_rotation=cfg.min_rotation,
+            min_gap=cfg.min_gap,
+            max_tiny_share=cfg.min_step_share,
         )
     except CalibrationError as exc:
         raise CalibrationError(f"{log}: {exc}") from None
+    rel = None
+    if relations is not None:
+        from slamtrials.calibration.odometry import check_relations_belong
+        from slamtrials.io.relations import read_relations
+
+        rel = read_relations(relations)
+        try:
+            check_relations_belong(record.t, rel, cfg.relation_tolerance)
+        except CalibrationError as exc:
+            raise CalibrationError(f"{relations}: {exc} ({log})") from None
     profile_id = name if name is not None else profile_name(log)
     console = make_console()
     columns = (TextColumn(f"{algorithm} reference"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
@@ -182,14 +234,16 @@ def calibrate(
             on_frame=lambda k, total: progress.update(task, completed=k + 1),
         )
     try:
-        result = fit(record, reference, cfg, seed=seed)
+        result = fit(
+            record, reference, cfg, seed=seed, relations=rel, relations_source=relations.name if relations else ""
+        )
     except CalibrationError as exc:
         raise CalibrationError(f"{log}: {exc}") from None
     today = _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d")
+    against = reference.source if rel is None else f"{reference.source} (laser), {result.odometry_reference} (odometry)"
     description = (
-        f"fitted by slamtrials calibrate on {today} to the log {log.name} against {reference.source}; "
-        "biases as +- the measured per-run bias; noise per simulator step of "
-        f"{cfg.sim_dt:g} s; no slips"
+        f"fitted by slamtrials calibrate on {today} to the log {log.name} against {against}; "
+        "biases as +- the measured per-run bias; odometry noise per metre and per radian; no slips"
     )
     try:
         profile = result.profile(profile_id, description)

@@ -113,7 +113,7 @@ def format_calibration(cal: Calibration, log: str) -> str:
     what = "segments" if rel is None else "relations"
     if odo.conflicts:
         lines.append(
-            f"  excluded: {odo.conflicts} {what} ({odo.conflict_distance:.1f} m) where the odometry moves against "
+            f"  excluded: {odo.conflicts} {what} ({odo.conflict_distance:.2f} m) where the odometry moves against "
             f"the reference (a recording defect, e.g. reversing logged as driving forward), {odo.conflict_neighbours} "
             f"next to them (where a reversal starts or ends), and the {odo.excluded_windows} windows holding one"
         )

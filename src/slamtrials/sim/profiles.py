@@ -15,10 +15,12 @@ Bundled:
 
 ``mit-csail``, ``fr079``
     Fitted by ``slamtrials calibrate`` to the shared real logs (MIT CSAIL with GMapping's defaults;
-    fr079 with the GMapping setting that maps it, ``linearUpdate=0.1``, seed 0), against GMapping's
-    final path and map. The values are the printed fit rounded to four
-    significant digits; docs/realism.md, "Calibration", has the method, the uncertainties and what the
-    values include besides the sensors' own errors (the reference is itself a SLAM estimate).
+    fr079 with the GMapping setting that maps it, ``linearUpdate=0.1``, seed 0): the laser against
+    GMapping's final path and map, the odometry against the log's benchmark relations (``--relations``,
+    issue 32: a random walk per metre and per radian, independent of any SLAM run). The values are the
+    printed fit rounded to four significant digits; docs/realism.md, "How the bundled profiles were
+    fitted", has the command lines, and "Calibration" the method, the uncertainties and what the values
+    include besides the sensors' own errors.
 
 ``realistic``
     The mean of the two fits, field by field, without the short readings' persistence: see
@@ -50,9 +52,10 @@ BUNDLED_PROFILES: dict[str, ErrorProfile] = {
     ),
     "mit-csail": ErrorProfile(
         name="mit-csail",
-        description="fitted by slamtrials calibrate (2026-11-28) to the shared MIT CSAIL log against GMapping's "
-        "final path and map (default settings, seed 0); biases +- the measured per-run bias; noise per simulator "
-        "step of 0.1 s; no slips (docs/realism.md, Calibration)",
+        description="fitted by slamtrials calibrate (2026-11-28) to the shared MIT CSAIL log: the laser against "
+        "GMapping's final path and map (default settings, seed 0), the odometry against the log's 1,043 short "
+        "benchmark relations (--relations); biases +- the measured per-run bias; odometry noise per metre and "
+        "per radian; no slips (docs/realism.md, How the bundled profiles were fitted)",
         laser={
             "range_noise_std": 0.033,
             "range_noise_per_m": 0.0049,
@@ -70,21 +73,22 @@ BUNDLED_PROFILES: dict[str, ErrorProfile] = {
             "edge_reach": math.radians(1.0),
         },
         odometry={
-            "bias_linear_range": (-0.02207, 0.02207),
-            "bias_angular_range": (-0.06411, 0.06411),
-            "noise_linear_per_m": 0.05505,
-            "noise_linear_per_rad": 0.05409,
-            "noise_angular_per_rad": 0.2957,
-            "noise_angular_per_m": 0.09202,
+            "bias_linear_range": (-0.02376, 0.02376),
+            "bias_angular_range": (-0.06621, 0.06621),
+            "noise_linear_per_m": 0.03424,
+            "noise_linear_per_rad": 0.01494,
+            "noise_angular_per_rad": 0.1315,
+            "noise_angular_per_m": 0.02857,
         },
     ),
     "fr079": ErrorProfile(
         name="fr079",
-        description="fitted by slamtrials calibrate (2026-11-28) to the shared fr079 log against GMapping's final "
-        "path and map (linearUpdate=0.1, seed 0: GMapping's defaults do not map fr079, docs/real-datasets.md); "
-        "the odometry without the 81 segments where the log moves against the reference (reversing logged as "
-        "driving forward); biases +- the measured per-run bias; noise per simulator step of 0.1 s; no slips "
-        "(docs/realism.md, Calibration)",
+        description="fitted by slamtrials calibrate (2026-11-28) to the shared fr079 log: the laser against "
+        "GMapping's final path and map (linearUpdate=0.1, seed 0: GMapping's defaults do not map fr079, "
+        "docs/real-datasets.md), the odometry against the log's 982 short benchmark relations (--relations) "
+        "without the 34 where the log moves against them (reversing logged as driving forward) and their 41 "
+        "neighbours; biases +- the measured per-run bias; odometry noise per metre and per radian; no slips "
+        "(docs/realism.md, How the bundled profiles were fitted)",
         laser={
             "range_noise_std": 0.0323,
             "range_noise_per_m": 0.001789,
@@ -102,12 +106,12 @@ BUNDLED_PROFILES: dict[str, ErrorProfile] = {
             "edge_reach": math.radians(1.0),
         },
         odometry={
-            "bias_linear_range": (-0.006648, 0.006648),
-            "bias_angular_range": (-0.009969, 0.009969),
-            "noise_linear_per_m": 0.04682,
-            "noise_linear_per_rad": 0.1464,
-            "noise_angular_per_rad": 0.3657,
-            "noise_angular_per_m": 0.09295,
+            "bias_linear_range": (-0.00156, 0.00156),
+            "bias_angular_range": (-0.01155, 0.01155),
+            "noise_linear_per_m": 0.0,
+            "noise_linear_per_rad": 0.04803,
+            "noise_angular_per_rad": 0.05656,
+            "noise_angular_per_m": 0.0308,
         },
     ),
 }

@@ -12,6 +12,8 @@ from pydantic import ValidationError
 from slamtrials.errors import ConfigError, SimulationError
 from slamtrials.record import RunRecord
 from slamtrials.sim import LaserConfig, OdometryConfig, RobotConfig, SimConfig, Simulator
+from slamtrials.sim.config import LASER_ERROR_FIELDS, ODOMETRY_ERROR_FIELDS
+from slamtrials.sim.profiles import DEFAULT_PROFILE
 
 
 def room_world(size_m: float = 10.0, resolution: float = 0.05):
@@ -28,14 +30,14 @@ COMMANDS = [(0.5, 0.2)] * 30 + [(0.7, -0.4)] * 30 + [(0.0, 1.0)] * 10 + [(0.4, 0
 
 
 def run(seed, config: SimConfig | None = None, commands=COMMANDS) -> RunRecord:
-    sim = Simulator(room_world(), config or SimConfig(), np.random.default_rng(seed))
+    sim = Simulator(room_world(), config or SimConfig.paper(), np.random.default_rng(seed))
     frames = [sim.observe()] + [sim.step(c) for c in commands]
     return RunRecord.from_frames(frames, sim.laser, sim.metadata)
 
 
 def test_first_frame():
     world = room_world()
-    sim = Simulator(world, SimConfig(), np.random.default_rng(0))
+    sim = Simulator(world, SimConfig.paper(), np.random.default_rng(0))
     f = sim.observe()
     assert f.t == 0.0 and sim.t == 0.0
     np.testing.assert_array_equal(f.truth, world.start)
@@ -76,13 +78,13 @@ def test_different_seed_different_bias():
 
 def test_generator_and_seed_give_the_same_run():
     world = room_world()
-    a = Simulator(world, SimConfig(), 5)
-    b = Simulator(world, SimConfig(), np.random.default_rng(5))
+    a = Simulator(world, SimConfig.paper(), 5)
+    b = Simulator(world, SimConfig.paper(), np.random.default_rng(5))
     assert a.bias == b.bias
 
 
 def test_metadata_and_laser_info():
-    sim = Simulator(room_world(), SimConfig(), np.random.default_rng(3))
+    sim = Simulator(room_world(), SimConfig.paper(), np.random.default_rng(3))
     meta = sim.metadata
     json.dumps(meta)
     assert meta["world"] == "room"
@@ -92,11 +94,11 @@ def test_metadata_and_laser_info():
     info = sim.laser
     assert info.angle_min == pytest.approx(-math.radians(135))
     assert info.angle_increment == pytest.approx(math.radians(0.5))
-    assert info.range_max == 30.0 and info.range_min == 0.0
+    assert info.range_max == 80.0 and info.range_min == 0.0
 
 
 def test_accessors_return_copies():
-    sim = Simulator(room_world(), SimConfig(), np.random.default_rng(3))
+    sim = Simulator(room_world(), SimConfig.paper(), np.random.default_rng(3))
     truth = sim.truth
     truth[0] = 99.0
     assert sim.truth[0] != 99.0
@@ -104,15 +106,15 @@ def test_accessors_return_copies():
 
 
 def test_bad_commands_and_start():
-    sim = Simulator(room_world(), SimConfig(), np.random.default_rng(3))
+    sim = Simulator(room_world(), SimConfig.paper(), np.random.default_rng(3))
     with pytest.raises(SimulationError, match="finite"):
         sim.step((math.nan, 0.0))
     with pytest.raises(SimulationError, match="two numbers"):
         sim.step((1.0,))
     with pytest.raises(SimulationError, match="overlaps a wall"):
-        Simulator(room_world(), SimConfig(), np.random.default_rng(3), start=[0.1, 0.1, 0.0])
+        Simulator(room_world(), SimConfig.paper(), np.random.default_rng(3), start=[0.1, 0.1, 0.0])
     with pytest.raises(TypeError):
-        Simulator(room_world(), SimConfig(), "seed")  # type: ignore[arg-type]
+        Simulator(room_world(), SimConfig.paper(), "seed")  # type: ignore[arg-type]
 
 
 def test_scan_matches_the_truth():
@@ -120,7 +122,7 @@ def test_scan_matches_the_truth():
     from slamtrials.sim.raycast import LaserModel
 
     world = room_world()
-    sim = Simulator(world, SimConfig(), np.random.default_rng(3))
+    sim = Simulator(world, SimConfig.paper(), np.random.default_rng(3))
     for _ in range(20):
         f = sim.step((0.6, 0.3))
     np.testing.assert_array_equal(f.ranges, LaserModel(world, LaserConfig()).true_ranges(f.truth))
@@ -129,11 +131,20 @@ def test_scan_matches_the_truth():
 # --- configuration ---------------------------------------------------------------------------------------
 
 
-def test_paper_config_is_the_default():
+def test_paper_config_is_explicit_and_realistic_the_default():
     cfg = SimConfig.paper()
-    assert cfg == SimConfig()
+    assert cfg == SimConfig(profile="paper") and cfg.profile_label == "paper" and not cfg.laser.has_errors
+    default = SimConfig()
+    assert default.profile_name == DEFAULT_PROFILE == "realistic" and default.profile_label == "realistic"
+    assert default.laser.has_errors and default.model_copy(update={"profile": "paper"}) != cfg
+    # everything but the error models is the paper's in both
+    errors = {*LASER_ERROR_FIELDS, *ODOMETRY_ERROR_FIELDS, "profile"}
+    assert {k: v for k, v in default.laser.model_dump().items() if k not in errors} == {
+        k: v for k, v in cfg.laser.model_dump().items() if k not in errors
+    }
+    assert default.robot == cfg.robot and default.dt == cfg.dt
     assert cfg.dt == 0.1
-    assert cfg.laser.num_beams == 541 and cfg.laser.max_range == 30.0
+    assert cfg.laser.num_beams == 541 and cfg.laser.max_range == 80.0
     assert cfg.laser.fov == pytest.approx(math.radians(270))
     assert cfg.robot.max_linear_speed == 0.7
     assert cfg.robot.max_angular_speed == pytest.approx(math.radians(70))
@@ -149,7 +160,7 @@ def test_paper_config_is_the_default():
         (LaserConfig, {"fov": 7.0}, "fov"),
         (LaserConfig, {"max_range": -1.0}, "max_range"),
         (LaserConfig, {"mount": (0.0, math.inf, 0.0)}, "mount"),
-        (LaserConfig, {"min_range": 40.0}, "min_range"),
+        (LaserConfig, {"min_range": 90.0}, "min_range"),
         (OdometryConfig, {"bias_linear_range": (0.01, -0.01)}, "bias_linear_range"),
         (OdometryConfig, {"noise_linear_per_m": -1.0}, "noise_linear_per_m"),
         (SimConfig, {"dt": 0.0}, "dt"),
@@ -164,7 +175,7 @@ def test_invalid_values_name_the_field(model, kwargs, field):
 def test_configs_are_strict_and_frozen():
     with pytest.raises(ValidationError, match="extra"):
         RobotConfig(radus=0.2)
-    cfg = SimConfig()
+    cfg = SimConfig.paper()
     with pytest.raises(ValidationError):
         cfg.dt = 0.2  # type: ignore[misc]
 

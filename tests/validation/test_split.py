@@ -84,7 +84,7 @@ def test_mit_csail_split_half_calibrates_the_first_half_and_validates_the_second
     record = load_recording(LOG)
     relations = read_relations(RELATIONS)
     result = split_validate(
-        record, relations, ValidationSettings(runs=1), CalibrationSettings(bootstrap=5), log="mit-csail.clf"
+        record, relations, ValidationSettings(runs=1), CalibrationSettings(bootstrap=10), log="mit-csail.clf"
     )
     halves = result.halves
     assert result.validation.relations_total == len(halves.second_relations)

@@ -1,9 +1,11 @@
 """Configuration of the simulated robot, laser and odometry (pydantic models, SI units).
 
-All lengths are in metres, angles in radians, times in seconds. The defaults are the settings of the
-paper (Amigoni, Castelli and Luperto, IROS 2018) and of its Stage set-up, so ``SimConfig()`` and
-``SimConfig.paper()`` are the same. Every model is frozen and rejects unknown keys; a bad value raises a
-``pydantic.ValidationError`` that names the field, the value and the allowed range
+All lengths are in metres, angles in radians, times in seconds. The robot's, the laser's geometry and
+the step are the settings of the paper (Amigoni, Castelli and Luperto, IROS 2018) and of its Stage
+set-up; the error models take their values from an error profile, ``realistic`` unless the config names
+another (:data:`slamtrials.sim.profiles.DEFAULT_PROFILE`), so ``SimConfig.paper()`` (the paper's
+noise-free set-up) is not ``SimConfig()``. Every model is frozen and rejects unknown keys; a bad value
+raises a ``pydantic.ValidationError`` that names the field, the value and the allowed range
 (:meth:`SimConfig.from_dict` turns that into a one-line :class:`~slamtrials.errors.ConfigError`).
 """
 
@@ -154,7 +156,12 @@ class LaserConfig(BaseModel):
     angular_resolution:
         Requested angle between beams (rad). Default 0.5 deg.
     max_range:
-        Largest range (m). A beam that hits nothing within it reads exactly ``max_range``. Default 30 m.
+        Largest range (m): the sensor's maximum, the ``range_max`` of the recorded laser geometry. A beam
+        that hits nothing within it has no return and reads ``+inf`` (ROS REP 117), which every algorithm
+        skips. Default 80 m: the seed paper's Stage laser (its ``hokuyo.inc``, ``range [0 80]``), whose
+        GMapping used returns up to 30 m (``maxUrange``) and skipped readings beyond 60 m (``maxRange``),
+        no-returns among them; the ``paper`` GMapping preset holds those two values, so the paper's
+        "30 m laser" is this 80 m sensor read through GMapping's 30 m cut.
     min_range:
         Smallest reportable range (m); readings are clipped up to it. Default 0: the simulator never
         reports less than the true distance, and the robot's footprint keeps a centred laser at least
@@ -163,7 +170,7 @@ class LaserConfig(BaseModel):
         Pose (x, y, theta) of the laser in the robot base frame (m, m, rad). Default (0, 0, 0).
     range_noise_std:
         Constant part (m) of the standard deviation of the zero-mean Gaussian noise added to every reading
-        that hit something. Max-range readings (no return) stay exactly ``max_range``. Default 0, as
+        that hit something. No-returns stay no-returns. Default 0, as
         Stage's laser.
     range_noise_per_m:
         Range-proportional part (m/m): the noise's standard deviation is
@@ -196,7 +203,7 @@ class LaserConfig(BaseModel):
         fraction ``v`` of the beam from ``min_range`` to the wall has density ``(a + 1) v^a``. 0 (the
         default): anywhere, uniformly. Real short readings stand farther out (fits near 1).
     dropout_rate, dropout_per_m, dropout_grazing:
-        Probability per beam of no return (the reading is ``max_range``):
+        Probability per beam of no return (the reading is ``+inf``, like any beam without a return):
         ``dropout_rate + dropout_per_m * range + dropout_grazing * (1 - |cos(incidence)|)``, capped at 1,
         where the incidence is the angle between the beam and the normal of the wall it hits. Default 0.
     edge_chance, edge_reach:
@@ -215,7 +222,9 @@ class LaserConfig(BaseModel):
     angular_resolution: float = Field(
         math.radians(0.5), gt=0.0, le=2.0 * math.pi, description="angle between beams (rad)"
     )
-    max_range: float = Field(30.0, gt=0.0, le=1000.0, description="largest range (m)")
+    max_range: float = Field(
+        80.0, gt=0.0, le=1000.0, description="the sensor's largest range (m); beyond it a beam reads +inf (no return)"
+    )
     min_range: float = Field(0.0, ge=0.0, le=1000.0, description="smallest range (m)")
     mount: tuple[float, float, float] = Field((0.0, 0.0, 0.0), description="laser pose (x, y, theta) in the base frame")
     range_noise_std: float = Field(0.0, ge=0.0, le=10.0, description="Gaussian range noise std, constant part (m)")
@@ -465,6 +474,13 @@ def _known(section: str, values: dict[str, Any], fields: tuple[str, ...]) -> Non
         raise ValueError(f"unknown {section} error field {unknown[0]!r}; known: {', '.join(fields)}")
 
 
+def _default_profile() -> str:
+    """The name of the profile of a config that names none: :data:`slamtrials.sim.profiles.DEFAULT_PROFILE`."""
+    from slamtrials.sim.profiles import DEFAULT_PROFILE
+
+    return DEFAULT_PROFILE
+
+
 def _under(profile_values: dict[str, Any], given: Any, model: type[BaseModel]) -> Any:
     """``given`` (a mapping, a model instance or None) with ``profile_values`` for the fields it does not set."""
     if given is None:
@@ -488,9 +504,12 @@ class SimConfig(BaseModel):
     robot, laser, odometry:
         The sub-configurations.
     profile:
-        The error profile (:mod:`slamtrials.sim.profiles`): a bundled name (``paper``, the default) or an
-        inline :class:`~slamtrials.sim.profiles.ErrorProfile`. It gives the laser's and the odometry's
-        error-model fields their values; a value written in ``laser`` or ``odometry`` overrides it.
+        The error profile (:mod:`slamtrials.sim.profiles`): a bundled name (by default
+        :data:`~slamtrials.sim.profiles.DEFAULT_PROFILE`, ``realistic``) or an inline
+        :class:`~slamtrials.sim.profiles.ErrorProfile`. It gives the laser's and the odometry's
+        error-model fields their values; a value written in ``laser`` or ``odometry`` that differs from
+        the profile's overrides it (:attr:`profile_overrides`, :mod:`slamtrials.sim.overrides`).
+        :meth:`paper` is the paper's set-up.
     """
 
     model_config = _MODEL_CONFIG
@@ -500,7 +519,9 @@ class SimConfig(BaseModel):
     laser: LaserConfig = Field(default_factory=LaserConfig)
     odometry: OdometryConfig = Field(default_factory=OdometryConfig)
     profile: str | ErrorProfile = Field(
-        "paper", description="error profile: a bundled name (paper) or inline {name, laser, odometry}"
+        default_factory=lambda: _default_profile(),
+        description="error profile, which sets the error models: a bundled name (realistic, paper, mit-csail, "
+        "fr079), a profile YAML file or inline {name, laser, odometry}",
     )
 
     @model_validator(mode="before")
@@ -511,7 +532,7 @@ class SimConfig(BaseModel):
         from slamtrials.sim.profiles import BUNDLED_PROFILES, resolve_profile
 
         try:
-            profile = resolve_profile(data.get("profile", "paper"))
+            profile = resolve_profile(data.get("profile", _default_profile()))
         except ValidationError as exc:
             raise ValueError(f"profile: {validation_problems(exc)}") from None
         data = dict(data)
@@ -526,13 +547,36 @@ class SimConfig(BaseModel):
         """The error profile's name."""
         return self.profile if isinstance(self.profile, str) else self.profile.name
 
+    @property
+    def error_profile(self) -> ErrorProfile:
+        """The error profile itself (a bundled one looked up by name)."""
+        from slamtrials.sim.profiles import resolve_profile
+
+        return resolve_profile(self.profile)
+
+    @property
+    def profile_overrides(self) -> tuple[Any, ...]:
+        """The error-model fields whose values differ from the profile's
+        (:class:`~slamtrials.sim.overrides.ProfileOverride`, empty for a config that is its profile)."""
+        from slamtrials.sim.overrides import profile_overrides
+
+        return profile_overrides(self)
+
+    @property
+    def profile_label(self) -> str:
+        """``realistic``, or ``realistic + 2 overrides``: the profile and how many of its values are overridden."""
+        from slamtrials.sim.overrides import profile_label
+
+        return profile_label(self)
+
     @classmethod
     def paper(cls) -> SimConfig:
-        """The settings of the paper (270 deg / 0.5 deg / 30 m laser, 10 Hz, +-0.5 % and +-1 deg/rad bias).
+        """The settings of the paper (270 deg / 0.5 deg / 80 m laser, 10 Hz, +-0.5 % and +-1 deg/rad bias).
 
-        These are the defaults.
+        The default profile is ``realistic`` (:data:`~slamtrials.sim.profiles.DEFAULT_PROFILE`); this
+        is the explicit way to get the paper's Stage set-up, bit for bit.
         """
-        return cls()
+        return cls(profile="paper")
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> SimConfig:

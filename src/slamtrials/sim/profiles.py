@@ -10,8 +10,9 @@ Bundled:
 
 ``paper``
     The IROS 2018 Stage set-up: a noise-free laser and a constant per-run odometry scale bias drawn
-    from +-0.5 % and +-1 deg/rad, nothing else. These are the config's own defaults, so a config that
-    names no profile is this one, bit for bit.
+    from +-0.5 % and +-1 deg/rad, nothing else. These are the error-model fields' own defaults
+    (``SimConfig.paper()``, bit for bit); a config that names no profile is ``realistic``
+    (:data:`DEFAULT_PROFILE`).
 
 ``mit-csail``, ``fr079``
     Fitted by ``slamtrials calibrate`` to the shared real logs (MIT CSAIL with GMapping's defaults;
@@ -37,9 +38,12 @@ from typing import Any
 
 from slamtrials.sim.config import ErrorProfile
 
-__all__ = ["ErrorProfile", "BUNDLED_PROFILES", "resolve_profile", "DEFAULT_PROFILE"]
+__all__ = ["ErrorProfile", "BUNDLED_PROFILES", "resolve_profile", "mean_profile", "DEFAULT_PROFILE"]
 
-DEFAULT_PROFILE = "paper"
+#: The profile of every simulation that names none: ``SimConfig()``, ``TrialConfig()``, campaigns, the
+#: demo, ``slamtrials trial``, ``simulate`` and ``validate``, :func:`slamtrials.validation.validate`. The one
+#: source of that default; ``SimConfig.paper()`` (or ``profile: paper``) is the paper's set-up.
+DEFAULT_PROFILE = "realistic"
 
 
 BUNDLED_PROFILES: dict[str, ErrorProfile] = {
@@ -117,15 +121,31 @@ BUNDLED_PROFILES: dict[str, ErrorProfile] = {
 }
 
 
-def _mean(a: Any, b: Any) -> Any:
-    """The mean of two values of a field: numbers, or ranges (tuples) bound by bound; rounded to 6 places."""
-    if isinstance(a, tuple):
-        return tuple(_mean(x, y) for x, y in zip(a, b))
-    return round(0.5 * (float(a) + float(b)), 6)
+def _mean(values: list[Any]) -> Any:
+    """The mean of one field's values: numbers, or ranges (tuples) bound by bound; rounded to 6 places."""
+    if isinstance(values[0], tuple):
+        return tuple(_mean(list(bounds)) for bounds in zip(*values))
+    return round(math.fsum(float(v) for v in values) / len(values), 6)
+
+
+def mean_profile(name: str, description: str, profiles: list[ErrorProfile]) -> ErrorProfile:
+    """The profile whose every error-model value is the mean of ``profiles``' values (ranges bound by bound,
+    rounded to 6 places): the pooled fit of several logs, each log's fit one sample of its kind of robot."""
+    if not profiles:
+        raise ValueError("mean_profile needs at least one profile")
+    lasers = [p.laser_values() for p in profiles]
+    odometries = [p.odometry_values() for p in profiles]
+    odometry_fields = sorted({field for p in profiles for field in p.odometry})
+    return ErrorProfile(
+        name=name,
+        description=description,
+        laser={field: _mean([laser[field] for laser in lasers]) for field in lasers[0]},
+        odometry={field: _mean([odometry[field] for odometry in odometries]) for field in odometry_fields},
+    )
 
 
 def _realistic(mit: ErrorProfile, fr079: ErrorProfile) -> ErrorProfile:
-    """``realistic``: the mean of the two fitted logs' values, field by field (ranges bound by bound).
+    """``realistic``: the mean of the two fitted logs' values, field by field (:func:`mean_profile`).
 
     Both logs were recorded with SICK laser scanners on wheeled robots in office buildings, so their fits
     are two samples of one kind of sensor, odometry and place; their mean stands for neither log alone.
@@ -138,16 +158,14 @@ def _realistic(mit: ErrorProfile, fr079: ErrorProfile) -> ErrorProfile:
     (which the simulator leaves at random places, not where real things stand): with them, trials explore
     1.5 to 2 times as long in simulated time (docs/realism.md, "Profiles"). Add them in a config to study it.
     """
-    mit_odometry, fr079_odometry = mit.odometry_values(), fr079.odometry_values()
-    laser = {name: _mean(value, fr079.laser_values()[name]) for name, value in mit.laser_values().items()}
-    laser.update(short_lifetime=0.0, short_fleeting_share=0.0)
-    return ErrorProfile(
-        name="realistic",
-        description="the mean of the mit-csail and fr079 fits, field by field, without the short readings' "
+    pooled = mean_profile(
+        "realistic",
+        "the mean of the mit-csail and fr079 fits, field by field, without the short readings' "
         "persistence (docs/realism.md, Profiles)",
-        laser=laser,
-        odometry={name: _mean(mit_odometry[name], fr079_odometry[name]) for name in mit.odometry},
+        [mit, fr079],
     )
+    laser = {**pooled.laser, "short_lifetime": 0.0, "short_fleeting_share": 0.0}
+    return pooled.model_copy(update={"laser": dict(sorted(laser.items()))})
 
 
 BUNDLED_PROFILES["realistic"] = _realistic(BUNDLED_PROFILES["mit-csail"], BUNDLED_PROFILES["fr079"])

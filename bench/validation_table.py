@@ -5,8 +5,8 @@ Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/validation_table.py [--runs 5]
 [--log NAME LOG RELATIONS [KEY=VALUE ...]] [--only NAME] [--profiles NAME|FILE.yaml ...]``.
 
 For each log the algorithm (GMapping, its defaults plus the log's overrides) runs once on the real log
-(seed 0); that run's path and map are the replica and the reference of the log's calibration
-(``slamtrials calibrate``, bootstrap 100). Rows per log, each ``--runs`` replicas (seeds 0 to N-1)
+(seed 0); that run's path and map are the replica and the laser's reference in the log's calibration
+(``slamtrials calibrate --relations``, bootstrap 100: the odometry fitted against the log's relations). Rows per log, each ``--runs`` replicas (seeds 0 to N-1)
 scored on the real relations' time pairs (:func:`slamtrials.validation.validate`, one core):
 
 * ``default``: :data:`slamtrials.sim.profiles.DEFAULT_PROFILE`, the profile every command uses;
@@ -103,7 +103,11 @@ def main() -> None:
         reference = run_over_recording(record, "gmapping", overrides=overrides, seed=0)
         source = f"gmapping final estimate and map (seed 0, {', '.join(settings) or 'defaults'})"
         fit = calibrate(
-            record, Reference.from_grid(reference.estimate_per_frame(record), reference.occupancy, source), calibration
+            record,
+            Reference.from_grid(reference.estimate_per_frame(record), reference.occupancy, source),
+            calibration,
+            relations=relations,
+            relations_source=str(relations_file),
         )
         profile = fit.profile(f"{log_name}-fit", f"slamtrials calibrate of {log.name} against {source}")
         loaded[log_name] = (log, relations_file, record, relations, overrides, reference, profile)

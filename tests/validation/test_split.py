@@ -92,3 +92,23 @@ def test_mit_csail_split_half_calibrates_the_first_half_and_validates_the_second
     real = result.validation.real("slam").translational
     simulated = result.validation.simulated("slam", "translational").mean
     assert 0.0 < real < 0.2 and 0.0 < simulated < 0.2
+
+
+@pytest.mark.skipif(not (LOG.is_file() and RELATIONS.is_file()), reason=f"no MIT CSAIL data in {DATA}")
+def test_cli_split_with_a_half_without_relations_or_with_a_profile_is_one_line_and_nothing_runs(tmp_path):
+    from typer.testing import CliRunner
+
+    from slamtrials.cli.main import app
+
+    lines = RELATIONS.read_text().splitlines()
+    early = tmp_path / "early.relations"
+    early.write_text("\n".join(lines[:40]) + "\n")  # the relations file is in time order: all in the first half
+    out = tmp_path / "v.json"
+    runner = CliRunner()
+    result = runner.invoke(app, ["validate", str(LOG), "-r", str(early), "--split", "--json", str(out)])
+    assert result.exit_code == 2, result.output
+    message = result.output.strip().splitlines()
+    assert len(message) == 1 and "the second 0" in message[0] and "mit-csail.clf" in message[0]
+    result = runner.invoke(app, ["validate", str(LOG), "-r", str(RELATIONS), "--split", "--profile", "paper"])
+    assert result.exit_code == 2 and "leave out --profile" in result.output
+    assert not out.exists()

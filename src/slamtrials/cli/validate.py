@@ -101,6 +101,14 @@ def validate(
     scheduler: Annotated[
         str | None, typer.Option("--scheduler", help="Address of a running Dask scheduler for the replicas.")
     ] = None,
+    split: Annotated[
+        bool,
+        typer.Option(
+            "--split",
+            help="Out of sample: calibrate on the first half of LOG (by time; odometry against that half's "
+            "relations) and validate that profile on the second half. Not with --profile.",
+        ),
+    ] = False,
 ) -> None:
     """Replicate the real run LOG in the simulator and compare the algorithm's errors (paper, Section IV).
 
@@ -109,6 +117,10 @@ def validate(
     and the profile's errors, --runs times (replica i has seed i). Every replica is scored on the real
     relations' time pairs with relations from its own ground truth; the raw odometry too. Prints the
     error profile (``profile: realistic`` by default) on stderr before the reference run.
+
+    With --split the profile is fitted to the log's first half (``slamtrials calibrate --relations`` on
+    the frames up to the middle of its time span and the relations within them), and the second half is
+    validated with it as a log of its own: both are printed.
     """
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
@@ -129,6 +141,8 @@ def validate(
             raise ConfigError(f"{what} {path}: is a folder; give a file name")
     if figure is not None and figure.suffix.lower() not in (".png", ".pdf", ".svg"):
         raise ConfigError(f"--figure {figure}: the name must end in .png, .pdf or .svg")
+    if split and profile is not None:
+        raise ConfigError("--split fits the profile to the log's first half; leave out --profile")
     from slamtrials.sim.profiles import DEFAULT_PROFILE
 
     chosen = resolve_profile_option(DEFAULT_PROFILE if profile is None else profile)
@@ -136,7 +150,13 @@ def validate(
     record = load_recording(log)
     rel = read_relations(relations)
     check_belong(record, rel, tolerance, log=str(log), relations_source=str(relations))
-    say_profile(chosen)
+    halves = None
+    if split:
+        from slamtrials.validation.split import split_log
+
+        halves = split_log(record, rel, log=str(log))  # a bad split fails before any work
+    else:
+        say_profile(chosen)
     runner = None
     if workers > 1 or scheduler is not None:
         quiet_dask()
@@ -151,16 +171,48 @@ def validate(
         disable=not console.is_terminal,
     ) as progress:
         task = progress.add_task("replicas", total=runs)
-        result = run_validation(
-            record,
-            rel,
-            chosen,
-            options,
-            runner=runner,
-            on_replica=lambda _: progress.update(task, advance=1),
-            log=str(log),
-            relations_source=str(relations),
-        )
+        if halves is None:
+            result = run_validation(
+                record,
+                rel,
+                chosen,
+                options,
+                runner=runner,
+                on_replica=lambda _: progress.update(task, advance=1),
+                log=str(log),
+                relations_source=str(relations),
+            )
+        else:
+            from slamtrials.calibration import CalibrationSettings
+            from slamtrials.cli.calibrate import format_calibration, profile_name
+            from slamtrials.validation.split import split_validate
+
+            out_of_sample = split_validate(
+                record,
+                rel,
+                options,
+                CalibrationSettings(),
+                profile_name=f"{profile_name(log)}-first-half",
+                runner=runner,
+                on_replica=lambda _: progress.update(task, advance=1),
+                log=str(log),
+                relations_source=str(relations),
+            )
+            result = out_of_sample.validation
+            cut = halves.split_t
+            console.print(
+                f"first half (to {cut:.1f} s, {len(halves.first)} frames, {len(halves.first_relations)} relations): "
+                "calibration",
+                soft_wrap=True,
+                highlight=False,
+            )
+            console.print(format_calibration(out_of_sample.calibration, f"{log} (first half)"), highlight=False)
+            console.print(
+                f"\nsecond half (from {cut:.1f} s, {len(halves.second)} frames, {len(halves.second_relations)} "
+                "relations): validation with the first half's profile",
+                soft_wrap=True,
+                highlight=False,
+            )
     console.print(format_validation(result), soft_wrap=True, highlight=False)
     written = []
     if json_out is not None:

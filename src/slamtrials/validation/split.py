@@ -118,8 +118,9 @@ def split_validate(
 ) -> SplitValidation:
     """Calibrate on the first half of ``record`` (by time) and validate the fitted profile on the second.
 
-    The first half's reference is ``settings.algorithm`` run with ``settings.reference_seed`` (the same
-    algorithm, settings and seed that give the real error on the second half); the calibration's
+    The first half's laser is fitted against ``settings.algorithm`` run over it with
+    ``settings.reference_seed`` (the same algorithm, settings and seed that give the real error on the
+    second half), its odometry against its own relations (``calibrate --relations``); the calibration's
     bootstrap uses that seed too.
 
     Raises
@@ -142,13 +143,20 @@ def split_validate(
         raise CalibrationError(f"{log}, first half (to {halves.split_t:.1f} s): {exc}") from None
     reference = slam_reference(halves.first, s.algorithm, preset=s.preset, overrides=s.overrides, seed=s.reference_seed)
     try:
-        calibration = calibrate(halves.first, reference, cal, seed=s.reference_seed)
+        calibration = calibrate(
+            halves.first,
+            reference,
+            cal,
+            seed=s.reference_seed,
+            relations=halves.first_relations,
+            relations_source=f"{relations_source} (first half)",
+        )
     except CalibrationError as exc:
         raise CalibrationError(f"{log}, first half (to {halves.split_t:.1f} s): {exc}") from None
     profile = calibration.profile(
         profile_name,
-        f"fitted by slamtrials validate --split to the first half of {log} (to {halves.split_t:.1f} s) against "
-        f"{reference.source}",
+        f"fitted by slamtrials validate --split to the first half of {log} (to {halves.split_t:.1f} s): the laser "
+        f"against {reference.source}, the odometry against the half's {len(halves.first_relations)} relations",
     )
     validation = validate(
         halves.second,

@@ -21,8 +21,9 @@ ALLOWED = {
     "slam": {"geometry", "record"},
     "explore": {"geometry", "record"},
     "trial": {"geometry", "record", "worlds", "sim", "slam", "explore"},
-    # validation composes sim, slam and metric like a trial (DESIGN.md, "Realism"); it computes only
-    "validation": {"geometry", "record", "worlds", "sim", "slam", "metric"},
+    # validation composes sim, slam and metric like a trial (DESIGN.md, "Realism"), and calibration for the
+    # split-half check (fit on one half of a log, validate on the other); it computes only
+    "validation": {"geometry", "record", "worlds", "sim", "slam", "metric", "calibration"},
     "metric": {"geometry", "record"},
     "calibration": {"geometry", "record", "worlds", "sim", "slam", "metric"},
     "io": {"geometry", "record", "worlds"},

@@ -10,7 +10,6 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
-from slamtrials.geometry import compose
 from slamtrials.sim.config import LaserConfig
 from slamtrials.sim.raycast import LaserModel, RaycastMap, cast_scan, cast_scan_dda
 from slamtrials.worlds.world import World, world_to_map

@@ -349,7 +349,9 @@ def _chunk_bounds(abs_length, abs_turn, max_length, max_turn):  # pragma: no cov
     return out[:count]
 
 
-def motion_chunks(odo_length: NDArray[np.float64], odo_turn: NDArray[np.float64], settings: CalibrationSettings):
+def motion_chunks(
+    odo_length: NDArray[np.float64], odo_turn: NDArray[np.float64], settings: CalibrationSettings
+) -> NDArray[np.int64]:
     """int64 ``[C + 1]`` frame bounds of the chunks the true motion is measured over: a chunk ends after
     ``chunk_distance`` metres or ``chunk_turn`` radians of odometry travel (``odo_*`` ``[T - 1]`` per step)."""
     return _chunk_bounds(

@@ -28,6 +28,7 @@ _PUBLIC = {
     "SimConfig": "slamtrials.sim",
     "simulate_waypoints": "slamtrials.sim",
     "Frame": "slamtrials.record",
+    "Reading": "slamtrials.record",
     "RunRecord": "slamtrials.record",
     "evaluate_run": "slamtrials.evaluation",
     "evaluate_files": "slamtrials.evaluation",

@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 
 __all__ = [
     "Frame",
+    "Reading",
     "LaserGeometry",
     "RunRecord",
     "Trajectory",
@@ -54,6 +55,34 @@ class Frame:
     odometry: NDArray[np.float64]
     truth: NDArray[np.float64]
     stalled: bool = False
+
+    def reading(self) -> Reading:
+        """What a SLAM algorithm is given of this frame: its time, ranges and odometry, no ground truth."""
+        return Reading(t=self.t, ranges=self.ranges, odometry=self.odometry)
+
+
+@dataclass(frozen=True, eq=False)
+class Reading:
+    """What a SLAM algorithm is given at one step: the robot's sensor data and nothing else.
+
+    The ground truth of a run (:attr:`Frame.truth`) never reaches an algorithm, built-in, plug-in or
+    external program: an algorithm that could read it would score whatever it liked. Built from a frame
+    with :meth:`Frame.reading`, or from a recording's arrays.
+
+    Attributes
+    ----------
+    t:
+        Time in seconds (the recording's time base).
+    ranges:
+        float32 ``[B]`` laser ranges in metres, as :attr:`Frame.ranges` (a no-return is ``+inf`` or at
+        least the laser's ``range_max``).
+    odometry:
+        float64 ``[3]`` pose of the robot base in the odometry frame.
+    """
+
+    t: float
+    ranges: NDArray[np.float32]
+    odometry: NDArray[np.float64]
 
 
 @dataclass(frozen=True)

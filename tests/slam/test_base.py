@@ -146,3 +146,43 @@ def test_frames_feed_the_protocol():
     pose = algorithm.process(Frame(0.0, np.full(5, 3.0, np.float32), np.array([1.0, 2.0, 0.5]), np.zeros(3)))
     np.testing.assert_allclose(pose, [0.0, 0.0, 0.0])  # the first frame is at the initial pose
     assert algorithm.updates == 1 and len(algorithm.trajectory()) == 1
+
+
+class TruthReader(ShiftedOdometry):
+    """A plug-in that reaches for the ground truth (it would score 0 m if it got it)."""
+
+    name = "test-truth-reader"
+
+    def process(self, frame):
+        pose = np.asarray(frame.truth, dtype=np.float64)
+        self._t.append(frame.t)
+        self._poses.append(pose)
+        self.updates += 1
+        return pose
+
+
+def test_an_algorithm_is_given_no_ground_truth_offline_or_in_a_trial():
+    from slamtrials.trial import TrialConfig, run_trial
+    from slamtrials.worlds import World
+
+    register_algorithm(TruthReader)
+    try:
+        with pytest.raises(AttributeError, match="truth"):
+            run_slam(_record(), "test-truth-reader")
+        occupied = np.ones((60, 100), bool)
+        occupied[10:50, 10:90] = False
+        world = World(occupied, 0.05, name="box", start=np.array([1.0, 1.0, 0.0]))
+        config = TrialConfig.from_dict(
+            {"slam": {"algorithm": "test-truth-reader", "preset": None}, "termination": {"max_time": 5.0}}
+        )
+        with pytest.raises(AttributeError, match="truth"):
+            run_trial(world, config, seed=1)
+    finally:
+        ALGORITHMS.pop("test-truth-reader", None)
+
+
+def test_a_frame_gives_its_sensor_data_and_not_its_truth():
+    frame = Frame(t=1.5, ranges=np.ones(3, np.float32), odometry=np.zeros(3), truth=np.ones(3))
+    reading = frame.reading()
+    assert reading.t == 1.5 and reading.ranges is frame.ranges and reading.odometry is frame.odometry
+    assert not hasattr(reading, "truth")

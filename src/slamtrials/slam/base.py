@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ValidationError
 
 from slamtrials.errors import ConfigError
-from slamtrials.record import FREE, OCCUPIED, UNKNOWN, Frame, LaserGeometry, OccupancyGrid, Trajectory
+from slamtrials.record import FREE, OCCUPIED, UNKNOWN, LaserGeometry, OccupancyGrid, Reading, Trajectory
 
 __all__ = [
     "OccupancyGrid",
@@ -80,8 +80,9 @@ class SlamAlgorithm(Protocol):
         """Forget every processed frame; later random draws come from ``rng``."""
         ...
 
-    def process(self, frame: Frame) -> NDArray[np.float64]:
-        """Take one frame; return the current pose estimate of the robot base, float64 ``[3]``, map frame."""
+    def process(self, frame: Reading) -> NDArray[np.float64]:
+        """Take one reading (time, ranges, odometry: never the ground truth); return the current pose
+        estimate of the robot base, float64 ``[3]``, map frame."""
         ...
 
     def occupancy(self) -> OccupancyGrid:

@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from slamtrials.geometry import compose1, ominus1
-from slamtrials.record import Frame, LaserGeometry, Trajectory
+from slamtrials.record import LaserGeometry, Reading, Trajectory
 from slamtrials.slam.base import OccupancyGrid, register_algorithm
 from slamtrials.slam.gridmap import GridMap
 
@@ -104,7 +104,7 @@ class OdometrySlam:
         self._turned = 0.0
         self._last_update_t = -math.inf
 
-    def _due(self, frame: Frame) -> bool:
+    def _due(self, frame: Reading) -> bool:
         """GMapping's update rule, accumulating the odometry motion since the last mapped frame."""
         c = self.config
         if self._last_odometry is None:
@@ -116,7 +116,7 @@ class OdometrySlam:
             return True
         return c.temporal_update >= 0 and frame.t - self._last_update_t > c.temporal_update
 
-    def process(self, frame: Frame) -> NDArray[np.float64]:
+    def process(self, frame: Reading) -> NDArray[np.float64]:
         """The odometry pose composed onto the initial pose; maps the scan when an update is due."""
         odometry = np.asarray(frame.odometry, dtype=np.float64)
         if self._first_odometry is None:

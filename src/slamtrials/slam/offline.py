@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 from pydantic import BaseModel
 
 from slamtrials.errors import ConfigError
-from slamtrials.record import Frame, OccupancyGrid, RunRecord, Trajectory
+from slamtrials.record import OccupancyGrid, Reading, RunRecord, Trajectory
 from slamtrials.seeding import check_seed, slam_rng
 from slamtrials.slam.base import get_algorithm, resolve_config
 
@@ -121,13 +121,7 @@ def run_over_recording(
     timing = np.empty(total, dtype=np.float64)
     online = np.empty((total, 3), dtype=np.float64)
     for k in range(total):
-        frame = Frame(
-            t=float(record.t[k]),
-            ranges=record.scans[k],
-            odometry=record.odometry[k],
-            truth=record.truth[k],
-            stalled=bool(record.stalled[k]),
-        )
+        frame = Reading(t=float(record.t[k]), ranges=record.scans[k], odometry=record.odometry[k])
         started = time.perf_counter()
         online[k] = slam.process(frame)
         timing[k] = time.perf_counter() - started

@@ -146,7 +146,7 @@ def run_trial(
     while True:
         frames.append(frame)
         tick = time.perf_counter()
-        estimate = slam.process(frame)
+        estimate = slam.process(frame.reading())  # the algorithm never sees the truth
         slam_seconds += time.perf_counter() - tick
         online.append(np.array(estimate, dtype=np.float64))
         grid = slam.occupancy()

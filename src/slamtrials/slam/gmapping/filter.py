@@ -52,7 +52,7 @@ from numpy.typing import NDArray
 
 from slamtrials import stablemath
 from slamtrials.geometry import compose, compose1, inverse, ominus, wrap_angle1
-from slamtrials.record import Frame, LaserGeometry, Trajectory
+from slamtrials.record import LaserGeometry, Reading, Trajectory
 from slamtrials.slam.base import OccupancyGrid, register_algorithm
 from slamtrials.slam.gmapping.config import PRESETS, GMappingConfig, default_max_range
 from slamtrials.slam.gmapping.kernels import match_particles
@@ -221,7 +221,7 @@ class GMapping:
             self.lineage.resampled(indexes)
             self.resamplings += 1
 
-    def process(self, frame: Frame) -> NDArray[np.float64]:
+    def process(self, frame: Reading) -> NDArray[np.float64]:
         """Take one reading; return the best particle's base pose (map frame), float64 ``[3]``."""
         c = self.config
         t = float(frame.t)

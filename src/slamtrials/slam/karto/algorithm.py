@@ -46,7 +46,7 @@ from numpy.typing import NDArray
 from slamtrials import stablemath
 from slamtrials.errors import ConfigError
 from slamtrials.geometry import compose, compose1, inverse, ominus, ominus1, wrap_angle1
-from slamtrials.record import Frame, LaserGeometry, Trajectory
+from slamtrials.record import LaserGeometry, Reading, Trajectory
 from slamtrials.slam.base import OccupancyGrid, register_algorithm
 from slamtrials.slam.karto.config import KartoConfig
 from slamtrials.slam.karto.graph import PoseGraph, ScanNode
@@ -510,7 +510,7 @@ class Karto:
 
     # ------------------------------------------------------------------ protocol
 
-    def process(self, frame: Frame) -> NDArray[np.float64]:
+    def process(self, frame: Reading) -> NDArray[np.float64]:
         """Take one frame; return the online base-pose estimate (map frame), float64 ``[3]``.
 
         Raises

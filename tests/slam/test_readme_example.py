@@ -1,4 +1,4 @@
-"""The README's "Plugging in a SLAM algorithm" example runs as written: Python API and command line."""
+"""The user guide's "Plugging in a SLAM algorithm" example runs as written: Python API and command line."""
 
 from __future__ import annotations
 
@@ -16,11 +16,11 @@ from slamtrials.sim import SimConfig, simulate_waypoints
 from slamtrials.slam import ALGORITHMS, OdometrySlam
 from slamtrials.worlds import World
 
-README = Path(__file__).resolve().parents[2] / "README.md"
+GUIDE = Path(__file__).resolve().parents[2] / "docs" / "guide.md"
 
 
 def _section_blocks(language: str) -> list[str]:
-    text = README.read_text(encoding="utf-8")
+    text = GUIDE.read_text(encoding="utf-8")
     section = text.split("## Plugging in a SLAM algorithm", 1)[1].split("\n## ", 1)[0]
     return re.findall(rf"```{language}\n(.*?)```", section, flags=re.S)
 
@@ -28,7 +28,7 @@ def _section_blocks(language: str) -> list[str]:
 @pytest.fixture
 def readme_algorithm():
     namespace: dict = {"__name__": "readme_example"}
-    exec(compile(_section_blocks("python")[0], str(README), "exec"), namespace)  # noqa: S102 - our own README
+    exec(compile(_section_blocks("python")[0], str(GUIDE), "exec"), namespace)  # noqa: S102 - our own guide
     yield namespace["DeadReckoning"]
     ALGORITHMS.pop("dead-reckoning", None)
 

@@ -178,3 +178,13 @@ def test_simulate_path_refuses_times_that_do_not_increase():
     t[5] = t[4]
     with pytest.raises(SimulationError, match="strictly increasing"):
         simulate_path(_world(), t, path, None, 0)
+
+
+def test_simulate_path_defaults_to_the_default_profile():
+    t, path = _regular()
+    by_default = simulate_path(_world(), t, path, None, 4)
+    realistic = simulate_path(_world(), t, path, SimConfig(), 4)
+    paper = simulate_path(_world(), t, path, SimConfig.paper(), 4)
+    assert np.array_equal(by_default.scans, realistic.scans)
+    assert np.array_equal(by_default.odometry, realistic.odometry)
+    assert not np.array_equal(by_default.odometry, paper.odometry)

@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 from slamtrials.calibration.beams import BeamSample, beam_sample
 from slamtrials.calibration.laser import LASER_VALUES, LaserFit, fit_laser
 from slamtrials.calibration.lifetime import LifetimeFit, fit_lifetime, model_laser_values
+from slamtrials.calibration.model_config import fitted_laser_config
 from slamtrials.calibration.odometry import (
     ODOMETRY_VALUES,
     OdometryFit,
@@ -31,8 +32,8 @@ from slamtrials.calibration.odometry import (
 from slamtrials.calibration.reference import Reference, check_calibratable
 from slamtrials.calibration.settings import CalibrationSettings
 from slamtrials.errors import CalibrationError
-from slamtrials.record import Relations, RunRecord
-from slamtrials.sim.config import ErrorProfile, LaserConfig
+from slamtrials.record import LaserGeometry, Relations, RunRecord
+from slamtrials.sim.config import ErrorProfile
 from slamtrials.sim.laser_errors import apply_laser_errors
 
 __all__ = ["Calibration", "calibrate", "FittedValue"]
@@ -154,8 +155,8 @@ def _block_index(frames: NDArray[np.int64], block: int, rng: np.random.Generator
     return np.concatenate([np.arange(starts[b], ends[b]) for b in chosen])
 
 
-def _laser_model(sample: BeamSample, fit: LaserFit, range_min: float, range_max: float, rng: np.random.Generator):
-    config = LaserConfig(max_range=min(range_max, 1000.0), min_range=min(range_min, range_max * 0.5), **fit.values)
+def _laser_model(sample: BeamSample, fit: LaserFit, laser: LaserGeometry, rng: np.random.Generator):
+    config = fitted_laser_config(laser, fit.values)
     readings = apply_laser_errors(
         sample.cast.astype(np.float32), config, rng, sample.incidence, nearer=sample.nearer
     ).astype(np.float64)
@@ -280,7 +281,7 @@ def calibrate(
             FittedValue(k, float(odometry.values[k]), float(se), _UNITS[k]) for k, se in zip(ODOMETRY_VALUES, odo_se)
         )
     )
-    model_e, model_drop = _laser_model(sample, laser, record.laser.range_min, record.laser.range_max, rng)
+    model_e, model_drop = _laser_model(sample, laser, record.laser, rng)
     return Calibration(
         laser=laser,
         odometry=odometry,

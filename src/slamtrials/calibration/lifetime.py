@@ -45,10 +45,10 @@ from numpy.typing import NDArray
 from slamtrials import stablemath
 from slamtrials.calibration.beams import FrameCast, FrameCaster
 from slamtrials.calibration.laser import LaserFit
+from slamtrials.calibration.model_config import fitted_laser_config
 from slamtrials.calibration.reference import Reference
 from slamtrials.calibration.settings import CalibrationSettings
 from slamtrials.record import RunRecord
-from slamtrials.sim.config import LaserConfig
 from slamtrials.sim.laser_errors import apply_laser_errors
 from slamtrials.sim.unmapped import UnmappedScan, UnmappedThings
 
@@ -194,13 +194,7 @@ def _replay(
     """float32 ``[T, B]``: the simulator's laser model with ``values``, ``lifetime`` and ``fleeting`` reading the
     cast ranges of every frame in order, its draws from ``seed``."""
     laser = record.laser
-    config = LaserConfig(
-        max_range=min(float(laser.range_max), 1000.0),
-        min_range=min(float(laser.range_min), float(laser.range_max) * 0.5),
-        short_lifetime=lifetime,
-        short_fleeting_share=fleeting,
-        **values,
-    )
+    config = fitted_laser_config(laser, values, short_lifetime=lifetime, short_fleeting_share=fleeting)
     rng = np.random.default_rng(np.random.SeedSequence(seed))
     things = UnmappedThings()
     out = np.empty((len(casts), angles.size), dtype=np.float32)

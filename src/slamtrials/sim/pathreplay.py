@@ -43,7 +43,7 @@ def simulate_path(
         float64 ``[T, 3]`` true poses of the robot base (x, y, theta; world frame, m and rad).
     config:
         Laser and odometry settings with their error models (``config.dt`` and ``config.robot`` are not
-        used); ``None`` means :meth:`SimConfig.paper`.
+        used); ``None`` means ``SimConfig()`` (the default profile, :data:`~slamtrials.sim.profiles.DEFAULT_PROFILE`).
     rng:
         The run's simulator stream (a Generator, or a seed turned into one).
 
@@ -84,7 +84,7 @@ def simulate_path(
         raise SimulationError("simulate_path: times and poses must be finite")
     if np.any(np.diff(times) <= 0.0):
         raise SimulationError("simulate_path: times must be strictly increasing")
-    config = SimConfig.paper() if config is None else config
+    config = SimConfig() if config is None else config
     generator = as_generator(rng)
     bias = draw_bias(config.odometry, generator)
     laser = LaserModel(world, config.laser)

@@ -195,6 +195,20 @@ def _check_covers(source: _Source, run_t, run: Path, tolerance: float) -> None:
         )
 
 
+def _check_turns(source: _Source, odometry: Trajectory, run: Path) -> None:
+    """Refuse an estimate whose turns are not the run's odometry's: a trajectory of another run that
+    happens to cover this one's time span."""
+    from slamtrials.metric.belongs import turn_agreement
+
+    agreement = turn_agreement(source.trajectory, odometry)
+    if not agreement.belongs:
+        raise FormatError(
+            source.path,
+            f"its heading changes contradict the run {run}'s odometry in {agreement.contradicting_windows} of "
+            f"{agreement.turning_windows} turning windows of 2 s: not an estimate of this run",
+        )
+
+
 def _with_lines(exc: MetricError, sources: dict[str, _Source], relations_path: Path | None) -> Exception:
     """Turn a MetricError that names an index into a FormatError that names the file and line."""
     if exc.what == "relations" and relations_path is not None and exc.index is not None:
@@ -359,7 +373,8 @@ def evaluate_run(
     ------
     FormatError
         An unreadable run folder or estimate file, data the metric refuses, or an estimate file whose
-        timestamps do not cover the run's (a trajectory of another run).
+        timestamps do not cover the run's or whose turns contradict the run's odometry (a trajectory of
+        another run).
     ConfigError
         ``out`` already holds relations.
     """
@@ -380,6 +395,7 @@ def evaluate_run(
     if estimate is not None:
         source = _read_trajectory(Path(estimate), estimate_pose, "estimate")
         _check_covers(source, record.t, run, tolerance)
+        _check_turns(source, odometry, run)
     elif record.estimate is not None:
         source = _Source(
             Trajectory(t=record.t, poses=record.estimate), files.frames, "run", f"{run} (the run's estimate)"

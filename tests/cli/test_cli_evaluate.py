@@ -298,3 +298,34 @@ def test_pose_indices_map_to_file_lines(tmp_path):
     assert (mapped.path, mapped.line) == (mixed, 6) and "2 ROBOTLASER1 lines" in source.label
     unknown = MetricError("no index")
     assert _with_lines(unknown, {}, None) is unknown
+
+
+def test_the_estimate_of_another_run_of_the_same_length_is_refused(tmp_path, drive, odometry_of):
+    """Same times, other turns: the time-span check cannot see it, the turn check does (exit 2, nothing
+    written); the run's own estimate passes."""
+    t, truth = drive(1)
+    record = RunRecord(
+        t=t,
+        scans=np.zeros((len(t), 3), np.float32),
+        odometry=odometry_of(truth, 2),
+        truth=truth,
+        stalled=np.zeros(len(t), bool),
+        laser=LASER,
+        metadata={"seed": 0},
+    )
+    folder = write_run(tmp_path / "run", record)
+    _, other_truth = drive(5)
+    foreign = tmp_path / "run001.tum"
+    write_tum(foreign, Trajectory(t=t, poses=other_truth))
+    result = runner.invoke(app, ["evaluate", str(folder), "--estimate", str(foreign)])
+    assert result.exit_code == 2, result.output
+    assert len(result.output.strip().splitlines()) == 1
+    assert (
+        "run001.tum" in result.output
+        and "contradict" in result.output
+        and "not an estimate of this run" in result.output
+    )
+    assert not (folder / "evaluations").exists()
+    own = tmp_path / "run000.tum"
+    write_tum(own, Trajectory(t=t, poses=truth))
+    assert runner.invoke(app, ["evaluate", str(folder), "--estimate", str(own)]).exit_code == 0

@@ -112,3 +112,24 @@ def test_a_missing_option_keeps_the_usage_panel():
     result = runner.invoke(app, ["export", "RUN", "--to", "tum"])
     assert result.exit_code == 2
     assert "Missing option '--out'" in result.output and "Usage" in result.output
+
+
+def _command_paths(group, prefix=()):
+    """Every command of the CLI as the words that name it, groups included."""
+    yield prefix
+    if hasattr(group, "list_commands"):  # a group (typer vendors its own click)
+        ctx = group.context_class(group)
+        for name in group.list_commands(ctx):
+            yield from _command_paths(group.get_command(ctx, name), (*prefix, name))
+
+
+def test_boolean_flags_are_shown_as_flags_in_every_help():
+    """typer's rich help prints a type after every option; a flag must not read as taking a value."""
+    paths = list(_command_paths(typer.main.get_command(app)))
+    assert len(paths) > 15
+    for words in paths:
+        result = runner.invoke(app, [*words, "--help"], env={"COLUMNS": "120"})
+        assert result.exit_code == 0, (words, result.output)
+        assert "<bool>" not in result.output, words
+    shown = runner.invoke(app, ["trial", "--help"], env={"COLUMNS": "120"}).output
+    assert "--overwrite" in shown and "<int>" in shown

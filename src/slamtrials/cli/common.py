@@ -41,6 +41,15 @@ class ErrorReportingGroup(TyperGroup):
     typer's usage panel, which points to --help.
     """
 
+    def get_params(self, ctx):
+        return _flags_as_flags(super().get_params(ctx))
+
+    def get_command(self, ctx, cmd_name):
+        command = super().get_command(ctx, cmd_name)
+        if command is not None:
+            _flags_as_flags(command.get_params(ctx))
+        return command
+
     def invoke(self, ctx):  # ctx: typer's (vendored) click Context
         try:
             return super().invoke(ctx)
@@ -56,6 +65,16 @@ class ErrorReportingGroup(TyperGroup):
             where = f"{exc.filename}: " if exc.filename else ""
             typer.echo(f"error: {where}{exc.strerror or exc}", err=True)
             raise typer.Exit(EXIT_BAD_INPUT) from None
+
+
+def _flags_as_flags(params: list) -> list:
+    """Show boolean flags in the help as flags: typer's rich help prints a type after every option
+    (``--overwrite <bool>``), which reads as if the flag took a value (``--overwrite true`` fails).
+    An empty metavar leaves the type column empty for them."""
+    for param in params:
+        if getattr(param, "is_flag", False) and param.metavar is None:
+            param.metavar = ""
+    return params
 
 
 def bad_value_line(exc: BadParameter) -> str:

@@ -6,11 +6,14 @@ import csv
 
 import numpy as np
 import pytest
+from typer.testing import CliRunner
 
 from slamtrials.campaign import CampaignConfig, campaign_status, load_summary, run_campaign, run_seed
 from slamtrials.campaign.testing import FakeTrial
+from slamtrials.cli.main import app
 from slamtrials.errors import ConfigError, SimulationError
 from slamtrials.metric import replay_run_count
+from slamtrials.report.load import load_campaign
 
 FAKE = FakeTrial(mean_t=0.3, std_t=0.05, mean_r=0.05, std_r=0.012)
 
@@ -90,8 +93,18 @@ def test_the_cap_is_reported(tmp_path, rooms, client):
     config = config_for(rooms[:1], runs={"initial": 5, "max_runs": 6})
     result = run_campaign(config, tmp_path / "c", scheduler=client, trial_fn=FAKE)
     (row,) = result.summary
-    assert row.status == "capped" and row.capped and row.runs == 6
-    assert any("cap" in note for note in result.notes)
+    assert row.status == "capped" and row.capped and row.runs == 6 and row.cap == 6
+    # the rule's own figure, not the cap, everywhere: the summary, summary.csv, the note, status, the report
+    asked = row.runs_needed
+    assert asked > 6
+    (csv_row,) = csv.DictReader((tmp_path / "c" / "summary.csv").open())
+    assert (csv_row["runs_needed"], csv_row["capped"], csv_row["capped_at"]) == (str(asked), "1", "6")
+    assert any(f"cap of 6 runs; the rule asked for {asked}," in note for note in result.notes)
+    status = CliRunner().invoke(app, ["campaign", "status", str(tmp_path / "c")], env={"COLUMNS": "200"})
+    assert f"{asked} (capped at 6)" in status.output, status.output
+    assert f"6/{asked} (capped at 6)" in status.output
+    worlds = load_campaign(tmp_path / "c").worlds
+    assert int(worlds["runs_needed"].iloc[0]) == asked
 
 
 class FailingIn:

@@ -168,3 +168,20 @@ def test_a_campaign_stored_by_an_earlier_version_loads_and_resumes(tmp_path):
     open_campaign(folder, config, WORLDS, kind="campaign").close()
     with pytest.raises(ConfigError, match="different config"):
         open_campaign(folder, CampaignConfig(worlds=["a", "b"], seed=6), WORLDS, kind="campaign")
+
+
+def test_a_capped_world_keeps_the_rule_s_own_run_count(tmp_path):
+    """runs_needed is what the rule asked for before the cap; a catalog of an earlier version, which
+    stored the capped figure, reads the same from needed_t and needed_r."""
+    from slamtrials.metric import runs_needed
+
+    eps_t = [0.1, 0.5, 0.2, 0.9, 0.3]
+    decision = runs_needed(eps_t, eps_t, margin_t=0.02, margin_r=0.02, min_runs=5, max_runs=5)
+    assert decision.capped and decision.needed == 5 and decision.asked == max(decision.needed_t, decision.needed_r) > 5
+    with CampaignStore.create(tmp_path / "c", CampaignConfig(worlds=["a", "b"]), WORLDS) as store:
+        store.record_world("a", status="capped", target=5, decision=decision)
+        assert store.worlds()[0].runs_needed == decision.asked and store.worlds()[0].capped
+    with sqlite3.connect(tmp_path / "c" / DB_FILE) as conn:  # as an earlier version wrote it
+        conn.execute("UPDATE worlds SET runs_needed = 5 WHERE name = 'a'")
+    with CampaignStore.open(tmp_path / "c") as store:
+        assert store.worlds()[0].runs_needed == decision.asked

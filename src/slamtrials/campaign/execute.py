@@ -93,7 +93,8 @@ def result_notes(summary: list) -> tuple[str, ...]:
     for row in summary:
         if row.status == "capped":
             notes.append(
-                f"{row.world}: stopped at the cap of {row.runs} runs; the rule asked for more, the margins are not reached"
+                f"{row.world}: stopped at the cap of {row.cap or row.runs} runs; the rule asked for "
+                f"{row.runs_needed or 'more'}, the margins are not reached"
             )
         elif row.status == "failed":
             notes.append(f"{row.world}: failed ({row.note or 'see the runs table'}); resume to retry")

@@ -9,8 +9,9 @@ Tables (SQLite, WAL journal, ``synchronous=FULL``, one transaction per state cha
 ``worlds``
     one row per world: ``name`` (campaign name, the run folder name), ``ref`` (catalog name or absolute
     file), ``position``, ``reachable_area`` (m^2), ``status`` (pending, running, done, capped, failed,
-    short), the last decision of the run-count rule (``runs_target``, ``runs_needed``, ``needed_t``,
-    ``needed_r``, ``std_t`` m, ``std_r`` rad, ``capped``), ``note``, ``updated``.
+    short), the last decision of the run-count rule (``runs_target``; ``runs_needed``, the runs the rule
+    asked for before the cap; ``needed_t``, ``needed_r``, ``std_t`` m, ``std_r`` rad, ``capped``: the cap,
+    ``runs_target``, cut ``runs_needed``), ``note``, ``updated``.
 ``runs``
     one row per submitted run, primary key ``(world, idx)``: ``seed``, ``status`` (running, done,
     failed, or pending: to be submitted again after a resume), ``attempts`` (submissions by a driver),
@@ -33,7 +34,7 @@ import sqlite3
 import time
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -112,6 +113,16 @@ class WorldRow:
     capped: int
     note: str | None
     updated: str | None
+
+
+def _asked_before_cap(row: WorldRow) -> WorldRow:
+    """``row`` with ``runs_needed`` the rule's own figure: catalogs written before it was stored held the
+    capped figure, which ``needed_t`` and ``needed_r`` still tell apart."""
+    if row.capped and row.runs_needed is not None:
+        asked = max(row.runs_needed, row.needed_t or 0, row.needed_r or 0)
+        if asked != row.runs_needed:
+            return replace(row, runs_needed=asked)
+    return row
 
 
 @dataclass(frozen=True)
@@ -345,7 +356,7 @@ class CampaignStore:
     def worlds(self) -> list[WorldRow]:
         """The worlds, in campaign order."""
         rows = self._conn.execute(f"SELECT {_WORLD_COLUMNS} FROM worlds ORDER BY position").fetchall()
-        return [WorldRow(*row) for row in rows]
+        return [_asked_before_cap(WorldRow(*row)) for row in rows]
 
     def world_infos(self) -> list[WorldInfo]:
         """The worlds as :class:`WorldInfo`, in campaign order."""
@@ -454,7 +465,7 @@ class CampaignStore:
         values = (
             status,
             target,
-            getattr(d, "needed", None),
+            getattr(d, "asked", getattr(d, "needed", None)),
             getattr(d, "needed_t", None),
             getattr(d, "needed_r", None),
             _finite(getattr(d, "std_t", None)),

@@ -5,11 +5,12 @@ For each world: its status, the runs done, the mean and standard deviation of th
 at the run-count rule's confidence and distribution), whether the cap stopped it, and how its runs
 ended. :func:`write_summary_csv` saves it as ``summary.csv`` (atomically).
 
-CSV columns: ``world, status, runs, runs_needed, capped, eps_t_mean, eps_t_std, eps_t_std_population,
+CSV columns: ``world, status, runs, runs_needed, capped, capped_at, eps_t_mean, eps_t_std, eps_t_std_population,
 eps_t_ci_low, eps_t_ci_high, eps_r_mean, eps_r_std, eps_r_std_population, eps_r_ci_low, eps_r_ci_high,
 confidence, failed_runs, terminations, eps_t_metric_share, eps_r_metric_share`` (``std`` has divisor
-``n - 1``, ``std_population`` divisor ``n`` as printed in the paper; empty cells where a value is
-undefined; ``terminations`` as ``reason:count;...``; ``*_metric_share``: the metric's share of the
+``n - 1``, ``std_population`` divisor ``n`` as printed in the paper; ``runs_needed`` the runs the rule
+asked for at its last decision, also where the cap stopped the world (``capped`` 1, ``capped_at`` the
+cap; empty otherwise); empty cells where a value is undefined; ``terminations`` as ``reason:count;...``; ``*_metric_share``: the metric's share of the
 between-run variance, :func:`slamtrials.metric.metric_noise_share`, empty for runs stored without
 standard errors).
 """
@@ -38,6 +39,7 @@ CSV_COLUMNS = (
     "runs",
     "runs_needed",
     "capped",
+    "capped_at",
     "eps_t_mean",
     "eps_t_std",
     "eps_t_std_population",
@@ -67,9 +69,11 @@ class WorldSummary:
     runs:
         Done runs.
     runs_needed:
-        Runs the rule asked for at its last decision (None before the first).
+        Runs the rule asked for at its last decision, before any cap (None before the first).
     capped:
         The cap stopped the world before the margins were reached.
+    cap:
+        The cap on runs per world (``runs.max_runs``) where it stopped the world, else None.
     eps_t, eps_r:
         Statistics of the per-run errors (m, rad); None without runs.
     failed_runs:
@@ -96,6 +100,7 @@ class WorldSummary:
     note: str | None = None
     metric_share_t: float | None = None
     metric_share_r: float | None = None
+    cap: int | None = None
 
 
 def summarize_store(store: CampaignStore) -> list[WorldSummary]:
@@ -134,6 +139,7 @@ def summarize_store(store: CampaignStore) -> list[WorldSummary]:
                 world.note,
                 share_t,
                 share_r,
+                settings.max_runs if world.capped else None,
             )
         )
     return rows
@@ -189,6 +195,7 @@ def write_summary_csv(folder: str | Path, rows: list[WorldSummary], confidence: 
                 row.runs,
                 "" if row.runs_needed is None else row.runs_needed,
                 int(row.capped),
+                "" if row.cap is None else row.cap,
                 *_stats_cells(row.eps_t),
                 *_stats_cells(row.eps_r),
                 repr(confidence),

@@ -57,9 +57,19 @@ def summary_table(rows, confidence: float, title: str):
                     fmt_number(stats.half_width, digits),
                 ]
         needed = f"/{row.runs_needed}" if row.runs_needed is not None and row.runs_needed > row.runs else ""
+        if row.cap is not None:
+            needed += f" (capped at {row.cap})"
         reasons = ", ".join(f"{k} {v}" for k, v in row.terminations.items())
         table.add_row(row.world, row.status, f"{row.runs}{needed}", *cells, reasons)
     return table
+
+
+def _needed_cell(world) -> str:
+    """The runs a world needs (a :class:`~slamtrials.campaign.store.WorldRow`): the current batch's target,
+    or where the cap stopped it, the rule's figure and the cap."""
+    if world.capped and world.runs_needed is not None:
+        return f"{world.runs_needed} (capped at {world.runs_target})"
+    return "-" if world.runs_target is None else str(world.runs_target)
 
 
 def metric_share_line(rows) -> str | None:
@@ -246,7 +256,7 @@ def status(folder: Annotated[Path, typer.Argument(help="Campaign folder.")]) -> 
             world.name,
             world.status,
             str(counts.get("done", 0)),
-            "-" if world.runs_target is None else str(world.runs_target),
+            _needed_cell(world),
             str(counts.get("interrupted" if interrupted else "running", 0)),
             str(counts.get("failed", 0)),
             world.note or "",

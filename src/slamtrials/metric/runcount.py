@@ -59,6 +59,12 @@ class RunCount:
     enough: bool
     capped: bool
 
+    @property
+    def asked(self) -> int:
+        """Runs the rule asks for before any cap: ``max(needed_t, needed_r, min_runs)`` (``needed`` unless
+        ``capped``)."""
+        return max(self.needed, self.needed_t, self.needed_r)
+
 
 def runs_needed(
     eps_t: ArrayLike,

@@ -345,6 +345,8 @@ def _table_one(data: CampaignData, done: pd.DataFrame) -> str:
     for _, w in data.worlds.iterrows():
         needed = w["runs_needed"]
         runs = f"{w['runs_done']}" + (f" / {needed}" if pd.notna(needed) and int(needed) > w["runs_done"] else "")
+        if w["capped"] and pd.notna(w["runs_target"]):
+            runs += f" (capped at {w['runs_target']})"
         cells = [w["world"], w["status"], h.Cell(runs, numeric=True)]
         for metric, digits in (("eps_t", 3), ("eps_r", 4)):
             cells += [
@@ -375,7 +377,8 @@ def _table_one(data: CampaignData, done: pd.DataFrame) -> str:
     caption = (
         f"The paper's Table I: per world, the mean and sample standard deviation (divisor n \u2212 1) of the runs' "
         f"translational error {SYMBOLS['eps_t']} (m) and rotational error {SYMBOLS['eps_r']} (rad), and the half width "
-        f"of the {_pct(confidence)} confidence interval of the mean. Runs: done (/ needed by the run-count rule when more)."
+        f"of the {_pct(confidence)} confidence interval of the mean. Runs: done (/ needed by the run-count rule when more, "
+        f"also where the cap stopped a world)."
     )
     parts = [
         h.table(header, rows, id="summary-table", caption=caption, row_classes=classes, groups=groups),

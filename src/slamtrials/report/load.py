@@ -278,6 +278,9 @@ def _worlds_frame(rows: list[tuple], runs: pd.DataFrame, config: dict[str, Any])
     worlds["capped"] = worlds["capped"].astype(bool)
     for column in ("runs_target", "runs_needed", "needed_t", "needed_r"):
         worlds[column] = pd.array(worlds[column].tolist(), dtype="Int64")
+    # the rule's own figure where the cap cut it (catalogs of earlier versions stored the capped one)
+    asked = worlds[["runs_needed", "needed_t", "needed_r"]].max(axis=1, skipna=True).astype("Int64")
+    worlds["runs_needed"] = worlds["runs_needed"].where(~worlds["capped"] | worlds["runs_needed"].isna(), asked)
     for column in ("reachable_area", "std_t", "std_r"):
         worlds[column] = pd.to_numeric(worlds[column], errors="coerce").astype("float64")
     for status in ("done", "failed", "running", "pending"):

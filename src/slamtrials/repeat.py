@@ -29,6 +29,7 @@ from slamtrials.atomicfile import atomic_write, atomic_write_text
 from slamtrials.errors import ConfigError, MetricError
 from slamtrials.metric.divergence import DEFAULT_DIVERGENCE_FACTOR, Divergence, divergence
 from slamtrials.metric.matching import DEFAULT_TOLERANCE, relations_meet
+from slamtrials.metric.meaninterval import MeanInterval, positive_mean_interval
 from slamtrials.metric.relerrors import evaluate_relations
 from slamtrials.metric.runcount import runs_needed
 from slamtrials.metric.stats import EnvironmentStats, environment_stats
@@ -149,6 +150,9 @@ class RepeatedSlam:
         The runs, in seed order.
     stats_t, stats_r:
         Mean, sample std and Student t interval of the per-run errors (m, rad).
+    interval_t, interval_r:
+        The interval of the mean error that is printed: the Student t one, or a bootstrap one where that
+        reaches below zero (:func:`~slamtrials.metric.meaninterval.positive_mean_interval`).
     diverged:
         The runs whose translational error is above ``divergence_factor`` times the median.
     rule:
@@ -163,6 +167,8 @@ class RepeatedSlam:
     runs: tuple[RepeatedRun, ...]
     stats_t: EnvironmentStats
     stats_r: EnvironmentStats
+    interval_t: MeanInterval
+    interval_r: MeanInterval
     diverged: Divergence
     rule: str
     source: str
@@ -309,11 +315,16 @@ def repeat_slam(
             run_seeds(range(settings.runs), settings.runs)
     runs = tuple(done[s] for s in sorted(done))
     eps_t = [r.eps_t for r in runs]
+    eps_r = [r.eps_r for r in runs]
+    stats_t = environment_stats(eps_t, confidence=settings.confidence, distribution="t")
+    stats_r = environment_stats(eps_r, confidence=settings.confidence, distribution="t")
     return RepeatedSlam(
         settings=settings,
         runs=runs,
-        stats_t=environment_stats(eps_t, confidence=settings.confidence, distribution="t"),
-        stats_r=environment_stats([r.eps_r for r in runs], confidence=settings.confidence, distribution="t"),
+        stats_t=stats_t,
+        stats_r=stats_r,
+        interval_t=positive_mean_interval(eps_t, stats_t),
+        interval_r=positive_mean_interval(eps_r, stats_r),
         diverged=divergence(eps_t, settings.divergence_factor),
         rule=rule,
         source=source,
@@ -370,8 +381,8 @@ def write_repeat_outputs(result: RepeatedSlam, out_dir: str | Path, *, overwrite
         "seeds": [r.seed for r in result.runs],
         "run_count_rule": result.rule,
         "confidence": result.settings.confidence,
-        "translational_m": _stats_json(result.stats_t),
-        "rotational_rad": _stats_json(result.stats_r),
+        "translational_m": _stats_json(result.stats_t, result.interval_t),
+        "rotational_rad": _stats_json(result.stats_r, result.interval_r),
         "diverged": {
             "threshold_m": result.diverged.threshold,
             "factor": result.diverged.factor,
@@ -385,5 +396,12 @@ def write_repeat_outputs(result: RepeatedSlam, out_dir: str | Path, *, overwrite
     return [Path(p) for p in written]
 
 
-def _stats_json(stats: EnvironmentStats) -> dict[str, float]:
-    return {"mean": stats.mean, "std": stats.std_sample, "ci_low": stats.ci_low, "ci_high": stats.ci_high, "n": stats.n}
+def _stats_json(stats: EnvironmentStats, interval: MeanInterval) -> dict[str, float | str]:
+    return {
+        "mean": stats.mean,
+        "std": stats.std_sample,
+        "ci_low": interval.low,
+        "ci_high": interval.high,
+        "ci_method": interval.method,
+        "n": stats.n,
+    }

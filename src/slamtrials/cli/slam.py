@@ -246,13 +246,14 @@ def format_repeat(result: RepeatedSlam) -> str:
             + ("  diverged" if flagged[r.seed] else "")
         )
     st, sr, level = result.stats_t, result.stats_r, f"{100 * result.settings.confidence:g} %"
+    it, ir = result.interval_t, result.interval_r
     lines.append(
         f"translational: mean {st.mean:.6f} m, std {st.std_sample:.6f} m, {level} interval of the mean "
-        f"[{st.ci_low:.6f}, {st.ci_high:.6f}] (Student t, {st.n} runs)"
+        f"[{it.low:.6f}, {it.high:.6f}] ({it.method}, {st.n} runs)"
     )
     lines.append(
         f"rotational:    mean {sr.mean:.6f} rad, std {sr.std_sample:.6f} rad, {level} interval "
-        f"[{sr.ci_low:.6f}, {sr.ci_high:.6f}]"
+        f"[{ir.low:.6f}, {ir.high:.6f}]" + ("" if ir.method == it.method else f" ({ir.method})")
     )
     d = result.diverged
     lines.append(

@@ -160,3 +160,25 @@ def test_one_line_errors(campaigns, tmp_path):
     one_line_error(runner.invoke(app, ["export-table", str(a), "--out", str(tmp_path)]), "is a folder")
     bad_format = runner.invoke(app, ["export-table", str(a), "--format", "xlsx"])
     assert bad_format.exit_code == 2 and "xlsx" in bad_format.output
+
+
+def test_compare_with_itself_warns_in_one_line(campaigns, tmp_path):
+    a, _ = campaigns
+    result = runner.invoke(cli_app(), ["compare", str(a), str(a), "--out", str(tmp_path / "self"), "--no-pdf"])
+    assert result.exit_code == 0, result.output
+    warnings = [line for line in result.output.splitlines() if line.startswith("warning:")]
+    assert warnings == [f"warning: {a} is compared with itself: every difference is 0"]
+
+
+def test_compare_shows_world_names_whole_on_a_narrow_terminal(campaigns, replayed, tmp_path):
+    a, _ = campaigns
+    for columns in ("80", "100"):
+        result = runner.invoke(
+            cli_app(),
+            ["compare", str(a), str(replayed), "--out", str(tmp_path / columns), "--no-pdf"],
+            env={"COLUMNS": columns},
+        )
+        assert result.exit_code == 0, result.output
+        rows = [line for line in result.output.splitlines() if line.startswith("\u2502")]
+        names = [line.split("\u2502")[1].strip() for line in rows]
+        assert [name for name in names if name] == WORLDS * 2, names  # eps_t's table, eps_r's

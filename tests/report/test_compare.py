@@ -217,3 +217,11 @@ def test_bad_input_is_named() -> None:
         compare_campaigns(a, _frame({"other": [1.0, 2.0]}))
     with pytest.raises(ValueError, match="alpha"):
         compare_campaigns(a, a, alpha=1.5)
+
+
+def test_worlds_come_in_campaign_a_s_order():
+    """Not alphabetically: the order the campaign lists its worlds in (B's extra worlds left out)."""
+    a = _frame({"zeta_hall": [0.1, 0.2, 0.3], "alpha_lab": [0.2, 0.3, 0.4], "mid_office": [0.3, 0.2, 0.1]})
+    b = _frame({"alpha_lab": [0.2, 0.4, 0.5], "mid_office": [0.1, 0.2, 0.3], "zeta_hall": [0.1, 0.3, 0.3]})
+    comparison = compare_campaigns(a, b)
+    assert list(comparison.for_metric("eps_t")["world"]) == ["zeta_hall", "alpha_lab", "mid_office"]

@@ -121,8 +121,12 @@ def comparison_table(comparison, metric: str):
         ("verdict", "left"),
         ("trap", "right"),
     ]
+    longest = max((len(str(w)) for w in comparison.for_metric(metric)["world"]), default=5)
     for column, justify in columns:
-        table.add_column(column, justify=justify, no_wrap=column not in ("world", "verdict"))
+        # world names whole (never cut), the verdict wraps
+        table.add_column(
+            column, justify=justify, no_wrap=column != "verdict", min_width=longest if column == "world" else None
+        )
     short = {
         "A better": f"{name_a} better",
         "B better": f"{name_b} better",
@@ -176,6 +180,8 @@ def compare(
     folder = out if out is not None else campaign_b / REPORT_DIR / f"compare-{campaign_a.absolute().name}"
     result = compare_report(campaign_a, campaign_b, folder, alpha=alpha, correction=correction.value, pdf=pdf)
     console = make_console()
+    if campaign_a.resolve() == campaign_b.resolve():
+        typer.echo(f"warning: {campaign_a} is compared with itself: every difference is 0", err=True)
     print_differences(console, campaign_differences(campaign_a, campaign_b), str(campaign_a), str(campaign_b))
     comparison = result.comparison
     what = (

@@ -542,7 +542,8 @@ def compare_campaigns(
     values_a = {m: check_metric(a, m, "campaign A") for m in metrics}
     values_b = {m: check_metric(b, m, "campaign B") for m in metrics}
     worlds_a, worlds_b = a["world"].astype(str).to_numpy(), b["world"].astype(str).to_numpy()
-    common = sorted(set(worlds_a) & set(worlds_b))
+    in_b = set(worlds_b)
+    common = [w for w in dict.fromkeys(worlds_a) if w in in_b]  # campaign A's order
     if not common:
         raise ValueError("campaigns A and B have no world in common")
     runs_a, runs_b = a["run"].to_numpy(dtype=np.int64), b["run"].to_numpy(dtype=np.int64)

@@ -114,3 +114,14 @@ def test_csv_round_trip_and_paper_layout() -> None:
     assert list(printed.index) == ["average", "std dev"] and list(printed.columns) == ["a", "b", "c"]
     assert printed.loc["average", "a"] == pytest.approx(2.5)
     assert paper_table(table, "eps_t", population=True).loc["std dev", "a"] == pytest.approx(math.sqrt(1.25))
+
+
+@pytest.mark.parametrize(
+    ("share", "text"),
+    [(0.00019, "0.019 %"), (0.0037, "0.37 %"), (0.05, "5.0 %"), (0.123, "12 %"), (1.5, "150 %"), (0.0, "0 %")],
+)
+def test_a_metric_share_keeps_two_significant_digits(share, text):
+    """A share of 0.019 % must not read 0.0 % in the report while the CLI says 0.019 %."""
+    from slamtrials.report.tables import share_percent
+
+    assert share_percent(share) == text

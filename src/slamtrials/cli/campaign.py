@@ -74,11 +74,13 @@ def _needed_cell(world) -> str:
 
 def metric_share_line(rows) -> str | None:
     """One line: per world, the metric's share of the between-run variance of eps_t / eps_r; None if unknown."""
+    from slamtrials.report.tables import share_percent
+
     parts = []
     for row in rows:
         if row.metric_share_t is None or row.metric_share_r is None:
             continue
-        parts.append(f"{row.world} {100 * row.metric_share_t:.2g} % / {100 * row.metric_share_r:.2g} %")
+        parts.append(f"{row.world} {share_percent(row.metric_share_t)} / {share_percent(row.metric_share_r)}")
     if not parts:
         return None
     return (

@@ -67,7 +67,7 @@ from slamtrials.report.compare import (
 )
 from slamtrials.report.load import CampaignData, load_campaign
 from slamtrials.report.pairing import detect_pairing
-from slamtrials.report.tables import METRICS, NOISE_SHARE_LIMIT, OUTLIER_IQR, paper_table
+from slamtrials.report.tables import METRICS, NOISE_SHARE_LIMIT, OUTLIER_IQR, paper_table, share_percent
 
 __all__ = [
     "build_report",
@@ -183,7 +183,7 @@ def _share(value: Any) -> h.Cell:
     """The metric's share of the between-run variance as a percentage; ``n/a`` when it is not known."""
     if value is None or not math.isfinite(float(value)):
         return h.Cell("n/a", numeric=True, title="no standard errors recorded for these runs, or fewer than 2 runs")
-    return h.Cell(f"{100 * float(value):.{1 if value < 0.1 else 0}f} %", numeric=True)
+    return h.Cell(share_percent(float(value)), numeric=True)
 
 
 def _table_order(data: CampaignData, done: pd.DataFrame) -> list[str]:

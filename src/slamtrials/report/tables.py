@@ -37,6 +37,7 @@ __all__ = [
     "metric_shares",
     "STANDARD_ERRORS",
     "NOISE_SHARE_LIMIT",
+    "share_percent",
 ]
 
 #: The per-run error columns: translational (m) and rotational (rad).
@@ -206,3 +207,15 @@ def metric_shares(runs: pd.DataFrame, metric: str = "eps_t") -> pd.Series:
     names = sorted(set(worlds.tolist()))
     shares = [metric_noise_share(values[worlds == w], errors[worlds == w]) for w in names]
     return pd.Series(shares, index=pd.Index(names, name="world"), dtype="float64", name=f"{metric}_metric_share")
+
+
+def share_percent(share: float) -> str:
+    """A share (0.00019) as a percentage with two significant digits (``0.019 %``), whole percent from
+    10 % up (``12 %``, ``150 %``), so that a small share never reads as ``0.0 %``."""
+    percent = 100.0 * float(share)
+    if percent == 0.0:
+        return "0 %"
+    if abs(percent) >= 10.0:
+        return f"{percent:.0f} %"
+    digits = max(0, 1 - int(np.floor(np.log10(abs(percent)))))
+    return f"{percent:.{digits}f} %"

@@ -329,7 +329,8 @@ def draw_sampling_check(
             label += f" (Shapiro-Wilk p = {stats.shapiro(v).pvalue:.2g})"
         ax.plot(x, stats.norm.pdf(x, mu, sigma), color="tab:red", lw=1.5, label=label, gid="normal_fit")
         fit = (mu, sigma)
-    ax.legend(fontsize=7)
+    # below the axes: inside, the long fit label covers the bars wherever it goes
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)
     return fit
 
 

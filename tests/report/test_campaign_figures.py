@@ -324,3 +324,18 @@ def test_figure_modules_never_use_pyplot() -> None:
                 names = [node.module or ""] if isinstance(node, ast.ImportFrom) else [a.name for a in node.names]
                 assert not any("pyplot" in name or name == "pylab" for name in names)
                 assert not any(alias.name in ("pyplot", "use") for alias in node.names)
+
+
+def test_the_sampling_legend_stays_off_the_histogram():
+    """Fig. 3: the legend (with its long normal-fit label) sits below the axes, not over the bars."""
+    fig = Figure(figsize=(11, 3.8), dpi=100, layout="constrained")
+    canvas = FigureCanvasAgg(fig)
+    axes = fig.subplots(1, 2)
+    for ax in axes:
+        cf.draw_sampling_check(ax, np.random.default_rng(3).normal(0.225, 0.0008, 200))
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    for ax in axes:
+        legend = ax.get_legend().get_window_extent(renderer)
+        assert legend.y1 <= ax.get_window_extent(renderer).y0
+        assert fig.bbox.y0 <= legend.y0  # and inside the figure

@@ -28,7 +28,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -138,8 +138,8 @@ def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bo
     out.mkdir(parents=True, exist_ok=True)
     estimate = result.estimate_per_frame(result.record)
     written = [write_tum(out / "trajectory.tum", result.trajectory)]
-    as_run = replace(result.record, truth=estimate, estimate=estimate)  # first CARMEN triple = the estimate
-    written.append(write_carmen(out / "trajectory.clf", carmen_from_run(as_run)))
+    clf = carmen_from_run(result.record, first_triple=estimate)  # first triple = the estimate; no ground truth
+    written.append(write_carmen(out / "trajectory.clf", clf))
     written.append(
         write_carmen(out / "trajectory.log", carmen_from_trajectory(Trajectory(t=result.record.t, poses=estimate)))
     )

@@ -12,6 +12,8 @@ import pytest
 from typer.testing import CliRunner
 
 from slamtrials.cli.main import app
+from slamtrials.geometry import compose
+from slamtrials.io.carmen import read_carmen
 from slamtrials.io.rosbag import write_rosbag1
 from slamtrials.io.runfolder import read_run, write_run
 from slamtrials.io.tum import read_tum
@@ -92,8 +94,11 @@ def test_carmen_export_and_import(tmp_path, run_folder, compressed):
     assert result.exit_code == 0, result.output
     original, back = read_run(run_folder), read_run(tmp_path / "back")
     np.testing.assert_allclose(back.scans, original.scans, atol=5e-4 + 1e-6)  # CARMEN keeps millimetres
-    np.testing.assert_allclose(back.truth[:, :2], original.truth[:, :2], atol=1e-6)
+    np.testing.assert_allclose(back.truth[:, :2], original.truth[:, :2], atol=1e-6)  # from the TRUEPOS lines
     np.testing.assert_allclose(back.odometry[:, :2], original.odometry[:, :2], atol=1e-6)
+    assert back.laser.mount == original.laser.mount and back.metadata["truth_source"] == "carmen TRUEPOS lines"
+    laser = read_carmen(log).laser  # the first triple: the laser's pose by odometry (mount 0.1 m ahead)
+    np.testing.assert_allclose(laser.pose[:, :2], compose(original.odometry, original.laser.mount)[:, :2], atol=1e-6)
 
 
 def test_outputs_are_not_overwritten_without_overwrite(tmp_path, run_folder):
@@ -149,12 +154,15 @@ def test_recording_without_ground_truth(tmp_path, run_folder):
         == 0
     )
     result = _invoke("export", tmp_path / "robot", "--to", "carmen", "--out", tmp_path / "r.clf")
-    assert result.exit_code == 2 and "ground truth" in result.text
+    assert result.exit_code == 0 and "no ground truth" in result.text, result.output  # as a bag is written
+    assert "TRUEPOS" not in (tmp_path / "r.clf").read_text()
 
 
 def test_option_mistakes_exit_2(tmp_path, run_folder):
     result = _invoke("export", run_folder, "--to", "bag", "--what", "odometry", "--out", tmp_path / "x.bag")
     assert result.exit_code == 2 and "--what" in result.output
+    result = _invoke("export", run_folder, "--to", "bag", "--no-truth", "--out", tmp_path / "x.bag")
+    assert result.exit_code == 2 and "--no-truth applies to --to carmen only" in result.text
     assert _invoke("export", tmp_path / "nothing", "--to", "tum", "--out", tmp_path / "x.tum").exit_code == 2
     (tmp_path / "log.clf").write_text("ODOM 0 0 0 0 0 0 1.0 host 0.0\n")
     result = _invoke("import", tmp_path / "log.clf", "--out", tmp_path / "r", "--scan-topic", "/scan")

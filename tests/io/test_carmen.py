@@ -12,8 +12,9 @@ import numpy as np
 import pytest
 
 from slamtrials.errors import FormatError
+from slamtrials.geometry import compose
 from slamtrials.io.carmen import (
-    TRUTH_SOURCE,
+    TRUTH_SOURCE_TRUEPOS,
     CarmenLaser,
     CarmenLog,
     CarmenOdometry,
@@ -193,8 +194,11 @@ def _record(n: int = 40, beams: int = 541, seed: int = 1) -> RunRecord:
 @pytest.mark.parametrize("kind", ["ROBOTLASER1", "FLASER"])
 def test_run_export_and_import(tmp_path, kind):
     record = _record()
-    write_carmen(tmp_path / "run.clf", carmen_from_run(record, kind=kind))
-    back = run_from_carmen(read_carmen(tmp_path / "run.clf"))
+    write_carmen(tmp_path / "run.clf", carmen_from_run(record, kind=kind, truth=True))
+    log = read_carmen(tmp_path / "run.clf")
+    back = run_from_carmen(log)
+    # the first triple is the laser's pose by odometry; the ground truth comes from the TRUEPOS lines
+    np.testing.assert_array_equal(log.laser.pose, r6(compose(record.odometry, record.laser.mount)))
     np.testing.assert_array_equal(back.t, r6(record.t))
     np.testing.assert_array_equal(back.scans, r3(record.scans))
     np.testing.assert_array_equal(back.truth, r6(record.truth))
@@ -209,7 +213,7 @@ def test_run_export_and_import(tmp_path, kind):
     else:
         assert back.laser.angle_min == pytest.approx(record.laser.angle_min, rel=1e-15)
         assert back.laser.angle_increment == pytest.approx(record.laser.angle_increment, rel=1e-15)
-    assert back.metadata["truth_source"] == TRUTH_SOURCE and back.metadata["carmen_kind"] == kind
+    assert back.metadata["truth_source"] == TRUTH_SOURCE_TRUEPOS and back.metadata["carmen_kind"] == kind
 
 
 def test_export_writes_odometry_velocities(tmp_path):
@@ -264,7 +268,8 @@ def test_other_line_types_are_skipped_and_counted(tmp_path):
         + _flaser(3, 102.0)
     )
     log = read_carmen(path)
-    assert len(log.laser) == 2 and log.skipped == {"RLASER": 2, "TRUEPOS": 1, "SYNC": 1}
+    assert len(log.laser) == 2 and log.skipped == {"RLASER": 2, "SYNC": 1}
+    assert len(log.truepos) == 1  # TRUEPOS lines are read (tests/io/test_carmen_truepos.py)
     np.testing.assert_array_equal(log.laser.pose[0], [1, 2, 0.5])
     np.testing.assert_array_equal(log.laser.odometry[0], [1.1, 2.1, 0.6])
     assert log.laser.logger_t.tolist() == [1.0, 2.0]

@@ -55,6 +55,15 @@ CHANGING_LOG = (  # ROBOTLASER1 beam counts changing on one grid, ODOM lines bet
     "ODOM 1 2 0.1 0 0 0 5.02 host 0.15\n"
     "ROBOTLASER1 0 -0.5 1.25 0.25 30.0 0.01 0 6 1 2 3 4 5 6 0 1.2 2 0.2 1.2 2 0.2 0.1 0 0 0 0 5.2 host 0.3\n"
 )
+TRUEPOS_LOG = (  # an exported simulated run: ground truth in TRUEPOS lines, one written late
+    "PARAM robot_frontlaser_offset 0.1\n"
+    "ODOM 0 0 0 0 0 0 5.0 host 0.0\n"
+    "TRUEPOS 3.5 -2.0 0.5 0 0 0 5.0 host 0.0\n"
+    "ROBOTLASER1 0 -1.5708 3.1416 1.0472 30.0 0.01 0 4 1.0 2.0 3.0 4.0 0 0.1 0 0 0 0 0 0 0 0 0 0 5.0 host 0.0\n"
+    "ODOM 0.1 0 0 1 0 0 5.1 host 0.1\n"
+    "ROBOTLASER1 0 -1.5708 3.1416 1.0472 30.0 0.01 0 4 1.5 2.5 3.5 4.5 0 0.2 0 0 0.1 0 0 1 0 0 0 0 5.1 host 0.1\n"
+    "TRUEPOS 3.59 -1.95 0.5 0.1 0 0 5.1 host 0.1\n"
+)
 TUM_FILE = "# t x y z qx qy qz qw\n1.0 0.5 -0.5 0.0 0.0 0.0 0.3826834323650898 0.9238795325112867\n1.1 0.6 -0.4 0.0 0.0 0.0 0.0 1.0\n"
 RELATIONS_FILE = (
     "1134864645.90321 1134864646.32420 0.31293 0.02935 0.00000  0.00000 0.00000 0.24198\n1 2 0.1 0.2 0 0 0 -0.1\n"
@@ -90,6 +99,7 @@ TOKENS = [
     "ROBOTLASER1",
     "ODOM",
     "PARAM",
+    "TRUEPOS",
     "RLASER",
     "#",
     "b21",
@@ -155,6 +165,8 @@ def _sane_carmen(log: CarmenLog) -> None:
     assert np.all(np.diff(log.odom.t) >= 0) and np.isfinite(log.odom.pose).all()
     assert set(log.tolerated) <= set(TOLERATED) and all(count > 0 for count in log.tolerated.values())
     assert laser.line_readings is not None and laser.line_readings.shape == (len(laser),)
+    truepos = log.truepos
+    assert np.all(np.diff(truepos.t) >= 0) and np.isfinite(truepos.pose).all() and np.isfinite(truepos.odometry).all()
 
 
 def _sane_tum(trajectory: Trajectory) -> None:
@@ -175,7 +187,7 @@ def _sane_carmen_poses(log: CarmenLog) -> None:
     _sane_carmen(log)
 
 
-CARMEN_SEEDS = [FLASER_LOG, ROBOTLASER_LOG, POSE_ONLY_LOG, CHANGING_LOG]
+CARMEN_SEEDS = [FLASER_LOG, ROBOTLASER_LOG, POSE_ONLY_LOG, CHANGING_LOG, TRUEPOS_LOG]
 READERS: dict[str, tuple[Callable, Callable, list[str]]] = {
     "carmen": (read_carmen, _sane_carmen, CARMEN_SEEDS),
     "carmen_poses": (_read_carmen_poses, _sane_carmen_poses, CARMEN_SEEDS),
@@ -231,7 +243,7 @@ def test_mutated_files_raise_only_format_errors(folder, name, seed, data):
 @settings(max_examples=200, deadline=None)
 @given(
     lines=st.lists(st.lists(token, max_size=14), max_size=6),
-    first=st.sampled_from(["", "FLASER", "ROBOTLASER1", "ODOM", "PARAM", "1.0"]),
+    first=st.sampled_from(["", "FLASER", "ROBOTLASER1", "ODOM", "PARAM", "TRUEPOS", "1.0"]),
 )
 def test_random_token_lines_raise_only_format_errors(folder, name, lines, first):
     text = "\n".join(" ".join([first, *tokens]) for tokens in lines)

@@ -58,9 +58,21 @@ def export_run(
     carmen_kind: Annotated[
         str, typer.Option("--carmen-kind", help="For --to carmen: ROBOTLASER1 (geometry on every line) or FLASER.")
     ] = "ROBOTLASER1",
+    no_truth: Annotated[
+        bool,
+        typer.Option(
+            "--no-truth",
+            help="For --to carmen: no TRUEPOS lines, so the log holds no ground truth at all (what a SLAM "
+            "program is given). Default: the ground truth in TRUEPOS lines, so that import gives the run back.",
+        ),
+    ] = False,
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace an existing --out.")] = False,
 ) -> None:
-    """Export a run's laser, odometry and ground truth as a ROS bag (Stage topics), a CARMEN log or a TUM file."""
+    """Export a run's laser, odometry and ground truth as a ROS bag (Stage topics), a CARMEN log or a TUM file.
+
+    A CARMEN log's laser lines hold the laser's pose by odometry (first pose triple) and the odometry of
+    the base (second); the ground truth goes into TRUEPOS lines, or nowhere with --no-truth.
+    """
     from slamtrials.io.runfolder import read_run
     from slamtrials.io.transfer import export_record
 
@@ -68,6 +80,8 @@ def export_run(
         raise ConfigError("--what applies to --to tum only")
     if (time_origin is not None or compress) and to not in (ExportFormat.bag, ExportFormat.bag2):
         raise ConfigError("--time-origin-ns and --compress apply to --to bag and --to bag2 only")
+    if no_truth and to is not ExportFormat.carmen:
+        raise ConfigError("--no-truth applies to --to carmen only")
     if out.exists() and not overwrite:
         raise ConfigError(f"{out}: already exists; choose another --out or pass --overwrite")
     record = read_run(run)
@@ -80,6 +94,7 @@ def export_run(
             time_origin_ns=time_origin,
             compress=compress,
             carmen_kind=carmen_kind,
+            truth=not no_truth,
             overwrite=overwrite,
         )
     except ConfigError as exc:
@@ -111,7 +126,12 @@ def import_run(
         ),
     ] = None,
     no_truth: Annotated[
-        bool, typer.Option("--no-truth", help="Bag: the recording has no ground truth (truth becomes NaN).")
+        bool,
+        typer.Option(
+            "--no-truth",
+            help="The recording has no ground truth: truth becomes NaN (bag: no ground-truth topic; CARMEN: "
+            "TRUEPOS lines ignored and the first pose triple not taken for truth).",
+        ),
     ] = False,
     use_tf: Annotated[
         bool, typer.Option("--use-tf", help="Bag: odometry from the odom -> base_link transforms on /tf.")
@@ -121,7 +141,11 @@ def import_run(
     ] = Pairing.interpolate,
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace a run already stored in --out.")] = False,
 ) -> None:
-    """Import a ROS bag or a CARMEN log as a run folder, so recordings (also of real robots) can be evaluated."""
+    """Import a ROS bag or a CARMEN log as a run folder, so recordings (also of real robots) can be evaluated.
+
+    A CARMEN log's ground truth comes from its TRUEPOS lines; a log without them (a real robot's) gets its
+    laser lines' first pose triple as truth, which is no ground truth (run.json's truth_source says so).
+    """
     from slamtrials.io.runfolder import RunFolder, write_run
     from slamtrials.io.transfer import detect_recording_format, read_carmen_run
 
@@ -146,7 +170,6 @@ def import_run(
             "--scan-topic": scan_topic,
             "--odom-topic": odom_topic,
             "--truth-topic": truth_topic,
-            "--no-truth": no_truth or None,
             "--use-tf": use_tf or None,
         }
         given = [name for name, value in bag_options.items() if value is not None]
@@ -154,13 +177,15 @@ def import_run(
             raise ConfigError(
                 f"{', '.join(given)} appl{'ies' if len(given) == 1 else 'y'} to ROS bags, not to CARMEN logs"
             )
-        record = read_carmen_run(source)
+        record = read_carmen_run(source, truth=not no_truth)
     record.metadata.setdefault("imported_from", str(source))
     write_run(out, record)
     duration = float(record.t[-1] - record.t[0]) if len(record) else 0.0
     truth = "with ground truth" if record.metadata.get("truth_available", True) else "WITHOUT ground truth (NaN)"
-    if kind is ImportFormat.carmen:
-        truth = "truth = the log's first pose triple"
+    if kind is ImportFormat.carmen and "truth_available" not in record.metadata:
+        truth = "truth = the log's first pose triple (no TRUEPOS lines: not ground truth)"
+    elif kind is ImportFormat.carmen and record.metadata["truth_available"]:
+        truth = "with ground truth (TRUEPOS lines)"
     make_console().print(f"{out}: {len(record)} frames x {record.scans.shape[1]} beams, {duration:.1f} s, {truth}")
 
 

@@ -21,6 +21,7 @@ __all__ = [
     "parse_flaser",
     "parse_robotlaser",
     "parse_odom",
+    "parse_truepos",
     "parse_param",
     "param_number",
     "POSES",
@@ -28,6 +29,7 @@ __all__ = [
     "EXTRA",
     "CONFIG",
     "ODOM_FIELDS",
+    "TRUEPOS_FIELDS",
     "STAMP_COLUMNS",
 ]
 
@@ -36,6 +38,7 @@ ROBOT_POSES = ("laser_pose_x", "laser_pose_y", "laser_pose_theta", "robot_pose_x
 EXTRA = ("laser_tv", "laser_rv", "forward_safety_dist", "side_safety_dist", "turn_axis")
 CONFIG = ("start_angle", "field_of_view", "angular_resolution", "maximum_range", "accuracy")
 ODOM_FIELDS = ("x", "y", "theta", "tv", "rv", "accel", "ipc_timestamp", "logger_timestamp")
+TRUEPOS_FIELDS = ("true_x", "true_y", "true_theta", *POSES[3:], "ipc_timestamp", "logger_timestamp")
 
 
 @dataclass(frozen=True, eq=False)
@@ -127,6 +130,26 @@ def parse_odom(path: Path, line: int, tokens: list[str]) -> list[float]:
     return parse_floats(path, line, tokens[1:8], 2, ODOM_FIELDS[:7]) + parse_floats(
         path, line, tokens[9:], 10, "logger_timestamp"
     )
+
+
+def parse_truepos(path: Path, line: int, tokens: list[str]) -> list[float]:
+    """``TRUEPOS true_x true_y true_theta odom_x odom_y odom_theta ipc_timestamp ipc_hostname
+    logger_timestamp`` -> the 8 numbers, every one finite (a simulator's ground truth has no gaps)."""
+    if len(tokens) != 10:
+        raise FormatError(
+            path,
+            "expected 10 fields 'TRUEPOS true_x true_y true_theta odom_x odom_y odom_theta ipc_timestamp "
+            f"ipc_hostname logger_timestamp', got {len(tokens)}",
+            line=line,
+        )
+    values = parse_floats(path, line, tokens[1:8], 2, TRUEPOS_FIELDS[:7]) + parse_floats(
+        path, line, tokens[9:], 10, "logger_timestamp"
+    )
+    for i, (name, value) in enumerate(zip(TRUEPOS_FIELDS, values)):
+        if not math.isfinite(value):
+            field = i + 2 if i < 7 else 10
+            raise FormatError(path, f"TRUEPOS field {field} ({name}) is not finite: {value}", line=line)
+    return values
 
 
 def _is_number(token: str) -> bool:

@@ -1,4 +1,5 @@
-"""The contents of a CARMEN log as arrays: :class:`CarmenLaser`, :class:`CarmenOdometry`, :class:`CarmenLog`.
+"""The contents of a CARMEN log as arrays: :class:`CarmenLaser`, :class:`CarmenOdometry`, :class:`CarmenTruePos`,
+:class:`CarmenLog`.
 
 Plain containers with shape checks, filled by :func:`slamtrials.io.carmen.read_carmen` and written by
 :func:`slamtrials.io.carmen.write_carmen`. Times are float64 seconds, lengths metres, angles radians.
@@ -7,11 +8,12 @@ Plain containers with shape checks, filled by :func:`slamtrials.io.carmen.read_c
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["CarmenLaser", "CarmenOdometry", "CarmenLog", "LASER_KINDS", "ROBOTLASER_EXTRA"]
+__all__ = ["CarmenLaser", "CarmenOdometry", "CarmenTruePos", "CarmenLog", "LASER_KINDS", "ROBOTLASER_EXTRA"]
 
 #: The laser line types slamtrials reads and writes (the front laser, old and new format).
 LASER_KINDS = ("FLASER", "ROBOTLASER1")
@@ -53,9 +55,11 @@ class CarmenLaser:
         float32 ``[N, B]`` ranges (m); beam ``i`` at angle ``angle_min + i * angle_increment`` in the laser
         frame, counter-clockwise.
     pose:
-        float64 ``[N, 3]`` the first pose triple: FLASER ``x y theta``, ROBOTLASER1 ``laser_pose``. In logs
-        of real robots this is the laser pose, often corrected by a SLAM program; in logs slamtrials
-        writes it is the ground-truth pose of the robot base in the world frame.
+        float64 ``[N, 3]`` the first pose triple: FLASER ``x y theta``, ROBOTLASER1 ``laser_pose``: the pose
+        of the laser as the robot knows it. In logs of real robots the laser's odometry pose, often
+        corrected by a SLAM program; in runs slamtrials exports, the odometry of the base composed with
+        the laser mount (odometry frame); in ``trajectory.clf`` of ``slamtrials slam``, the SLAM estimate
+        of the base. Never the ground truth: that is in :class:`CarmenTruePos`.
     odometry:
         float64 ``[N, 3]`` the second pose triple: FLASER ``odom_x odom_y odom_theta``, ROBOTLASER1
         ``robot_pose``: the raw odometry of the robot base.
@@ -71,6 +75,9 @@ class CarmenLaser:
     line_readings:
         int64 ``[N]`` number of readings each line held in the file (set by the reader: the scans may
         have been padded to a common grid, or not read at all), or None (then ``B`` for every line).
+    line_numbers:
+        int64 ``[N]`` the 1-based file line of each laser line (set by the reader, for errors found after
+        reading), or None.
     """
 
     kind: str
@@ -88,6 +95,7 @@ class CarmenLaser:
     remission_mode: int = 0
     extra: NDArray[np.float64] | None = None
     line_readings: NDArray[np.int64] | None = None
+    line_numbers: NDArray[np.int64] | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in LASER_KINDS:
@@ -95,7 +103,7 @@ class CarmenLaser:
         n = len(self.t)
         if np.ndim(self.ranges) != 2 or len(self.ranges) != n:
             raise ValueError(f"CarmenLaser.ranges has shape {np.shape(self.ranges)}, expected [{n}, B]")
-        shapes = {
+        shapes: dict[str, tuple[NDArray, tuple[int, ...]]] = {
             "t": (self.t, (n,)),
             "logger_t": (self.logger_t, (n,)),
             "pose": (self.pose, (n, 3)),
@@ -105,6 +113,8 @@ class CarmenLaser:
             shapes["extra"] = (self.extra, (n, len(ROBOTLASER_EXTRA)))
         if self.line_readings is not None:
             shapes["line_readings"] = (self.line_readings, (n,))
+        if self.line_numbers is not None:
+            shapes["line_numbers"] = (self.line_numbers, (n,))
         _check("CarmenLaser", shapes)
         _check_host("CarmenLaser", self.hostname, n)
 
@@ -184,6 +194,64 @@ class CarmenOdometry:
 
 
 @dataclass(eq=False)
+class CarmenTruePos:
+    """The ``TRUEPOS`` lines of a log, stacked in timestamp order (``M`` may be 0): a simulator's ground truth.
+
+    CARMEN's simulator publishes the robot's true pose with its odometry pose, and CARMEN's logger writes
+    them as ``TRUEPOS true_x true_y true_theta odom_x odom_y odom_theta ipc_timestamp ipc_hostname
+    logger_timestamp``; slamtrials writes one per frame of a run exported with its ground truth.
+
+    Attributes
+    ----------
+    t:
+        float64 ``[M]`` ``ipc_timestamp`` (s), non-decreasing.
+    logger_t:
+        float64 ``[M]`` ``logger_timestamp`` (s).
+    hostname:
+        ``ipc_hostname``: one string for every line, or a list of ``M`` strings.
+    pose:
+        float64 ``[M, 3]`` ``true_x true_y true_theta``: the ground-truth pose of the robot base in the
+        world frame (m, m, rad).
+    odometry:
+        float64 ``[M, 3]`` ``odom_x odom_y odom_theta``: the odometry of the base (odometry frame).
+    line_numbers:
+        int64 ``[M]`` the 1-based file line of each TRUEPOS line (set by the reader), or None.
+    """
+
+    t: NDArray[np.float64]
+    logger_t: NDArray[np.float64]
+    hostname: str | list[str]
+    pose: NDArray[np.float64]
+    odometry: NDArray[np.float64]
+    line_numbers: NDArray[np.int64] | None = None
+
+    def __post_init__(self) -> None:
+        m = len(self.t)
+        shapes: dict[str, tuple[NDArray, tuple[int, ...]]] = {
+            "t": (self.t, (m,)),
+            "logger_t": (self.logger_t, (m,)),
+            "pose": (self.pose, (m, 3)),
+            "odometry": (self.odometry, (m, 3)),
+        }
+        if self.line_numbers is not None:
+            shapes["line_numbers"] = (self.line_numbers, (m,))
+        _check("CarmenTruePos", shapes)
+        _check_host("CarmenTruePos", self.hostname, m)
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    @classmethod
+    def empty(cls) -> CarmenTruePos:
+        """A log without TRUEPOS lines."""
+        return cls(t=np.zeros(0), logger_t=np.zeros(0), hostname=[], pose=np.zeros((0, 3)), odometry=np.zeros((0, 3)))
+
+    def hostnames(self) -> list[str]:
+        """The ``ipc_hostname`` of every line, a list of ``M`` strings."""
+        return _hostnames(self.hostname, len(self))
+
+
+@dataclass(eq=False)
 class CarmenLog:
     """What slamtrials reads from and writes to a CARMEN log.
 
@@ -196,13 +264,21 @@ class CarmenLog:
     params:
         ``PARAM`` lines, name -> value as written (a later line overrides an earlier one).
     skipped:
-        Line types read past without being interpreted (e.g. ``RLASER``, ``RAWLASER1``, ``TRUEPOS``,
-        ``SYNC``, and ``FLASER`` in a log that also holds ``ROBOTLASER1`` lines, which are read instead)
-        -> number of such lines. Never written back.
+        Line types read past without being interpreted (e.g. ``RLASER``, ``RAWLASER1``, ``SYNC``, and
+        ``FLASER`` in a log that also holds ``ROBOTLASER1`` lines, which are read instead) -> number of
+        such lines. Never written back.
     tolerated:
         Oddities the reader tolerated -> number of lines (keys and meanings in
         :data:`slamtrials.io.carmen_read.TOLERATED`: lines with non-finite poses skipped, timestamps
         reordered, a truncated last line, scans padded, ...). Never written back.
+    truepos:
+        The TRUEPOS lines (possibly none): the ground truth of a simulated run.
+    comments:
+        Lines written as ``# ...`` comments after the format header (without the ``#``): what the pose
+        triples of this log hold. Not read back (the reader ignores comments).
+    path:
+        The file the log was read from (set by the reader), named by errors found after reading; None
+        for a log built in memory.
     """
 
     laser: CarmenLaser
@@ -210,3 +286,6 @@ class CarmenLog:
     params: dict[str, str] = field(default_factory=dict)
     skipped: dict[str, int] = field(default_factory=dict)
     tolerated: dict[str, int] = field(default_factory=dict)
+    truepos: CarmenTruePos = field(default_factory=CarmenTruePos.empty)
+    comments: tuple[str, ...] = ()
+    path: Path | None = None

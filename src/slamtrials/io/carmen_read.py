@@ -13,7 +13,14 @@ oddity is counted in :attr:`CarmenLog.tolerated` and logged once, as one warning
   angular grid, padded with no-return readings (:mod:`slamtrials.io.carmen_grid`), or refused at the
   first line on another grid. ``read_carmen(path, ranges=False)`` reads only the poses, whatever the
   readings (what evaluation needs);
-* PARAM lines with any trailing fields (a numeric PARAM is its value's first token).
+* PARAM lines with any trailing fields (a numeric PARAM is its value's first token);
+* TRUEPOS lines whose timestamps go backwards: ordered by timestamp (stable).
+
+``TRUEPOS`` lines (the ground truth CARMEN's simulator logs, and slamtrials writes for a run exported
+with its ground truth) are read into :attr:`CarmenLog.truepos`; a broken one, or one with a non-finite
+number, is a FormatError naming its line. :func:`truth_at_laser` gives each laser line its TRUEPOS pose
+(same timestamp, else the nearest within :data:`TRUEPOS_TOLERANCE`), or a FormatError naming the first
+laser line without one.
 
 A log holding both FLASER and ROBOTLASER1 lines (CARMEN's logger can write the front laser in the old
 format and its ``robot_laser`` message of the same scans in the new one) is read as ONE stream, the
@@ -53,12 +60,14 @@ from slamtrials.io.carmen_lines import (
     parse_odom,
     parse_param,
     parse_robotlaser,
+    parse_truepos,
 )
-from slamtrials.io.carmen_log import LASER_KINDS, CarmenLaser, CarmenLog, CarmenOdometry
+from slamtrials.io.carmen_log import LASER_KINDS, CarmenLaser, CarmenLog, CarmenOdometry, CarmenTruePos
 from slamtrials.io.textfile import data_lines, first_bad_row, last_line, read_lines
 
 __all__ = [
     "read_carmen",
+    "truth_at_laser",
     "PARAM_RANGE_MAX",
     "PARAM_FOV",
     "PARAM_RESOLUTION",
@@ -66,6 +75,7 @@ __all__ = [
     "PARAM_RANGE_MIN",
     "PREFERRED_KIND",
     "SAME_SCAN_TOLERANCE",
+    "TRUEPOS_TOLERANCE",
     "TOLERATED",
 ]
 
@@ -86,6 +96,8 @@ PARAM_RANGE_MIN = "slamtrials_laser_range_min"
 PREFERRED_KIND = "ROBOTLASER1"
 #: Two laser lines of the two kinds whose ipc timestamps differ by at most this (s) are the same scan.
 SAME_SCAN_TOLERANCE = 1e-3
+#: A laser line takes the pose of the TRUEPOS line at its ipc timestamp, else of the nearest within this (s).
+TRUEPOS_TOLERANCE = 1e-3
 
 #: Keys of :attr:`CarmenLog.tolerated` -> what the warning says about the lines counted ({kind}: the
 #: line type).
@@ -100,6 +112,7 @@ TOLERATED = {
     "odom_against_velocity": "ODOM lines move the pose forward while their velocity tv is below "
     f"-{0.05:g} m/s (a reversing robot logged as driving forward?): the odometry's translation has the "
     "wrong sign there; SLAM that trusts it can fail (docs/real-datasets.md, fr079)",
+    "truepos_reordered": "TRUEPOS lines with a timestamp earlier than a line before them: TRUEPOS lines ordered by timestamp (stable)",
     "truncated_last_line": "the last line is cut short (no newline at the end of the file): skipped",
 }
 #: ``tv`` (m/s) below which an ODOM step counts as reversing, and the forward motion (m) that contradicts it.
@@ -189,9 +202,10 @@ def read_carmen(path: str | Path, *, ranges: bool = True) -> CarmenLog:
     A log holding both FLASER and ROBOTLASER1 lines is read as one stream, its ROBOTLASER1 lines (exact
     geometry on every line): the FLASER lines are parsed, then skipped, counted in
     :attr:`CarmenLog.skipped` and reported in one warning line with how many of their timestamps match a
-    ROBOTLASER1 line (module docstring: why, and what CARMEN's own tools do). Other line types
-    (``RLASER``, ``ROBOTLASER2``, ``RAWLASER1``, ``TRUEPOS``, ``SYNC``, ...) are skipped unparsed and
-    counted in :attr:`CarmenLog.skipped`; ``#`` lines and blank lines are ignored. What is
+    ROBOTLASER1 line (module docstring: why, and what CARMEN's own tools do). TRUEPOS lines (ground truth)
+    are read into :attr:`CarmenLog.truepos`, in timestamp order; :func:`truth_at_laser` pairs them with the
+    laser lines. Other line types (``RLASER``, ``ROBOTLASER2``, ``RAWLASER1``, ``SYNC``, ...) are skipped
+    unparsed and counted in :attr:`CarmenLog.skipped`; ``#`` lines and blank lines are ignored. What is
     tolerated (and counted in :attr:`CarmenLog.tolerated`, and logged once per kind) is listed in the
     module docstring.
 
@@ -213,16 +227,18 @@ def read_carmen(path: str | Path, *, ranges: bool = True) -> CarmenLog:
         ``robot_front_laser_max`` (m), else 180 degrees spread over the beams; the first beam at -90
         degrees as CARMEN's reader puts it (centred on the heading when a ``laser_front_laser_fov`` PARAM
         gives the field of view), and the largest range in the log as ``range_max`` (0 without readings).
-        The odometry of a frame is its laser line's own second pose triple; ODOM lines are returned
-        separately, not merged into the frames.
+        The odometry of a frame is its laser line's own second pose triple; ODOM and TRUEPOS lines are
+        returned separately, not merged into the frames. ``path`` and the laser lines' ``line_numbers``
+        are set, for errors found later.
 
     Raises
     ------
     FormatError
         Naming the file and line: a wrong field count (``num_readings`` disagreeing with the fields), a
         field that is not a number (in the lines of both front-laser kinds, the skipped one too), a
-        reading that is negative or not finite, lines whose beams are not on one angular grid (with
-        ``ranges``), a non-positive ROBOTLASER1 maximum range, or no usable laser line at all.
+        reading that is negative or not finite, a TRUEPOS number that is not finite, lines whose beams
+        are not on one angular grid (with ``ranges``), a non-positive ROBOTLASER1 maximum range, or no
+        usable laser line at all.
     """
     path = Path(path)
     lines = read_lines(path)
@@ -235,6 +251,9 @@ def read_carmen(path: str | Path, *, ranges: bool = True) -> CarmenLog:
     odom_rows: list[list[float]] = []
     odom_numbers: list[int] = []
     odom_hosts: list[str] = []
+    truepos_rows: list[list[float]] = []
+    truepos_numbers: list[int] = []
+    truepos_hosts: list[str] = []
     params: dict[str, str] = {}
     param_lines: dict[str, int] = {}
     skipped: Counter[str] = Counter()
@@ -252,6 +271,10 @@ def read_carmen(path: str | Path, *, ranges: bool = True) -> CarmenLog:
                 odom_rows.append(parse_odom(path, number, tokens))
                 odom_numbers.append(number)
                 odom_hosts.append(tokens[8])
+            elif name == "TRUEPOS":
+                truepos_rows.append(parse_truepos(path, number, tokens))
+                truepos_numbers.append(number)
+                truepos_hosts.append(tokens[8])
             elif name == "PARAM":
                 key, value = parse_param(path, number, tokens)
                 params[key] = value
@@ -285,6 +308,7 @@ def read_carmen(path: str | Path, *, ranges: bool = True) -> CarmenLog:
         ranges,
     )
     odom = _odometry(path, odom_rows, odom_numbers, odom_hosts, tally)
+    truepos = _truepos(truepos_rows, truepos_numbers, truepos_hosts, tally)
     tally.warn(
         kind,
         {
@@ -296,7 +320,15 @@ def read_carmen(path: str | Path, *, ranges: bool = True) -> CarmenLog:
         if other != kind:
             skipped[other] = len(laser_numbers[other])
             _warn_other_stream(path, laser, laser_lines[kind], other, laser_lines[other], laser_numbers[other])
-    return CarmenLog(laser=laser, odom=odom, params=params, skipped=dict(skipped), tolerated=dict(tally.counts))
+    return CarmenLog(
+        laser=laser,
+        odom=odom,
+        params=params,
+        skipped=dict(skipped),
+        tolerated=dict(tally.counts),
+        truepos=truepos,
+        path=path,
+    )
 
 
 def _same_scans(t: NDArray[np.float64], other: NDArray[np.float64]) -> int:
@@ -436,6 +468,7 @@ def _laser(
         remission_mode=integers[1],
         extra=rows[:, 6 : 6 + len(EXTRA)].copy() if kind == "ROBOTLASER1" else None,
         line_readings=np.array([len(r) for r in readings], dtype=np.int64),
+        line_numbers=np.asarray(kept_numbers, dtype=np.int64),
     )
 
 
@@ -471,3 +504,65 @@ def _odometry(
         rv=values[:, 4].copy(),
         accel=values[:, 5].copy(),
     )
+
+
+def _truepos(rows: list[list[float]], numbers_list: list[int], hosts: list[str], tally: _Tally) -> CarmenTruePos:
+    """The TRUEPOS lines (every number finite, checked when parsed) in timestamp order (stable)."""
+    if not rows:
+        return CarmenTruePos.empty()
+    values = np.array(rows, dtype=np.float64)
+    numbers = np.asarray(numbers_list, dtype=np.int64)
+    order = _order(values[:, 6], numbers, tally, "truepos", unique=False)
+    values = values[order]
+    return CarmenTruePos(
+        t=values[:, 6].copy(),
+        logger_t=values[:, 7].copy(),
+        hostname=_one_or_all([hosts[i] for i in order.tolist()]),
+        pose=values[:, :3].copy(),
+        odometry=values[:, 3:6].copy(),
+        line_numbers=numbers[order].copy(),
+    )
+
+
+def _nearest(t: NDArray[np.float64], at: NDArray[np.float64]) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """Index into the sorted ``t`` of the time nearest each of ``at`` (the first of equal times, the earlier
+    on a tie) and its distance (s)."""
+    after = np.clip(np.searchsorted(t, at, side="left"), 0, len(t) - 1)
+    before = np.searchsorted(t, t[np.clip(after - 1, 0, len(t) - 1)], side="left")
+    gap_before, gap_after = np.abs(at - t[before]), np.abs(t[after] - at)
+    pick = np.where((gap_before <= gap_after) & (t[before] != t[after]), before, after)
+    return pick, np.minimum(gap_before, gap_after)
+
+
+def truth_at_laser(log: CarmenLog) -> NDArray[np.float64]:
+    """The ground truth at every laser line from the log's TRUEPOS lines: float64 ``[N, 3]`` (m, m, rad).
+
+    Each laser line takes the true pose (``true_x true_y true_theta``, the robot base in the world frame)
+    of the TRUEPOS line at its ``ipc_timestamp``, or of the nearest one within :data:`TRUEPOS_TOLERANCE`
+    (the first in time of equal timestamps, the earlier of two equally near).
+
+    Raises
+    ------
+    FormatError
+        The log has no TRUEPOS lines, or a laser line has none within the tolerance: the error names the
+        file (:attr:`CarmenLog.path`) and that laser line (the first such).
+    """
+    laser, truepos = log.laser, log.truepos
+    path = log.path if log.path is not None else Path("<CARMEN log>")
+    if len(truepos) == 0:
+        raise FormatError(path, "no TRUEPOS line: the log holds no ground truth")
+    pick, gap = _nearest(truepos.t, laser.t)
+    missing = np.flatnonzero(~(gap <= TRUEPOS_TOLERANCE))
+    if missing.size:
+        i = int(missing[0])
+        line = int(laser.line_numbers[i]) if laser.line_numbers is not None else None
+        raise FormatError(
+            path,
+            f"the TRUEPOS lines do not cover the {laser.kind} lines: this one (ipc_timestamp {laser.t[i]:.6f}) "
+            f"has no TRUEPOS line within {TRUEPOS_TOLERANCE * 1e3:g} ms (the nearest is {gap[i]:.6g} s away; "
+            f"{len(truepos)} TRUEPOS lines from {truepos.t[0]:.6f} to {truepos.t[-1]:.6f} s, "
+            f"{missing.size} of {len(laser)} laser lines without one); read it without ground truth "
+            "(import --no-truth) to ignore them",
+            line=line,
+        )
+    return truepos.pose[pick].copy()

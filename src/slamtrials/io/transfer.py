@@ -1,8 +1,9 @@
 """Moving a run between the run folder and other formats: the library behind ``export`` and ``import``.
 
 Export writes a :class:`~slamtrials.record.RunRecord` as a ROS 1 bag, a ROS 2 bag (MCAP), a CARMEN log
-(first pose triple = ground truth, second = odometry) or a TUM trajectory. Import reads a ROS bag or a
-CARMEN log (plain, gzip or bzip2) back into a record. Functions return a one-line description of what they
+(first pose triple = the laser's pose by odometry, second = the odometry of the base, ground truth in
+TRUEPOS lines unless asked for none) or a TUM trajectory. Import reads a ROS bag or a CARMEN log (plain,
+gzip or bzip2) back into a record. Functions return a one-line description of what they
 did for the caller to show; they never print.
 """
 
@@ -47,6 +48,7 @@ def export_record(
     time_origin_ns: int | None = None,
     compress: bool = False,
     carmen_kind: str = "ROBOTLASER1",
+    truth: bool = True,
     overwrite: bool = False,
 ) -> str:
     """Write ``record`` to ``out`` in format ``to`` (one of :data:`EXPORT_FORMATS`); return a description.
@@ -60,12 +62,17 @@ def export_record(
         For bags: the ROS stamp of t = 0 (default 1 s) and LZ4 (ROS 1) or zstd (ROS 2) chunks.
     carmen_kind:
         For ``carmen``: ``"ROBOTLASER1"`` or ``"FLASER"``.
+    truth:
+        For ``carmen``: write the ground truth as TRUEPOS lines (default, so that import gives the run
+        back; a run without ground truth at any frame is written without them, as a bag is written
+        without ``/base_pose_ground_truth``). False writes a log holding no ground truth at all, what a
+        SLAM program is given.
 
     Raises
     ------
     ConfigError
         An unknown format or option, an existing ``out`` without ``overwrite``, or a record the format
-        cannot hold (no ground truth for a CARMEN log).
+        cannot hold (TRUEPOS lines for a run with ground truth at some frames only).
     """
     out = Path(out)
     if to not in EXPORT_FORMATS:
@@ -80,23 +87,34 @@ def export_record(
             _remove(out)
         origin = DEFAULT_TIME_ORIGIN_NS if time_origin_ns is None else time_origin_ns
         write_bag(out, record, ros=ros, time_origin_ns=origin, overwrite=overwrite, compress=compress)
-        truth = "with" if np.isfinite(record.truth).all(axis=1).any() else "without"
-        return f"{out}: ROS {ros} bag, {len(record)} scans on /base_scan, /odom, /tf, {truth} /base_pose_ground_truth"
+        held = "with" if np.isfinite(record.truth).all(axis=1).any() else "without"
+        return f"{out}: ROS {ros} bag, {len(record)} scans on /base_scan, /odom, /tf, {held} /base_pose_ground_truth"
     if to == "carmen":
-        from slamtrials.io.carmen import carmen_from_run, write_carmen
-
-        if carmen_kind not in ("ROBOTLASER1", "FLASER"):
-            raise ConfigError(f"CARMEN line kind must be ROBOTLASER1 or FLASER, got {carmen_kind!r}")
-        if not np.isfinite(record.truth).all():
-            raise ConfigError(
-                "the run has no ground truth for every frame; a CARMEN laser line needs it (first pose triple)"
-            )
-        try:
-            write_carmen(out, carmen_from_run(record, kind=carmen_kind))
-        except ValueError as exc:
-            raise ConfigError(f"the run cannot be written as a CARMEN log: {exc}") from None
-        return f"{out}: CARMEN log, {len(record)} {carmen_kind} and ODOM lines (first pose = ground truth, second = odometry)"
+        return _export_carmen(record, out, carmen_kind, truth)
     return _export_tum(record, out, tum_source)
+
+
+def _export_carmen(record: RunRecord, out: Path, kind: str, truth: bool) -> str:
+    from slamtrials.io.carmen import carmen_from_run, write_carmen
+
+    if kind not in ("ROBOTLASER1", "FLASER"):
+        raise ConfigError(f"CARMEN line kind must be ROBOTLASER1 or FLASER, got {kind!r}")
+    known = np.isfinite(record.truth).all(axis=1)
+    if truth and known.any() and not known.all():
+        raise ConfigError(
+            f"the run has ground truth for {np.count_nonzero(known)} of {len(record)} frames; TRUEPOS lines need it "
+            "for every laser line: pass --no-truth to write the log without ground truth"
+        )
+    with_truth = truth and bool(known.all())
+    try:
+        write_carmen(out, carmen_from_run(record, kind=kind, truth=with_truth))
+    except ValueError as exc:
+        raise ConfigError(f"the run cannot be written as a CARMEN log: {exc}") from None
+    held = "TRUEPOS lines with the ground truth" if with_truth else "no ground truth"
+    return (
+        f"{out}: CARMEN log, {len(record)} {kind} and ODOM lines (first pose = laser pose by odometry, "
+        f"second = odometry), {held}"
+    )
 
 
 def _export_tum(record: RunRecord, out: Path, source: str) -> str:
@@ -131,14 +149,18 @@ def detect_recording_format(path: str | Path) -> str:
     return "bag" if head.startswith((b"#ROSBAG", b"\x89MCAP")) else "carmen"
 
 
-def read_carmen_run(path: str | Path) -> RunRecord:
-    """A CARMEN log (plain, gzip- or bzip2-compressed) as a run record (truth = first pose triple).
+def read_carmen_run(path: str | Path, *, truth: bool = True) -> RunRecord:
+    """A CARMEN log (plain, gzip- or bzip2-compressed) as a run record.
+
+    ``truth`` (:func:`~slamtrials.io.carmen.run_from_carmen`): the log's TRUEPOS lines, else its first pose
+    triple, as ``metadata["truth_source"]`` says; with ``truth=False`` none (NaN).
 
     Raises
     ------
     FormatError
-        The log does not parse, or its laser lines hold no readings (a pose-only trajectory, which
-        ``slamtrials evaluate`` reads but which has nothing to map or replay).
+        The log does not parse, its laser lines hold no readings (a pose-only trajectory, which
+        ``slamtrials evaluate`` reads but which has nothing to map or replay), or (with ``truth``) its
+        TRUEPOS lines do not cover its laser lines.
     """
     from slamtrials.io.carmen import read_carmen, run_from_carmen
 
@@ -150,6 +172,6 @@ def read_carmen_run(path: str | Path) -> RunRecord:
             "replay; evaluate it with slamtrials evaluate --estimate",
         )
     try:
-        return run_from_carmen(log)
+        return run_from_carmen(log, truth=truth)
     except ValueError as exc:  # a geometry LaserGeometry refuses (one beam, a clockwise scan, no positive range)
         raise FormatError(path, f"its {log.laser.kind} laser geometry cannot be used: {exc}") from None

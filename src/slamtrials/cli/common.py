@@ -46,7 +46,7 @@ class ErrorReportingGroup(TyperGroup):
 
     def get_command(self, ctx, cmd_name):
         command = super().get_command(ctx, cmd_name)
-        if command is not None:
+        if command is not None and ctx is not None:  # the reference walks the tree without a context
             _flags_as_flags(command.get_params(ctx))
         return command
 

@@ -290,7 +290,7 @@ def test_runs_are_paired_by_index_and_the_rest_left_out() -> None:
     assert t.loc["w", "p"] == pytest.approx(stats.ttest_rel([5.1, 3.2, 2.1], [5.0, 3.0, 2.0]).pvalue)
     assert t.loc["v", "verdict"] == TOO_FEW and t.loc["v", "n_a"] == 0  # no run in common
     notes = comparison_notes(c)
-    assert any("left out of the paired tests: v 1 of A, 1 of B; w 2 of A, 1 of B" in n for n in notes)
+    assert any("left out of the paired tests: w 2 of A, 1 of B; v 1 of A, 1 of B" in n for n in notes)
     twice = _runs({"w": np.array([1.0, 2.0])}, {"w": [3, 3]})
     with pytest.raises(ValueError, match="run 3 twice"):
         compare_campaigns(twice, b, paired_by="test")

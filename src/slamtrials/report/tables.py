@@ -211,10 +211,13 @@ def metric_shares(runs: pd.DataFrame, metric: str = "eps_t") -> pd.Series:
 
 def share_percent(share: float) -> str:
     """A share (0.00019) as a percentage with two significant digits (``0.019 %``), whole percent from
-    10 % up (``12 %``, ``150 %``), so that a small share never reads as ``0.0 %``."""
+    10 % up (``12 %``, ``150 %``), ``< 0.001 %`` below that, so that a small share never reads as
+    ``0.0 %``."""
     percent = 100.0 * float(share)
     if percent == 0.0:
         return "0 %"
+    if abs(percent) < 0.001:
+        return "< 0.001 %"
     if abs(percent) >= 10.0:
         return f"{percent:.0f} %"
     digits = max(0, 1 - int(np.floor(np.log10(abs(percent)))))

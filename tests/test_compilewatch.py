@@ -72,6 +72,7 @@ def _cli(*args: str, cache) -> tuple[int, str, str]:
     return done.returncode, done.stdout, stderr.decode().replace("\r\n", "\n")
 
 
+@pytest.mark.slow
 def test_a_command_says_once_that_it_compiles_and_not_when_the_cache_has_the_kernels(tmp_path):
     cache = tmp_path / "numba-cache"  # empty: every kernel the command needs is compiled
     status, stdout, stderr = _cli("worlds", "info", "office_small_01", cache=cache)

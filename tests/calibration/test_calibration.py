@@ -60,6 +60,7 @@ def fitted(simulated):
     return calibrate(record, reference, CalibrationSettings(bootstrap=30), seed=1)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", [*LASER, *ODOMETRY])
 def test_fit_recovers_each_known_value_within_its_stated_uncertainty(fitted, name):
     value = fitted.value(name)
@@ -79,6 +80,7 @@ def test_fit_recovers_each_known_value_within_its_stated_uncertainty(fitted, nam
     assert 0.0 < value.stderr < 0.25 * abs(truth), value
 
 
+@pytest.mark.slow
 def test_without_edge_readings_the_fit_finds_next_to_none(fitted):
     # the short readings that land at a nearer wall are expected by the short-reading model and taken off
     edge = fitted.value("edge_chance")
@@ -87,6 +89,7 @@ def test_without_edge_readings_the_fit_finds_next_to_none(fitted):
     assert fitted.profile("p", "").laser["edge_reach"] == EDGE_REACH
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("chance", [0.25])
 def test_edge_chance_is_recovered_and_its_readings_are_not_counted_short(chance):
     world = load_world("office_small_01")
@@ -102,6 +105,7 @@ def test_edge_chance_is_recovered_and_its_readings_are_not_counted_short(chance)
     assert 0.95 * 0.1 - 2.0 * short.stderr <= short.value <= 0.1 + 2.0 * short.stderr, short
 
 
+@pytest.mark.slow
 def test_fit_reports_the_residual_figures_of_the_simulated_laser(fitted):
     laser = fitted.laser
     assert laser.beams > 100_000
@@ -113,6 +117,7 @@ def test_fit_reports_the_residual_figures_of_the_simulated_laser(fitted):
     assert fitted.odometry.reference_linear < 1e-4 and fitted.odometry.reference_angular < 1e-4
 
 
+@pytest.mark.slow
 def test_profile_holds_the_fit_with_symmetric_bias_ranges_and_round_trips(fitted, tmp_path):
     profile = fitted.profile("sim-test", "fitted to a simulated tour")
     lin, ang = abs(fitted.value("bias_linear").value), abs(fitted.value("bias_angular").value)
@@ -197,6 +202,7 @@ def _reversed_spans(record, spans):
     return flipped
 
 
+@pytest.mark.slow
 def test_odometry_that_moves_against_the_reference_is_left_out_not_fitted_as_noise(simulated, fitted):
     _, record = simulated
     spans = [(int(a), int(a) + 25) for a in np.linspace(50, len(record) - 80, 6)]
@@ -222,6 +228,7 @@ def test_odometry_that_moves_against_the_reference_is_left_out_not_fitted_as_noi
     )
 
 
+@pytest.mark.slow
 def test_long_readings_are_counted_apart_and_none_come_from_the_simulated_laser(fitted):
     # the simulated laser reads short (objects not in the map) but never past a wall, and here the
     # reference is the truth: beyond the cut there are short readings and, tails taken out, no long ones

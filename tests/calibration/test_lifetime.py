@@ -31,6 +31,7 @@ def _fit(lifetime: float, fleeting: float):
     return fit_lifetime(record, reference, fit, SETTINGS, seed=1)
 
 
+@pytest.mark.slow
 def test_the_lifetime_and_the_fleeting_share_are_read_back_within_their_stated_uncertainty():
     fit = _fit(4.0, 0.5)
     assert fit is not None and fit.short_readings > 5000
@@ -44,6 +45,7 @@ def test_the_lifetime_and_the_fleeting_share_are_read_back_within_their_stated_u
     assert fit.model[0, -1, -1] > fit.model[0, 1, -1]
 
 
+@pytest.mark.slow
 def test_short_readings_drawn_anew_for_every_scan_fit_no_lifetime():
     fit = _fit(0.0, 0.0)
     assert fit is not None

@@ -45,6 +45,7 @@ def _one_line_error(result, *words):
         assert word in lines[0], lines[0]
 
 
+@pytest.mark.slow
 def test_calibrate_writes_a_valid_profile_and_a_page_of_figures(record, tmp_path):
     log = write_carmen(tmp_path / "office.clf", carmen_from_run(record))
     out = tmp_path / "profiles" / "office.yaml"
@@ -159,6 +160,7 @@ def _relations_file(record, path, shift: float = 0.0):
     return write_relations(path, Relations(t1=rel.t1 + shift, t2=rel.t2 + shift, delta=rel.delta))
 
 
+@pytest.mark.slow
 def test_calibrate_fits_the_odometry_against_the_logs_relations_and_says_so(record, tmp_path):
     log = write_carmen(tmp_path / "office.clf", carmen_from_run(record))
     relations = _relations_file(record, tmp_path / "office.relations")

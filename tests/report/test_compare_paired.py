@@ -97,6 +97,7 @@ def test_pairing_removes_the_shared_variation_that_welch_keeps() -> None:
 # ---------------------------------------------------------------------------------- sizes and coverage
 
 
+@pytest.mark.slow
 def test_paired_test_rejects_alpha_of_the_time_under_no_difference() -> None:
     rng = np.random.default_rng(2026)
     reps, n, alpha = 4000, 10, 0.05

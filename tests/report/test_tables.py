@@ -118,7 +118,15 @@ def test_csv_round_trip_and_paper_layout() -> None:
 
 @pytest.mark.parametrize(
     ("share", "text"),
-    [(0.00019, "0.019 %"), (0.0037, "0.37 %"), (0.05, "5.0 %"), (0.123, "12 %"), (1.5, "150 %"), (0.0, "0 %"), (8.9e-38, "< 0.001 %")],
+    [
+        (0.00019, "0.019 %"),
+        (0.0037, "0.37 %"),
+        (0.05, "5.0 %"),
+        (0.123, "12 %"),
+        (1.5, "150 %"),
+        (0.0, "0 %"),
+        (8.9e-38, "< 0.001 %"),
+    ],
 )
 def test_a_metric_share_keeps_two_significant_digits(share, text):
     """A share of 0.019 % must not read 0.0 % in the report while the CLI says 0.019 %."""

@@ -113,6 +113,7 @@ def _arcs(poses: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     ],
     ids=["per-metre", "per-radian"],
 )
+@pytest.mark.slow
 def test_error_growth_per_metre_and_per_radian_does_not_depend_on_the_stamps(coefficients):
     profile = ErrorProfile(
         name="odometry-noise",

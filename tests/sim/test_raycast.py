@@ -95,6 +95,7 @@ def test_open_grid_rays_stop_at_the_image_border():
     np.testing.assert_allclose(ranges, expected, atol=1e-4, rtol=0)
 
 
+@pytest.mark.slow
 def test_beams_into_open_space_read_exactly_max_range_inside_and_inf_as_a_reading():
     # A 200 m x 200 m empty room; from its centre, nothing is within 80 m.
     world = room_world(size_m=200.0)

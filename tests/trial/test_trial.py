@@ -101,6 +101,7 @@ def test_mapped_fraction_counts_known_cells_of_the_true_free_space(record, world
     assert mapped_fraction(world, blank, record.estimate[0], record.truth[0]) == 0.0
 
 
+@pytest.mark.slow
 def test_same_seed_same_trial_bit_for_bit(record, world, config):
     progress = []
     again = run_trial(world, config, seed=4, on_progress=progress.append, progress_period=5.0)
@@ -133,6 +134,7 @@ def test_the_run_folder_keeps_estimate_and_map(record, tmp_path):
     assert (tmp_path / "run" / "estimate.tum").is_file() and (tmp_path / "run" / "map.png").is_file()
 
 
+@pytest.mark.slow
 def test_slam_over_the_run_folder_with_the_trial_seed_gives_the_trial_estimate(record, tmp_path):
     from typer.testing import CliRunner
 

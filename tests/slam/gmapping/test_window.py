@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from numba import njit
@@ -63,6 +64,7 @@ def test_random_windows_equal_the_scalar_loop_exactly():
     st.floats(-0.2, 0.2),
     st.sampled_from([0.01, 0.05, 0.1]),
 )
+@pytest.mark.slow
 def test_any_window_equals_the_scalar_loop(values, ox, oy, res):
     """Any cell contents (including ties and empty cells) and endpoint offsets: identical results."""
     mean = np.array(values, dtype=np.float32)

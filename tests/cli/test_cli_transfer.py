@@ -161,8 +161,9 @@ def test_recording_without_ground_truth(tmp_path, run_folder):
 def test_option_mistakes_exit_2(tmp_path, run_folder):
     result = _invoke("export", run_folder, "--to", "bag", "--what", "odometry", "--out", tmp_path / "x.bag")
     assert result.exit_code == 2 and "--what" in result.output
-    result = _invoke("export", run_folder, "--to", "bag", "--no-truth", "--out", tmp_path / "x.bag")
-    assert result.exit_code == 2 and "--no-truth applies to --to carmen only" in result.text
+    result = _invoke("export", run_folder, "--to", "tum", "--no-truth", "--out", tmp_path / "x.tum")
+    assert result.exit_code == 2 and "--no-truth applies to --to carmen, bag and bag2" in result.text
+    assert not (tmp_path / "x.tum").exists()
     assert _invoke("export", tmp_path / "nothing", "--to", "tum", "--out", tmp_path / "x.tum").exit_code == 2
     (tmp_path / "log.clf").write_text("ODOM 0 0 0 0 0 0 1.0 host 0.0\n")
     result = _invoke("import", tmp_path / "log.clf", "--out", tmp_path / "r", "--scan-topic", "/scan")
@@ -172,3 +173,26 @@ def test_option_mistakes_exit_2(tmp_path, run_folder):
     (tmp_path / "broken.clf.gz").write_bytes(b"not gzip at all")
     result = _invoke("import", tmp_path / "broken.clf.gz", "--out", tmp_path / "r")
     assert result.exit_code == 2 and "broken.clf.gz" in result.output and "Traceback" not in result.output
+
+
+@pytest.mark.parametrize("to, name", [("bag", "robot.bag"), ("bag2", "robot_bag")])
+def test_a_bag_without_truth_holds_nothing_a_robot_could_not_have_recorded(tmp_path, run_folder, to, name):
+    """What a SLAM program is given: scans and odometry; no ground-truth topic, and no start pose, drawn
+    bias, seed or scores in /slamtrials/run."""
+    bag = tmp_path / name
+    result = _invoke("export", run_folder, "--to", to, "--no-truth", "--out", bag)
+    assert result.exit_code == 0, result.output
+    assert "without /base_pose_ground_truth" in result.text
+    assert _invoke("import", bag, "--out", tmp_path / "back").exit_code == 2  # no truth topic to read
+    result = _invoke("import", bag, "--out", tmp_path / "back", "--no-truth")
+    assert result.exit_code == 0, result.output
+    original, back = read_run(run_folder), read_run(tmp_path / "back")
+    np.testing.assert_array_equal(back.scans, original.scans)
+    np.testing.assert_allclose(back.odometry[:, :2], original.odometry[:, :2], rtol=0, atol=1e-9)
+    assert np.isnan(back.truth).all() and back.metadata["truth_available"] is False
+    kept = {key for key in original.metadata if key in back.metadata}
+    assert kept <= {"format", "versions", "frames", "beams", "laser", "truth_available"}
+    for leak in ("start", "bias", "seed", "world"):
+        assert leak in original.metadata and leak not in back.metadata, leak
+    raw = b"".join(p.read_bytes() for p in ([bag] if bag.is_file() else sorted(bag.iterdir())))
+    assert b'"start"' not in raw and b'"bias"' not in raw and b"base_pose_ground_truth" not in raw

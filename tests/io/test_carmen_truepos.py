@@ -266,10 +266,10 @@ def test_export_keeps_the_truth_by_default_and_no_truth_writes_none(tmp_path):
     assert np.isnan(read_run(tmp_path / "n").truth).all()
 
 
-def test_no_truth_is_refused_for_other_formats(tmp_path):
+def test_no_truth_is_refused_for_tum(tmp_path):
     run = write_run(tmp_path / "run", _record(n=5))
     result = _invoke("export", run, "--to", "tum", "--no-truth", "--out", tmp_path / "t.tum")
-    assert result.exit_code == 2 and "--no-truth applies to --to carmen only" in result.text
+    assert result.exit_code == 2 and "--no-truth applies to --to carmen, bag and bag2" in result.text
 
 
 def test_import_of_uncovered_truepos_lines_is_one_line(tmp_path):

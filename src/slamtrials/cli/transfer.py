@@ -62,8 +62,9 @@ def export_run(
         bool,
         typer.Option(
             "--no-truth",
-            help="For --to carmen: no TRUEPOS lines, so the log holds no ground truth at all (what a SLAM "
-            "program is given). Default: the ground truth in TRUEPOS lines, so that import gives the run back.",
+            help="For carmen and bags: no ground truth at all (what a SLAM program is given): no TRUEPOS lines, "
+            "no /base_pose_ground_truth, and a bag's /slamtrials/run without the run's start pose, errors and "
+            "scores. Default: the ground truth kept, so that import gives the run back.",
         ),
     ] = False,
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace an existing --out.")] = False,
@@ -80,8 +81,8 @@ def export_run(
         raise ConfigError("--what applies to --to tum only")
     if (time_origin is not None or compress) and to not in (ExportFormat.bag, ExportFormat.bag2):
         raise ConfigError("--time-origin-ns and --compress apply to --to bag and --to bag2 only")
-    if no_truth and to is not ExportFormat.carmen:
-        raise ConfigError("--no-truth applies to --to carmen only")
+    if no_truth and to is ExportFormat.tum:
+        raise ConfigError("--no-truth applies to --to carmen, bag and bag2 (a TUM file holds one trajectory: --what)")
     if out.exists() and not overwrite:
         raise ConfigError(f"{out}: already exists; choose another --out or pass --overwrite")
     record = read_run(run)

@@ -20,6 +20,8 @@ from slamtrials.record import RunRecord, Trajectory
 __all__ = [
     "EXPORT_FORMATS",
     "export_record",
+    "sensor_only",
+    "SENSOR_METADATA",
     "detect_recording_format",
     "read_carmen_run",
     "CARMEN_SUFFIXES",
@@ -66,7 +68,10 @@ def export_record(
         For ``carmen``: write the ground truth as TRUEPOS lines (default, so that import gives the run
         back; a run without ground truth at any frame is written without them, as a bag is written
         without ``/base_pose_ground_truth``). False writes a log holding no ground truth at all, what a
-        SLAM program is given.
+        SLAM program is given. For bags: False publishes no ``/base_pose_ground_truth`` and strips
+        ``/slamtrials/run`` to the recording's format, versions, frame and beam counts and laser
+        (:func:`sensor_only`): a run's metadata holds its true start pose, its drawn odometry bias and its
+        scores.
 
     Raises
     ------
@@ -86,12 +91,36 @@ def export_record(
         if out.exists() and (out.is_dir() != (ros == 2)):
             _remove(out)
         origin = DEFAULT_TIME_ORIGIN_NS if time_origin_ns is None else time_origin_ns
+        if not truth:
+            record = sensor_only(record)
         write_bag(out, record, ros=ros, time_origin_ns=origin, overwrite=overwrite, compress=compress)
         held = "with" if np.isfinite(record.truth).all(axis=1).any() else "without"
         return f"{out}: ROS {ros} bag, {len(record)} scans on /base_scan, /odom, /tf, {held} /base_pose_ground_truth"
     if to == "carmen":
         return _export_carmen(record, out, carmen_kind, truth)
     return _export_tum(record, out, tum_source)
+
+
+#: The metadata a recording keeps when it is handed over without ground truth: nothing of the world,
+#: the start pose, the drawn errors, the trial or its scores.
+SENSOR_METADATA = ("format", "versions", "frames", "beams", "laser")
+
+
+def sensor_only(record: RunRecord) -> RunRecord:
+    """``record`` as a robot would have recorded it: the same times, scans, odometry, stalls and laser,
+    the ground truth NaN, no estimate, map or online path, and only :data:`SENSOR_METADATA` kept (with
+    ``truth_available`` False)."""
+    metadata = {key: record.metadata[key] for key in SENSOR_METADATA if key in record.metadata}
+    metadata["truth_available"] = False
+    return RunRecord(
+        t=record.t,
+        scans=record.scans,
+        odometry=record.odometry,
+        truth=np.full_like(np.asarray(record.truth, dtype=np.float64), np.nan),
+        stalled=record.stalled,
+        laser=record.laser,
+        metadata=metadata,
+    )
 
 
 def _export_carmen(record: RunRecord, out: Path, kind: str, truth: bool) -> str:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -29,6 +30,17 @@ def _hostnames(hostname: str | list[str], n: int) -> list[str]:
 def _check_host(name: str, hostname: str | list[str], n: int) -> None:
     if not isinstance(hostname, str) and len(hostname) != n:
         raise ValueError(f"{name}.hostname has {len(hostname)} entries for {n} lines")
+
+
+def _pose_pair_shapes(lines: Any, n: int) -> dict[str, tuple[NDArray, tuple[int, ...]]]:
+    """The shapes every line type with two pose triples must have: ``t``, ``logger_t`` ``[n]``, ``pose``
+    and ``odometry`` ``[n, 3]`` (laser and TRUEPOS lines)."""
+    return {
+        "t": (lines.t, (n,)),
+        "logger_t": (lines.logger_t, (n,)),
+        "pose": (lines.pose, (n, 3)),
+        "odometry": (lines.odometry, (n, 3)),
+    }
 
 
 def _check(name: str, arrays: dict[str, tuple[NDArray, tuple[int, ...]]]) -> None:
@@ -103,12 +115,7 @@ class CarmenLaser:
         n = len(self.t)
         if np.ndim(self.ranges) != 2 or len(self.ranges) != n:
             raise ValueError(f"CarmenLaser.ranges has shape {np.shape(self.ranges)}, expected [{n}, B]")
-        shapes: dict[str, tuple[NDArray, tuple[int, ...]]] = {
-            "t": (self.t, (n,)),
-            "logger_t": (self.logger_t, (n,)),
-            "pose": (self.pose, (n, 3)),
-            "odometry": (self.odometry, (n, 3)),
-        }
+        shapes = _pose_pair_shapes(self, n)
         if self.extra is not None:
             shapes["extra"] = (self.extra, (n, len(ROBOTLASER_EXTRA)))
         if self.line_readings is not None:
@@ -227,12 +234,7 @@ class CarmenTruePos:
 
     def __post_init__(self) -> None:
         m = len(self.t)
-        shapes: dict[str, tuple[NDArray, tuple[int, ...]]] = {
-            "t": (self.t, (m,)),
-            "logger_t": (self.logger_t, (m,)),
-            "pose": (self.pose, (m, 3)),
-            "odometry": (self.odometry, (m, 3)),
-        }
+        shapes = _pose_pair_shapes(self, m)
         if self.line_numbers is not None:
             shapes["line_numbers"] = (self.line_numbers, (m,))
         _check("CarmenTruePos", shapes)

@@ -19,6 +19,7 @@ __all__ = [
     "SimulationError",
     "MetricError",
     "CalibrationError",
+    "ProgramError",
 ]
 
 
@@ -68,6 +69,27 @@ class SimulationError(SlamtrialsError):
 
 class CalibrationError(SlamtrialsError):
     """A log cannot be calibrated from (too short, no odometry, too few usable beams or windows)."""
+
+
+class ProgramError(SlamtrialsError):
+    """An external SLAM program failed on a recording: it exited with an error, ran out of time, wrote
+    nothing, or wrote a trajectory that cannot be read or mapped onto the run.
+
+    Parameters
+    ----------
+    problem:
+        What went wrong, one line (with the last lines of the program's stderr, when it wrote any).
+    exit_code:
+        The program's exit status (None when it was killed at its timeout or did not fail by status).
+    stderr_tail:
+        The last lines of its stderr.
+    """
+
+    def __init__(self, problem: str, *, exit_code: int | None = None, stderr_tail: tuple[str, ...] = ()):
+        self.problem = problem
+        self.exit_code = exit_code
+        self.stderr_tail = tuple(stderr_tail)
+        super().__init__(problem)
 
 
 class MetricError(SlamtrialsError):

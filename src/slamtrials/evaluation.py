@@ -39,6 +39,7 @@ __all__ = [
     "Quantile",
     "evaluate_files",
     "evaluate_run",
+    "read_estimate_file",
     "format_report",
     "FILE_TOLERANCE",
     "RUN_TOLERANCE",
@@ -156,6 +157,18 @@ def _read_trajectory(path: Path, triple: PoseTriple, what: str) -> _Source:
 
     trajectory = read_tum(path)
     return _Source(trajectory, path, "tum", f"{path} (TUM, {len(trajectory)} poses)")
+
+
+def read_estimate_file(path: str | Path, triple: PoseTriple = PoseTriple.auto) -> Trajectory:
+    """An estimated trajectory from a TUM file or a CARMEN log (its laser lines' pose triple ``triple``:
+    by default the first, or the second of a pose-only log, as ``slamtrials evaluate --estimate`` reads it).
+
+    Raises
+    ------
+    FormatError
+        The file does not parse (naming the line).
+    """
+    return _read_trajectory(Path(path), triple, "estimate").trajectory
 
 
 def _check_belong(relations: Relations, relations_path: Path, sources: dict[str, _Source], tolerance: float) -> None:

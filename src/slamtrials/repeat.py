@@ -33,8 +33,9 @@ from slamtrials.metric.meaninterval import MeanInterval, positive_mean_interval
 from slamtrials.metric.relerrors import evaluate_relations
 from slamtrials.metric.runcount import runs_needed
 from slamtrials.metric.stats import EnvironmentStats, environment_stats
-from slamtrials.record import OccupancyGrid, Relations, RunRecord
+from slamtrials.record import OccupancyGrid, Relations, RunRecord, Trajectory
 from slamtrials.slam.offline import run_over_recording
+from slamtrials.slam.program import ProgramSpec
 
 __all__ = [
     "RepeatSettings",
@@ -67,7 +68,9 @@ class RepeatSettings:
     Attributes
     ----------
     algorithm, preset, overrides:
-        The SLAM algorithm and its configuration (as ``slamtrials slam``).
+        The SLAM algorithm and its configuration (as ``slamtrials slam``); with ``program``, its label.
+    program:
+        An external SLAM program to run instead of a registered algorithm (given ``{seed}``).
     runs:
         Number of runs (seeds ``0 .. runs-1``), or ``"auto"`` for the paper's Section III-C rule.
     confidence:
@@ -85,6 +88,7 @@ class RepeatSettings:
     algorithm: str
     preset: str | None = None
     overrides: dict[str, Any] | None = None
+    program: ProgramSpec | None = None
     runs: int | Literal["auto"] = 10
     confidence: float = 0.95
     margin_t: float = 0.02
@@ -211,9 +215,20 @@ def _one_run(record: RunRecord, relations: Relations, settings: RepeatSettings, 
     """Run the algorithm with one seed and score it (on a Dask worker)."""
     s = settings
     started = time.perf_counter()
-    result = run_over_recording(record, s.algorithm, preset=s.preset, overrides=s.overrides, seed=seed)
+    if s.program is not None:
+        from slamtrials.programrun import run_program
+
+        ran = run_program(record, s.program, seed)
+        trajectory, updates, occupancy = (
+            Trajectory(t=record.t, poses=ran.estimate),
+            ran.alignment.poses_read,
+            ran.occupancy,
+        )
+    else:
+        result = run_over_recording(record, s.algorithm, preset=s.preset, overrides=s.overrides, seed=seed)
+        trajectory, updates, occupancy = result.trajectory, result.updates, result.occupancy
     seconds = time.perf_counter() - started
-    errors = evaluate_relations(result.trajectory, relations, tolerance=s.tolerance, allow_outside=True)
+    errors = evaluate_relations(trajectory, relations, tolerance=s.tolerance, allow_outside=True)
     if len(errors) == 0:
         raise MetricError(f"seed {seed}: no relation matched a pose of the estimate within {s.tolerance:g} s")
     return RepeatedRun(
@@ -221,9 +236,9 @@ def _one_run(record: RunRecord, relations: Relations, settings: RepeatSettings, 
         eps_t=float(np.mean(errors.translational)),
         eps_r=float(np.mean(errors.rotational)),
         relations=len(errors),
-        updates=result.updates,
+        updates=updates,
         seconds=seconds,
-        occupancy=result.occupancy,
+        occupancy=occupancy,
     )
 
 
@@ -267,7 +282,8 @@ def repeat_slam(
 
     if len(record) == 0:
         raise ConfigError(f"{source or 'the recording'} has no frames")
-    resolve_config(get_algorithm(settings.algorithm), preset=settings.preset, overrides=settings.overrides)
+    if settings.program is None:
+        resolve_config(get_algorithm(settings.algorithm), preset=settings.preset, overrides=settings.overrides)
     check_relations_fit(
         record,
         relations,
@@ -375,6 +391,7 @@ def write_repeat_outputs(result: RepeatedSlam, out_dir: str | Path, *, overwrite
         "algorithm": result.settings.algorithm,
         "preset": result.settings.preset,
         "overrides": result.settings.overrides or {},
+        "program": result.settings.program.model_dump(mode="json") if result.settings.program else None,
         "input": result.source,
         "relations": result.relations_source,
         "runs": len(result.runs),

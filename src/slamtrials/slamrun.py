@@ -32,12 +32,22 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from slamtrials.atomicfile import atomic_write_text
 from slamtrials.errors import ConfigError, FormatError
-from slamtrials.record import RunRecord, Trajectory
+from slamtrials.record import OccupancyGrid, RunRecord, Trajectory
 from slamtrials.slam.offline import SlamRun, run_over_recording
 
-__all__ = ["SlamResult", "run_slam", "write_slam_outputs", "load_recording", "OUTPUT_FILES", "SLAM_FILE"]
+__all__ = [
+    "SlamResult",
+    "run_slam",
+    "write_slam_outputs",
+    "write_estimate_files",
+    "load_recording",
+    "OUTPUT_FILES",
+    "SLAM_FILE",
+]
 
 SLAM_FILE = "slam.json"
 #: Files :func:`write_slam_outputs` writes, in order (``slam.json`` last).
@@ -120,6 +130,25 @@ def run_slam(
     )
 
 
+def write_estimate_files(
+    out: Path, record: RunRecord, trajectory: Trajectory, estimate: np.ndarray, occupancy: OccupancyGrid
+) -> list[Path]:
+    """Write ``trajectory.tum`` (``trajectory``), ``trajectory.clf`` and ``trajectory.log`` (``estimate``,
+    float64 ``[T, 3]``, one pose per frame of ``record``) and ``map.yaml``/``.pgm``/``.png`` into ``out``."""
+    from slamtrials.io.carmen import carmen_from_run, carmen_from_trajectory, write_carmen
+    from slamtrials.io.mapfile import write_map, write_map_png
+    from slamtrials.io.tum import write_tum
+
+    written = [write_tum(out / "trajectory.tum", trajectory)]
+    clf = carmen_from_run(record, first_triple=estimate)  # first triple = the estimate; no ground truth
+    written.append(write_carmen(out / "trajectory.clf", clf))
+    written.append(write_carmen(out / "trajectory.log", carmen_from_trajectory(Trajectory(t=record.t, poses=estimate))))
+    written.append(write_map(out / "map.yaml", occupancy.grid, occupancy.resolution, occupancy.origin))
+    written.append(out / "map.pgm")
+    written.append(write_map_png(out / "map.png", occupancy.grid))
+    return [Path(p) for p in written]
+
+
 def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bool = False) -> list[Path]:
     """Write :data:`OUTPUT_FILES` into ``out_dir`` (created if needed); return the paths written.
 
@@ -128,25 +157,13 @@ def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bo
     ConfigError
         ``out_dir`` already holds SLAM outputs (``slam.json``) and ``overwrite`` is False.
     """
-    from slamtrials.io.carmen import carmen_from_run, carmen_from_trajectory, write_carmen
-    from slamtrials.io.mapfile import write_map, write_map_png
-    from slamtrials.io.tum import write_tum
-
     out = Path(out_dir)
     if (out / SLAM_FILE).exists() and not overwrite:
         raise ConfigError(f"{out}: already holds SLAM outputs; choose another --out or pass --overwrite")
     out.mkdir(parents=True, exist_ok=True)
     estimate = result.estimate_per_frame(result.record)
-    written = [write_tum(out / "trajectory.tum", result.trajectory)]
-    clf = carmen_from_run(result.record, first_triple=estimate)  # first triple = the estimate; no ground truth
-    written.append(write_carmen(out / "trajectory.clf", clf))
-    written.append(
-        write_carmen(out / "trajectory.log", carmen_from_trajectory(Trajectory(t=result.record.t, poses=estimate)))
-    )
+    written = write_estimate_files(out, result.record, result.trajectory, estimate, result.occupancy)
     grid = result.occupancy
-    written.append(write_map(out / "map.yaml", grid.grid, grid.resolution, grid.origin))
-    written.append(out / "map.pgm")
-    written.append(write_map_png(out / "map.png", grid.grid))
     rows = "".join(
         f"{k},{t!r},{s!r}\n" for k, (t, s) in enumerate(zip(result.record.t.tolist(), result.timing.tolist()))
     )

@@ -16,6 +16,7 @@ from slamtrials.errors import ConfigError
 
 if TYPE_CHECKING:
     from slamtrials.repeat import RepeatedSlam
+    from slamtrials.slam.program import ProgramSpec
 
 __all__ = ["slam", "register", "parse_settings", "format_repeat"]
 
@@ -45,9 +46,6 @@ def parse_settings(settings: list[str]) -> dict[str, Any]:
 
 
 def slam(
-    algorithm: Annotated[
-        str, typer.Option("--algorithm", "-a", help="Registered SLAM algorithm (built-in: gmapping, karto, odometry).")
-    ],
     input_: Annotated[
         Path, typer.Option("--input", "-i", help="Run folder, CARMEN log (.clf/.log, .gz, .bz2) or ROS bag.")
     ],
@@ -55,6 +53,27 @@ def slam(
         Path,
         typer.Option("--out", "-o", help="Folder for trajectory.tum/.clf, map.yaml/.pgm/.png, timing.csv, slam.json."),
     ],
+    algorithm: Annotated[
+        str | None,
+        typer.Option("--algorithm", "-a", help="Registered SLAM algorithm (built-in: gmapping, karto, odometry)."),
+    ] = None,
+    program: Annotated[
+        str | None,
+        typer.Option(
+            "--program",
+            help="Instead of --algorithm: a SLAM program, as a shell command with {input} and {output} "
+            "(and optionally {seed}, {workdir}).",
+        ),
+    ] = None,
+    program_input: Annotated[
+        str, typer.Option("--program-input", help="Format the program reads: carmen, bag (ROS 1) or bag2 (ROS 2).")
+    ] = "carmen",
+    program_output: Annotated[
+        str, typer.Option("--program-output", help="Format of the trajectory it writes: tum or carmen.")
+    ] = "tum",
+    timeout: Annotated[
+        float, typer.Option("--timeout", help="Seconds the program may run on the recording before it is killed.")
+    ] = 3600.0,
     preset: Annotated[str | None, typer.Option("--preset", "-p", help="Named parameter set of the algorithm.")] = None,
     settings: Annotated[
         list[str] | None, typer.Option("--set", help="Parameter override key=value (value read as YAML); repeatable.")
@@ -95,22 +114,33 @@ def slam(
         str | None, typer.Option("--scheduler", help="Address of a running Dask scheduler for --runs.")
     ] = None,
 ) -> None:
-    """Run SLAM algorithm ALGORITHM over a recording and write its trajectory, map and timings.
+    """Run a SLAM algorithm (--algorithm) or program (--program) over a recording and write its
+    trajectory and map; on a run folder, print its error on the run's relation set.
 
-    With --runs N and --relations R: run it N times (seeds 0..N-1, in parallel), score each run on the
-    dataset's relations, and print and write the per-run errors, their mean, sample std, Student t
-    interval and the share of runs that diverged, with a figure of the sorted errors and the best and
-    worst run's maps.
+    A program gets the recording with odometry and laser only (no ground truth), in the run's time
+    base, and writes its trajectory; a program that fails, times out or writes nothing is one line and
+    exit status 2. With --runs N and --relations R: run it N times (seeds 0..N-1, in parallel), score
+    each run on the dataset's relations, and print and write the per-run errors, their mean, sample
+    std, Student t interval and the share of runs that diverged, with a figure of the sorted errors
+    and the best and worst run's maps.
     """
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+    from slamtrials.slamrun import SLAM_FILE
 
-    from slamtrials.slamrun import SLAM_FILE, load_recording, run_slam, write_slam_outputs
+    if (algorithm is None) == (program is None):
+        raise ConfigError("give either --algorithm NAME or --program COMMAND")
+    spec = None
+    if program is not None:
+        from slamtrials.slam.program import program_spec
 
+        if preset is not None or settings:
+            raise ConfigError("--preset and --set configure an --algorithm; a --program is configured in its command")
+        spec = program_spec(command=program, input=program_input, output=program_output, timeout=timeout)
     if runs is not None or relations is not None:
         if runs is None or relations is None:
             raise ConfigError("--runs and --relations go together: give both to repeat SLAM on a dataset")
         _repeat(
             algorithm,
+            spec,
             input_,
             out,
             preset,
@@ -131,8 +161,21 @@ def slam(
         raise ConfigError(f"--seed must be a non-negative integer, got {seed}")
     if (out / SLAM_FILE).exists() and not overwrite:
         raise ConfigError(f"{out}: already holds SLAM outputs; choose another --out or pass --overwrite")
-    overrides = parse_settings(settings or [])
+    if spec is not None:
+        _run_program(spec, input_, out, seed, overwrite)
+    else:
+        assert algorithm is not None
+        _run_algorithm(algorithm, input_, out, preset, parse_settings(settings or []), seed, overwrite)
+    _print_score(input_, out)
+
+
+def _run_algorithm(
+    algorithm: str, input_: Path, out: Path, preset: str | None, overrides: dict[str, Any], seed: int, overwrite: bool
+) -> None:
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
     from slamtrials.slam import get_algorithm, resolve_config
+    from slamtrials.slamrun import load_recording, run_slam, write_slam_outputs
 
     resolve_config(get_algorithm(algorithm), preset=preset, overrides=overrides)  # fail before reading the input
     record = load_recording(input_)
@@ -159,8 +202,51 @@ def slam(
     )
 
 
+def _run_program(spec: ProgramSpec, input_: Path, out: Path, seed: int, overwrite: bool) -> None:
+    from slamtrials.programrun import check_program, run_program, write_program_outputs
+    from slamtrials.slamrun import load_recording
+
+    check_program(spec)  # before reading the input
+    record = load_recording(input_)
+    console = make_console()
+    with console.status(f"{spec.label} on {len(record)} frames", spinner="dots") if console.is_terminal else _nothing():
+        run = run_program(record, spec, seed)
+    written = write_program_outputs(run, record, out, source=str(input_), overwrite=overwrite)
+    a = run.alignment
+    console.print(
+        f"{out}: {spec.label} ran {run.seconds:.1f} s on {len(record)} frames and wrote {a.poses_read} poses "
+        f"({a.frames_at_pose} at a frame, {a.frames_carried} frames carried by odometry); "
+        f"wrote {', '.join(p.name for p in written)}",
+        soft_wrap=True,
+        highlight=False,
+    )
+
+
+def _nothing():
+    from contextlib import nullcontext
+
+    return nullcontext()
+
+
+def _print_score(input_: Path, out: Path) -> None:
+    """On a simulated run folder: the estimate's error on the run's relation set (nothing written)."""
+    from slamtrials.evaluation import evaluate_run
+    from slamtrials.io.runfolder import RunFolder
+
+    if not (input_.is_dir() and RunFolder(input_).is_complete()):
+        return
+    result = evaluate_run(input_, estimate=out / "trajectory.tum", write=False)
+    t, r = result.translational, result.rotational
+    make_console().print(
+        f"error: eps_t {t.mean:.6f} m, eps_r {r.mean:.6f} rad on {result.relations_label}",
+        soft_wrap=True,
+        highlight=False,
+    )
+
+
 def _repeat(
-    algorithm: str,
+    algorithm: str | None,
+    program: ProgramSpec | None,
     input_: Path,
     out: Path,
     preset: str | None,
@@ -186,8 +272,10 @@ def _repeat(
     from slamtrials.slamrun import load_recording
 
     count: int | Literal["auto"] = "auto" if runs.strip().lower() == "auto" else _int_option("--runs", runs)
+    label = program.label if program is not None else str(algorithm)
     settings = RepeatSettings(
-        algorithm=algorithm,
+        algorithm=label,
+        program=program,
         preset=preset,
         overrides=overrides,
         runs=count,
@@ -199,14 +287,19 @@ def _repeat(
     )
     if (out / "summary.json").exists() and not overwrite:
         raise ConfigError(f"{out}: already holds a repeated experiment; choose another --out or pass --overwrite")
-    resolve_config(get_algorithm(algorithm), preset=preset, overrides=overrides)  # fail before reading the input
+    if program is not None:
+        from slamtrials.programrun import check_program
+
+        check_program(program)  # fail before reading the input
+    else:
+        resolve_config(get_algorithm(label), preset=preset, overrides=overrides)
     record = load_recording(input_)
     rel = read_relations(relations)
     console = make_console()
     quiet_dask()
     planned = settings.initial if count == "auto" else int(count)
     with Progress(
-        TextColumn(f"{algorithm} runs"),
+        TextColumn(f"{label} runs"),
         BarColumn(),
         MofNCompleteColumn(),
         console=console,

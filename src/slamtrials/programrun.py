@@ -1,0 +1,344 @@
+"""Running an external SLAM program over a recording: the library behind ``slamtrials slam --program``,
+``campaign replay --program`` and ``validate --program``.
+
+:func:`run_program` writes the recording in the program's input format (odometry and laser only: no
+ground truth, no start pose, no scores; :func:`slamtrials.io.transfer.export_record` with
+``truth=False``) into a scratch folder, runs the command of its
+:class:`~slamtrials.slam.program.ProgramSpec` there with ``/bin/sh -c`` (stdin closed, in its own
+process group), reads the trajectory it wrote, maps its times onto the run's and gives every frame an
+estimate (:func:`slamtrials.slam.program.align_to_frames`). The map is the scans traced at that
+estimate (:func:`slamtrials.slam.estimatemap.map_of_estimate`).
+
+Time base: a CARMEN log carries the run's own times. A bag does too when the run's first time is at
+least 1 s (a real log's stamps); a run that starts at 0 s (every simulated run) is written from 1 s
+on, since ROS reads a zero stamp as "unset", and the program's times are shifted back by that second.
+
+A program that exits with an error, runs past its timeout (its whole process group is killed), writes
+nothing, or writes a trajectory that does not parse or does not fit the run raises
+:class:`~slamtrials.errors.ProgramError` with its exit code and the last lines of its stderr. The
+scratch folder is removed in every case, so nothing is left half-written.
+"""
+
+from __future__ import annotations
+
+import os
+import shlex
+import shutil
+import signal
+import subprocess
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from slamtrials.errors import ConfigError, ProgramError, SlamtrialsError
+from slamtrials.record import OccupancyGrid, RunRecord, Trajectory
+from slamtrials.slam.program import FrameAlignment, ProgramSpec, align_to_frames
+
+__all__ = [
+    "ProgramRun",
+    "run_program",
+    "check_program",
+    "write_program_outputs",
+    "time_origin_ns",
+    "STDERR_LINES",
+    "PROGRAM_OUTPUT_FILES",
+]
+
+#: Lines of the program's stderr kept with a run (the last ones).
+STDERR_LINES = 20
+
+_INPUT_NAMES = {"carmen": "input.clf", "bag": "input.bag", "bag2": "input_bag2"}
+_OUTPUT_NAMES = {"tum": "output.tum", "carmen": "output.clf"}
+_SHELL_WORDS = {"cd", "exec", "env", "export", "set", "time", "nice", "timeout", "!", "(", "{", "if", "for", "while"}
+
+
+@dataclass(frozen=True, eq=False)
+class ProgramRun:
+    """What one run of an external program over a recording produced.
+
+    Attributes
+    ----------
+    spec:
+        The program.
+    seed:
+        The run's seed (given to the command as ``{seed}``).
+    command:
+        The command as run (placeholders replaced; the scratch paths no longer exist).
+    trajectory:
+        The poses the program wrote, in the run's time base (s; map frame).
+    alignment:
+        One estimate per frame (:class:`~slamtrials.slam.program.FrameAlignment`).
+    occupancy:
+        The map of the estimate.
+    seconds:
+        Wall time of the program (s), writing the input and reading the output excluded.
+    time_origin_s:
+        Seconds added to the run's times in the input (0, or 1 for a bag of a run starting at 0 s).
+    stderr_tail:
+        The last :data:`STDERR_LINES` lines of its stderr.
+    """
+
+    spec: ProgramSpec
+    seed: int
+    command: str
+    trajectory: Trajectory
+    alignment: FrameAlignment
+    occupancy: OccupancyGrid
+    seconds: float
+    time_origin_s: float
+    stderr_tail: tuple[str, ...]
+
+    @property
+    def estimate(self) -> np.ndarray:
+        """float64 ``[T, 3]``: the estimate at each frame (map frame)."""
+        return self.alignment.estimate
+
+
+def time_origin_ns(record: RunRecord, input_format: str) -> int:
+    """Nanoseconds added to the run's times in the program's input (see the module docstring)."""
+    from slamtrials.io.ros_messages import DEFAULT_TIME_ORIGIN_NS
+
+    if input_format == "carmen" or (len(record) and float(record.t[0]) >= 1.0):
+        return 0
+    return DEFAULT_TIME_ORIGIN_NS
+
+
+def _first_word(spec: ProgramSpec) -> str | None:
+    """The program the command starts (None when it starts with a shell construct)."""
+    dummy = spec.command_for(input="in", output="out", seed=0, workdir="work")
+    try:
+        words = shlex.split(dummy)
+    except ValueError:
+        return None
+    for word in words:
+        if "=" in word.split("/", 1)[0]:
+            continue  # VAR=value before the program
+        return None if word in _SHELL_WORDS else word
+    return None
+
+
+def check_program(spec: ProgramSpec, cwd: str | Path | None = None) -> None:
+    """Refuse a command whose program cannot be found (not on PATH, nor a file relative to ``cwd``).
+
+    Raises
+    ------
+    ConfigError
+        The program is not found.
+    """
+    word = _first_word(spec)
+    if word is None:
+        return
+    base = Path(cwd) if cwd is not None else Path.cwd()
+    if "/" in word:
+        path = Path(word) if Path(word).is_absolute() else base / word
+        if not path.is_file():
+            raise ConfigError(f"program {word!r} of the command not found (no such file from {base})")
+        return
+    if shutil.which(word) is None:
+        raise ConfigError(f"program {word!r} of the command not found on PATH")
+
+
+def _tail(path: Path) -> tuple[str, ...]:
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return ()
+    lines = [line.rstrip() for line in text.splitlines() if line.strip()]
+    return tuple(lines[-STDERR_LINES:])
+
+
+def _said(tail: tuple[str, ...], count: int = 3) -> str:
+    """The last ``count`` stderr lines, as one line."""
+    return f"; its stderr ends: {' | '.join(tail[-count:])}" if tail else "; its stderr is empty"
+
+
+def _kill(process: subprocess.Popen) -> None:
+    try:
+        os.killpg(process.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+    process.wait()
+
+
+def _run_command(command: str, cwd: Path, work: Path, timeout: float) -> tuple[float, tuple[str, ...]]:
+    """Run ``command``; return (seconds, stderr tail). Raises ProgramError on a failure of the program."""
+    out_log, err_log = work / "stdout.txt", work / "stderr.txt"
+    started = time.perf_counter()
+    with open(out_log, "wb") as stdout, open(err_log, "wb") as stderr:
+        process = subprocess.Popen(
+            ["/bin/sh", "-c", command],
+            cwd=cwd,
+            stdin=subprocess.DEVNULL,
+            stdout=stdout,
+            stderr=stderr,
+            start_new_session=True,  # its own process group, so a timeout kills its children too
+        )
+        try:
+            code = process.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            _kill(process)
+            tail = _tail(err_log)
+            raise ProgramError(
+                f"the program ran past its timeout of {timeout:g} s and was killed{_said(tail)}", stderr_tail=tail
+            ) from None
+        except BaseException:
+            _kill(process)
+            raise
+    seconds = time.perf_counter() - started
+    tail = _tail(err_log)
+    if code != 0:
+        what = "was not found" if code == 127 else f"exited with status {code}"
+        raise ProgramError(f"the program {what} after {seconds:.1f} s{_said(tail)}", exit_code=code, stderr_tail=tail)
+    return seconds, tail
+
+
+def run_program(
+    record: RunRecord,
+    spec: ProgramSpec,
+    seed: int = 0,
+    *,
+    cwd: str | Path | None = None,
+    scratch: str | Path | None = None,
+    resolution: float = 0.05,
+) -> ProgramRun:
+    """Run program ``spec`` over ``record`` and carry its trajectory onto the frames (module docstring).
+
+    Parameters
+    ----------
+    record:
+        The recording (its ground truth, if any, is not written).
+    spec:
+        The program.
+    seed:
+        Given to the command as ``{seed}``.
+    cwd:
+        The command's working directory (default: the current one), so relative paths in the command
+        mean what they mean where slamtrials was started.
+    scratch:
+        Folder in which the scratch folder is made (default: the system's temporary folder).
+    resolution:
+        Cell size (m) of the map of the estimate.
+
+    Raises
+    ------
+    ConfigError
+        A recording without frames, or one the input format cannot hold.
+    ProgramError
+        The program failed, timed out, wrote nothing, or wrote a trajectory that does not parse or fit.
+    """
+    from slamtrials.evaluation import read_estimate_file
+    from slamtrials.io.transfer import export_record
+    from slamtrials.io.tum import read_tum
+    from slamtrials.slam.estimatemap import map_of_estimate
+
+    if len(record) == 0:
+        raise ConfigError("the recording has no frames")
+    run_dir = Path(cwd) if cwd is not None else Path.cwd()
+    origin_ns = time_origin_ns(record, spec.input)
+    with tempfile.TemporaryDirectory(prefix="slamtrials-program-", dir=scratch) as tmp:
+        work = Path(tmp)
+        workdir = work / "workdir"
+        workdir.mkdir()
+        input_path = work / _INPUT_NAMES[spec.input]
+        output_path = work / _OUTPUT_NAMES[spec.output]
+        export_record(record, input_path, spec.input, truth=False, time_origin_ns=origin_ns)
+        command = spec.command_for(input=str(input_path), output=str(output_path), seed=seed, workdir=str(workdir))
+        seconds, tail = _run_command(command, run_dir, work, spec.timeout)
+        if not output_path.is_file() or output_path.stat().st_size == 0:
+            raise ProgramError(
+                f"the program exited with status 0 after {seconds:.1f} s but wrote nothing to {{output}}{_said(tail)}",
+                exit_code=0,
+                stderr_tail=tail,
+            )
+        try:
+            written = read_tum(output_path) if spec.output == "tum" else read_estimate_file(output_path)
+            alignment = align_to_frames(written, record.t, record.odometry, time_shift=origin_ns * 1e-9)
+        except SlamtrialsError as exc:
+            problem = str(exc).replace(str(output_path), "{output}")
+            raise ProgramError(
+                f"the program's output ({spec.output}) cannot be used: {problem}", exit_code=0, stderr_tail=tail
+            ) from None
+    trajectory = Trajectory(t=np.asarray(written.t, dtype=np.float64) - origin_ns * 1e-9, poses=written.poses)
+    occupancy = map_of_estimate(alignment.estimate, record.scans, record.laser, resolution=resolution)
+    return ProgramRun(
+        spec=spec,
+        seed=int(seed),
+        command=command,
+        trajectory=trajectory,
+        alignment=alignment,
+        occupancy=occupancy,
+        seconds=seconds,
+        time_origin_s=origin_ns * 1e-9,
+        stderr_tail=tail,
+    )
+
+
+#: Files :func:`write_program_outputs` writes, in order (``slam.json`` last).
+PROGRAM_OUTPUT_FILES = (
+    "trajectory.tum",
+    "trajectory.clf",
+    "trajectory.log",
+    "map.yaml",
+    "map.pgm",
+    "map.png",
+    "program.tum",
+    "program_stderr.txt",
+    "slam.json",
+)
+
+
+def write_program_outputs(
+    run: ProgramRun, record: RunRecord, out_dir: str | Path, *, source: str = "", overwrite: bool = False
+) -> list[Path]:
+    """Write :data:`PROGRAM_OUTPUT_FILES` into ``out_dir`` (created if needed); return the paths written.
+
+    ``trajectory.tum``, ``.clf``, ``.log`` and the map are those of ``slamtrials slam``
+    (:func:`slamtrials.slamrun.write_estimate_files`), with one pose per frame; ``program.tum`` holds
+    the poses the program wrote, in the run's time base; ``program_stderr.txt`` the last lines of its
+    stderr; ``slam.json`` the program, the command, the seed, the time origin and the pose counts.
+
+    Raises
+    ------
+    ConfigError
+        ``out_dir`` already holds SLAM outputs and ``overwrite`` is False.
+    """
+    import json
+
+    from slamtrials.atomicfile import atomic_write_text
+    from slamtrials.io.tum import write_tum
+    from slamtrials.slamrun import SLAM_FILE, write_estimate_files
+
+    out = Path(out_dir)
+    if (out / SLAM_FILE).exists() and not overwrite:
+        raise ConfigError(f"{out}: already holds SLAM outputs; choose another --out or pass --overwrite")
+    out.mkdir(parents=True, exist_ok=True)
+    per_frame = Trajectory(t=np.asarray(record.t, dtype=np.float64), poses=run.estimate)
+    written = write_estimate_files(out, record, per_frame, run.estimate, run.occupancy)
+    written.append(write_tum(out / "program.tum", run.trajectory))
+    written.append(atomic_write_text(out / "program_stderr.txt", "".join(f"{line}\n" for line in run.stderr_tail)))
+    a = run.alignment
+    summary = {
+        "algorithm": run.spec.label,
+        "program": run.spec.model_dump(mode="json"),
+        "command": run.command,
+        "seed": run.seed,
+        "input": source,
+        "frames": len(record),
+        "seconds_total": run.seconds,
+        "time_origin_s": run.time_origin_s,
+        "poses_written": a.poses_read,
+        "frames_at_a_pose": a.frames_at_pose,
+        "frames_carried_by_odometry": a.frames_carried,
+        "map": {
+            "shape": list(run.occupancy.grid.shape),
+            "resolution": run.occupancy.resolution,
+            "origin": [float(v) for v in run.occupancy.origin],
+            "drawn": "the scans at the estimated poses",
+        },
+        "trajectory_clf": "first pose triple = the estimate at each frame, second = recorded odometry",
+    }
+    written.append(atomic_write_text(out / SLAM_FILE, json.dumps(summary, indent=2) + "\n"))
+    return [Path(p) for p in written]

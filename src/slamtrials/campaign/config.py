@@ -281,6 +281,8 @@ class CampaignConfig(BaseModel):
             raise ConfigError(f"{source}: " + validation_problems(exc)) from None
         try:
             config.slam.resolved()
+            if config.replay_of is None:
+                config.slam.check_online()
         except ConfigError as exc:
             raise ConfigError(f"{source}: slam: {exc}") from None
         return config

@@ -49,6 +49,7 @@ from slamtrials.campaign.task import failure, outcome, write_scored_run
 from slamtrials.errors import ConfigError, SlamtrialsError
 from slamtrials.record import RunRecord
 from slamtrials.slam.offline import run_over_recording
+from slamtrials.slam.program import ProgramSpec
 from slamtrials.trial import SlamSettings
 
 __all__ = [
@@ -78,6 +79,7 @@ def replay_slam_settings(
     algorithm: str | None = None,
     preset: PresetChoice = SOURCE_PRESET,
     params: dict[str, Any] | None = None,
+    program: ProgramSpec | None = None,
 ) -> SlamSettings:
     """The SLAM settings of a replay of a campaign that ran with ``source``.
 
@@ -93,7 +95,21 @@ def replay_slam_settings(
     params:
         Parameter overrides. For the source's algorithm they go on top of the source's own overrides
         (which are kept, whatever the preset); another algorithm gets only these.
+    program:
+        An external program to replay with instead of an algorithm (then ``algorithm``, ``preset``
+        and ``params`` must be left out).
+
+    Raises
+    ------
+    ConfigError
+        A program together with an algorithm, preset or parameters.
     """
+    if program is not None:
+        if algorithm is not None or params or preset is not SOURCE_PRESET:
+            raise ConfigError("a replay runs either --program or --algorithm (with --preset, --set), not both")
+        return SlamSettings(program=program)
+    if source.program is not None and algorithm is None and not params and preset in (SOURCE_PRESET, None):
+        return source  # a replay of a program's campaign with the same program
     algorithm = source.algorithm if algorithm is None else algorithm
     same = algorithm == source.algorithm
     if preset is SOURCE_PRESET:
@@ -109,6 +125,7 @@ def replay_config(
     algorithm: str | None = None,
     preset: PresetChoice = SOURCE_PRESET,
     params: dict[str, Any] | None = None,
+    program: ProgramSpec | None = None,
 ) -> CampaignConfig:
     """The config of the replay in ``folder`` of the campaign in ``source`` (config ``source_config``).
 
@@ -120,7 +137,7 @@ def replay_config(
     ConfigError
         An unknown algorithm or preset, or a bad parameter (named).
     """
-    slam = replay_slam_settings(source_config.slam, algorithm, preset, params)
+    slam = replay_slam_settings(source_config.slam, algorithm, preset, params, program)
     data = source_config.model_dump(mode="json")
     data.update(
         slam=slam.model_dump(mode="json"), replay_of=str(Path(source).absolute()), output=str(Path(folder).absolute())
@@ -162,13 +179,18 @@ def replay_slam(record: RunRecord, slam: SlamSettings, seed: int) -> RunRecord:
     """``record`` with the estimate and map of ``slam`` run over its frames with the run's ``seed``.
 
     The algorithm runs through :func:`slamtrials.slam.offline.run_over_recording`, seeded as in
-    :func:`slamtrials.trial.run_trial` (:mod:`slamtrials.seeding`).
+    :func:`slamtrials.trial.run_trial` (:mod:`slamtrials.seeding`); a program through
+    :func:`slamtrials.programrun.run_program` (given the seed as ``{seed}``).
 
     Raises
     ------
     ConfigError
         A bad configuration, or an algorithm whose trajectory does not hold one pose per frame.
+    ProgramError
+        The program failed on the run.
     """
+    if slam.program is not None:
+        return _replay_program(record, slam.program, seed)
     result = run_over_recording(record, slam.algorithm, preset=slam.preset, overrides=slam.params, seed=seed)
     estimate = result.estimate_per_frame(record)
     metadata = dict(record.metadata)
@@ -184,6 +206,36 @@ def replay_slam(record: RunRecord, slam: SlamSettings, seed: int) -> RunRecord:
         estimate=estimate,
         map=result.occupancy,
         online=result.online,
+    )
+
+
+def _replay_program(record: RunRecord, program: ProgramSpec, seed: int) -> RunRecord:
+    from slamtrials.programrun import run_program
+
+    ran = run_program(record, program, seed)
+    a = ran.alignment
+    metadata = dict(record.metadata)
+    metadata["slam_config"] = program.model_dump(mode="json")
+    metadata["program"] = {
+        "command": ran.command,
+        "seconds": ran.seconds,
+        "time_origin_s": ran.time_origin_s,
+        "poses_written": a.poses_read,
+        "frames_at_a_pose": a.frames_at_pose,
+        "frames_carried_by_odometry": a.frames_carried,
+        "stderr_tail": list(ran.stderr_tail),
+    }
+    return RunRecord(
+        t=record.t,
+        scans=record.scans,
+        odometry=record.odometry,
+        truth=record.truth,
+        stalled=record.stalled,
+        laser=record.laser,
+        metadata=metadata,
+        estimate=ran.estimate,
+        map=ran.occupancy,
+        online=ran.estimate,
     )
 
 
@@ -204,6 +256,7 @@ def replay_one(task: ReplayTask) -> RunResult:
         "algorithm": task.slam.algorithm,
         "preset": task.slam.preset,
         "params": dict(task.slam.params),
+        "program": task.slam.program.model_dump(mode="json") if task.slam.program else None,
         "wall_time_s": time.perf_counter() - started,
         "note": REPLAY_NOTE,
     }
@@ -281,6 +334,7 @@ def replay_campaign(
     preset: PresetChoice = SOURCE_PRESET,
     params: dict[str, Any] | None = None,
     *,
+    program: ProgramSpec | None = None,
     scheduler: Any = None,
     workers: int | None = None,
     on_event: Callable[[CampaignEvent], None] | None = None,
@@ -299,6 +353,9 @@ def replay_campaign(
         The SLAM algorithm (None: the source's), its preset (:data:`SOURCE_PRESET`: the source's for
         the same algorithm, the defaults for another; None: the defaults) and parameter overrides, on
         top of the source's own for the same algorithm (:func:`replay_slam_settings`).
+    program:
+        An external SLAM program to evaluate instead (:class:`~slamtrials.slam.program.ProgramSpec`);
+        its failure on a run makes that run failed, with the program's exit code and stderr.
     scheduler, workers, on_event:
         As for :func:`slamtrials.campaign.run_campaign`.
 
@@ -325,7 +382,11 @@ def replay_campaign(
         base = src.config()
         worlds = src.world_infos()
         recorded = _recorded_runs(src)
-    config = replay_config(base, source, folder, algorithm, preset, params)
+    config = replay_config(base, source, folder, algorithm, preset, params, program)
+    if program is not None:
+        from slamtrials.programrun import check_program
+
+        check_program(program)
 
     check_campaign_folder(folder, config, worlds, kind="replay")  # before starting a cluster; touches nothing
     complete = completed_result(folder, ("done", "capped", "short"))

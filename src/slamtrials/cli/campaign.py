@@ -22,6 +22,7 @@ from typing import Annotated
 import typer
 
 from slamtrials.cli.common import fmt_number, make_app, make_console, quiet_dask, sim_profile_line, table_one
+from slamtrials.cli.slam import ProgramInputOpt, ProgramOpt, ProgramOutputOpt, TimeoutOpt
 from slamtrials.errors import ConfigError
 
 __all__ = ["app", "register", "summary_table", "print_differences", "EXIT_INTERRUPTED"]
@@ -311,26 +312,33 @@ def replay(
             help="Parameter override key=value (value read as YAML), on top of the source's parameters; repeatable.",
         ),
     ] = None,
+    program: ProgramOpt = None,
+    program_input: ProgramInputOpt = "carmen",
+    program_output: ProgramOutputOpt = "tum",
+    timeout: TimeoutOpt = 3600.0,
     scheduler: SchedulerOpt = None,
     workers: WorkersOpt = None,
 ) -> None:
-    """Evaluate another SLAM algorithm or configuration on a campaign's recorded runs, with no simulation.
+    """Evaluate another SLAM algorithm, configuration or program on a campaign's recorded runs, with no simulation.
 
-    The replay keeps the source's algorithm, preset and parameters and changes only what is given.
+    The replay keeps the source's algorithm, preset and parameters and changes only what is given. A
+    --program gets each run's odometry and laser (no ground truth); a run it fails on is a failed run
+    with its exit code and the end of its stderr.
     """
     from slamtrials.campaign import REPLAY_NOTE, replay_campaign
     from slamtrials.campaign.differences import setting_differences
     from slamtrials.campaign.replay import SOURCE_PRESET, replay_config
     from slamtrials.campaign.store import CampaignStore
-    from slamtrials.cli.slam import parse_settings
+    from slamtrials.cli.slam import parse_settings, program_option
 
     if preset is not None and no_preset:
         raise ConfigError("give --preset NAME or --no-preset, not both")
     chosen = None if no_preset else (SOURCE_PRESET if preset is None else preset)
     params = parse_settings(settings or [])
+    spec = program_option(program, program_input, program_output, timeout)
     with CampaignStore.open(source) as store:
         base = store.config()
-    config = replay_config(base, source, out, algorithm, chosen, params)  # checks the settings before any output
+    config = replay_config(base, source, out, algorithm, chosen, params, spec)  # checks the settings before any output
     quiet_dask()
     console = make_console()
     print_differences(console, setting_differences(base, config), str(source), str(out))
@@ -338,7 +346,15 @@ def replay(
     try:
         with _Progress(console) as progress:
             result = replay_campaign(
-                source, out, algorithm, chosen, params, scheduler=scheduler, workers=workers, on_event=progress
+                source,
+                out,
+                algorithm,
+                chosen,
+                params,
+                program=spec,
+                scheduler=scheduler,
+                workers=workers,
+                on_event=progress,
             )
     except KeyboardInterrupt:
         typer.echo("interrupted; resume with the same command", err=True)

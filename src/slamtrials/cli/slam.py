@@ -18,7 +18,35 @@ if TYPE_CHECKING:
     from slamtrials.repeat import RepeatedSlam
     from slamtrials.slam.program import ProgramSpec
 
-__all__ = ["slam", "register", "parse_settings", "format_repeat"]
+__all__ = ["slam", "register", "parse_settings", "format_repeat", "program_option"]
+
+
+ProgramOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--program",
+        help="Instead of --algorithm: a SLAM program, as a shell command with {input} and {output} "
+        "(and optionally {seed}, {workdir}).",
+    ),
+]
+ProgramInputOpt = Annotated[
+    str, typer.Option("--program-input", help="Format the program reads: carmen, bag (ROS 1) or bag2 (ROS 2).")
+]
+ProgramOutputOpt = Annotated[
+    str, typer.Option("--program-output", help="Format of the trajectory the program writes: tum or carmen.")
+]
+TimeoutOpt = Annotated[
+    float, typer.Option("--timeout", help="Seconds the program may run on one recording before it is killed.")
+]
+
+
+def program_option(command: str | None, input_format: str, output_format: str, timeout: float) -> ProgramSpec | None:
+    """The :class:`~slamtrials.slam.program.ProgramSpec` of the ``--program`` options (None without ``--program``)."""
+    if command is None:
+        return None
+    from slamtrials.slam.program import program_spec
+
+    return program_spec(command=command, input=input_format, output=output_format, timeout=timeout)
 
 
 def parse_settings(settings: list[str]) -> dict[str, Any]:
@@ -57,23 +85,10 @@ def slam(
         str | None,
         typer.Option("--algorithm", "-a", help="Registered SLAM algorithm (built-in: gmapping, karto, odometry)."),
     ] = None,
-    program: Annotated[
-        str | None,
-        typer.Option(
-            "--program",
-            help="Instead of --algorithm: a SLAM program, as a shell command with {input} and {output} "
-            "(and optionally {seed}, {workdir}).",
-        ),
-    ] = None,
-    program_input: Annotated[
-        str, typer.Option("--program-input", help="Format the program reads: carmen, bag (ROS 1) or bag2 (ROS 2).")
-    ] = "carmen",
-    program_output: Annotated[
-        str, typer.Option("--program-output", help="Format of the trajectory it writes: tum or carmen.")
-    ] = "tum",
-    timeout: Annotated[
-        float, typer.Option("--timeout", help="Seconds the program may run on the recording before it is killed.")
-    ] = 3600.0,
+    program: ProgramOpt = None,
+    program_input: ProgramInputOpt = "carmen",
+    program_output: ProgramOutputOpt = "tum",
+    timeout: TimeoutOpt = 3600.0,
     preset: Annotated[str | None, typer.Option("--preset", "-p", help="Named parameter set of the algorithm.")] = None,
     settings: Annotated[
         list[str] | None, typer.Option("--set", help="Parameter override key=value (value read as YAML); repeatable.")
@@ -128,13 +143,9 @@ def slam(
 
     if (algorithm is None) == (program is None):
         raise ConfigError("give either --algorithm NAME or --program COMMAND")
-    spec = None
-    if program is not None:
-        from slamtrials.slam.program import program_spec
-
-        if preset is not None or settings:
-            raise ConfigError("--preset and --set configure an --algorithm; a --program is configured in its command")
-        spec = program_spec(command=program, input=program_input, output=program_output, timeout=timeout)
+    spec = program_option(program, program_input, program_output, timeout)
+    if spec is not None and (preset is not None or settings):
+        raise ConfigError("--preset and --set configure an --algorithm; a --program is configured in its command")
     if runs is not None or relations is not None:
         if runs is None or relations is None:
             raise ConfigError("--runs and --relations go together: give both to repeat SLAM on a dataset")

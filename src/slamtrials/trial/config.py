@@ -12,12 +12,13 @@ from __future__ import annotations
 
 from typing import Any
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from slamtrials.errors import ConfigError, validation_problems
 from slamtrials.explore import ExploreConfig, RobotLimits, TerminationConfig
 from slamtrials.sim import SimConfig
 from slamtrials.slam import get_algorithm, resolve_config
+from slamtrials.slam.program import ProgramSpec
 
 __all__ = ["SlamSettings", "TrialConfig"]
 
@@ -35,6 +36,10 @@ class SlamSettings(BaseModel):
         One of the algorithm's presets, or ``None`` for its defaults.
     params:
         Parameter overrides applied after the preset.
+    program:
+        An external SLAM program instead of a registered algorithm
+        (:class:`~slamtrials.slam.program.ProgramSpec`). It runs offline, over recorded runs (``slam``,
+        ``campaign replay``, ``validate``); ``algorithm`` is then its label and ``preset`` null.
     """
 
     model_config = _MODEL_CONFIG
@@ -42,10 +47,37 @@ class SlamSettings(BaseModel):
     algorithm: str = Field("gmapping", min_length=1, description="SLAM algorithm name")
     preset: str | None = Field("paper", description="preset of the algorithm, or null for its defaults")
     params: dict[str, Any] = Field(default_factory=dict, description="parameter overrides")
+    program: ProgramSpec | None = Field(None, description="an external SLAM program, run offline over recorded runs")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _program_named(cls, data: Any) -> Any:
+        """With a program, the algorithm is the program's label and there is no preset."""
+        if isinstance(data, dict) and data.get("program") is not None:
+            spec = data["program"]
+            if not isinstance(spec, ProgramSpec):
+                spec = ProgramSpec.model_validate(spec)
+            given = {k: data[k] for k in ("algorithm", "preset", "params") if data.get(k) not in (None, {})}
+            given.pop("algorithm", None) if given.get("algorithm") == spec.label else None
+            if given:
+                raise ValueError(f"slam.program replaces slam.{sorted(given)[0]}: give one or the other")
+            data = {**data, "program": spec, "algorithm": spec.label, "preset": None, "params": {}}
+        return data
 
     def resolved(self) -> BaseModel:
-        """The algorithm's validated config (raises :class:`ConfigError` naming the bad parameter)."""
+        """The algorithm's validated config, or the program (raises :class:`ConfigError` naming the bad parameter)."""
+        if self.program is not None:
+            return self.program
         return resolve_config(get_algorithm(self.algorithm), preset=self.preset, overrides=self.params)
+
+    def check_online(self) -> None:
+        """Raise :class:`ConfigError` for a program: it runs over recorded runs only, not in a trial."""
+        if self.program is not None:
+            raise ConfigError(
+                f"slam.program ({self.program.label}) runs offline, over recorded runs: use it with "
+                "'slamtrials slam --program', 'campaign replay SOURCE --program' or 'validate --program'; "
+                "a trial explores with a registered algorithm"
+            )
 
 
 class TrialConfig(BaseModel):
@@ -99,4 +131,5 @@ class TrialConfig(BaseModel):
         except ValidationError as exc:
             raise ConfigError("trial config: " + validation_problems(exc)) from None
         config.slam.resolved()
+        config.slam.check_online()
         return config

@@ -123,6 +123,7 @@ def run_trial(
     """
     streams = run_streams(check_seed(seed, "trial seed"))
     config = TrialConfig() if config is None else config
+    config.slam.check_online()
     slam_config = config.slam.resolved()
     started = time.perf_counter()
 

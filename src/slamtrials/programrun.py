@@ -35,11 +35,13 @@ import numpy as np
 
 from slamtrials.errors import ConfigError, ProgramError, SlamtrialsError
 from slamtrials.record import OccupancyGrid, RunRecord, Trajectory
+from slamtrials.slam.offline import SlamRun, run_over_recording
 from slamtrials.slam.program import FrameAlignment, ProgramSpec, align_to_frames
 
 __all__ = [
     "ProgramRun",
     "run_program",
+    "run_offline",
     "check_program",
     "write_program_outputs",
     "time_origin_ns",
@@ -342,3 +344,41 @@ def write_program_outputs(
     }
     written.append(atomic_write_text(out / SLAM_FILE, json.dumps(summary, indent=2) + "\n"))
     return [Path(p) for p in written]
+
+
+def run_offline(
+    record: RunRecord,
+    algorithm: str,
+    *,
+    preset: str | None = None,
+    overrides: dict | None = None,
+    program: ProgramSpec | None = None,
+    seed: int = 0,
+) -> SlamRun:
+    """A registered algorithm (:func:`slamtrials.slam.offline.run_over_recording`) or, when ``program`` is
+    given, that program (:func:`run_program`) over ``record``, as a
+    :class:`~slamtrials.slam.offline.SlamRun`.
+
+    For a program, the SlamRun's ``trajectory`` and ``online`` are its estimate at every frame, its
+    ``config`` the :class:`~slamtrials.slam.program.ProgramSpec`, ``updates`` the poses it wrote, and
+    ``timing`` NaN (a program is timed as a whole: the total is spread over no frame).
+
+    Raises
+    ------
+    ConfigError, ProgramError
+        As the two functions raise them.
+    """
+    if program is None:
+        return run_over_recording(record, algorithm, preset=preset, overrides=overrides, seed=seed)
+    ran = run_program(record, program, seed)
+    return SlamRun(
+        algorithm=program.label,
+        preset=None,
+        config=program,
+        seed=int(seed),
+        trajectory=Trajectory(t=np.asarray(record.t, dtype=np.float64), poses=ran.estimate),
+        online=ran.estimate,
+        occupancy=ran.occupancy,
+        timing=np.full(len(record), np.nan),
+        updates=ran.alignment.poses_read,
+    )

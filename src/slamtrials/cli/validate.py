@@ -17,7 +17,14 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from slamtrials.cli.common import fmt_number, make_console, quiet_dask, say_profile
-from slamtrials.cli.slam import parse_settings
+from slamtrials.cli.slam import (
+    ProgramInputOpt,
+    ProgramOpt,
+    ProgramOutputOpt,
+    TimeoutOpt,
+    parse_settings,
+    program_option,
+)
 from slamtrials.errors import ConfigError
 
 if TYPE_CHECKING:
@@ -77,8 +84,17 @@ def validate(
     ] = None,
     runs: Annotated[int, typer.Option("--runs", "-n", help="Number of replicas (seeds 0..N-1).")] = 5,
     algorithm: Annotated[
-        str, typer.Option("--algorithm", "-a", help="Registered SLAM algorithm (built-in: gmapping, karto, odometry).")
-    ] = "gmapping",
+        str | None,
+        typer.Option(
+            "--algorithm",
+            "-a",
+            help="Registered SLAM algorithm (built-in: gmapping, karto, odometry); default gmapping.",
+        ),
+    ] = None,
+    program: ProgramOpt = None,
+    program_input: ProgramInputOpt = "carmen",
+    program_output: ProgramOutputOpt = "tum",
+    timeout: TimeoutOpt = 3600.0,
     preset: Annotated[str | None, typer.Option("--preset", "-p", help="Named parameter set of the algorithm.")] = None,
     settings: Annotated[
         list[str] | None, typer.Option("--set", help="Parameter override key=value (value read as YAML); repeatable.")
@@ -131,8 +147,20 @@ def validate(
     from slamtrials.validation import validate as run_validation
 
     overrides = parse_settings(settings or [])
+    spec = program_option(program, program_input, program_output, timeout)
+    if spec is not None and (algorithm is not None or preset is not None or overrides):
+        raise ConfigError("give --program or --algorithm (with --preset, --set), not both")
+    if spec is not None and split:
+        raise ConfigError("--split fits the laser against a registered algorithm's map; it does not take --program")
+    algorithm = spec.label if spec is not None else (algorithm or "gmapping")
     options = ValidationSettings(
-        algorithm=algorithm, preset=preset, overrides=overrides, runs=runs, reference_seed=seed, tolerance=tolerance
+        algorithm=algorithm,
+        preset=preset,
+        overrides=overrides,
+        program=spec,
+        runs=runs,
+        reference_seed=seed,
+        tolerance=tolerance,
     )
     if workers < 1:
         raise ConfigError(f"--workers must be a positive integer, got {workers}")
@@ -146,7 +174,12 @@ def validate(
     from slamtrials.sim.profiles import DEFAULT_PROFILE
 
     chosen = resolve_profile_option(DEFAULT_PROFILE if profile is None else profile)
-    resolve_config(get_algorithm(algorithm), preset=preset, overrides=overrides)  # fail before reading the log
+    if spec is not None:
+        from slamtrials.programrun import check_program
+
+        check_program(spec)  # fail before reading the log
+    else:
+        resolve_config(get_algorithm(algorithm), preset=preset, overrides=overrides)
     record = load_recording(log)
     rel = read_relations(relations)
     check_belong(record, rel, tolerance, log=str(log), relations_source=str(relations))
@@ -239,18 +272,19 @@ def format_validation(result: ValidationResult) -> str:
     ]
     if result.blocked:
         lines.append(f"warning: {result.blocked} replica frames have the laser inside a wall of the reference map")
-    header = f"{'':<10} {'':<11} {'eps_t (m)':>10} {'s(eps_t)':>9}   {'eps_r (rad)':>11} {'s(eps_r)':>9}"
+    w = max(10, len(s.algorithm))
+    header = f"{'':<{w}} {'':<11} {'eps_t (m)':>10} {'s(eps_t)':>9}   {'eps_r (rad)':>11} {'s(eps_r)':>9}"
     lines += ["", header]
     for source in ("slam", "odometry"):
         name = s.algorithm if source == "slam" else "odometry"
         real = result.real(source)
         st, sr = result.simulated(source, "translational"), result.simulated(source, "rotational")
         lines.append(
-            f"{name:<10} {'real log':<11} {fmt_number(real.translational, 4):>10} {'':>9}   "
+            f"{name:<{w}} {'real log':<11} {fmt_number(real.translational, 4):>10} {'':>9}   "
             f"{fmt_number(real.rotational, 4):>11} {'':>9}"
         )
         lines.append(
-            f"{'':<10} {'simulation':<11} {fmt_number(st.mean, 4):>10} {fmt_number(st.std, 4):>9}   "
+            f"{'':<{w}} {'simulation':<11} {fmt_number(st.mean, 4):>10} {fmt_number(st.std, 4):>9}   "
             f"{fmt_number(sr.mean, 4):>11} {fmt_number(sr.std, 4):>9}"
         )
     lines += [

@@ -44,7 +44,8 @@ from slamtrials.sim.config import ErrorProfile, SimConfig
 from slamtrials.sim.pathreplay import simulate_path
 from slamtrials.sim.profiles import DEFAULT_PROFILE, resolve_profile
 from slamtrials.slam.base import get_algorithm, resolve_config
-from slamtrials.slam.offline import SlamRun, run_over_recording
+from slamtrials.slam.offline import SlamRun
+from slamtrials.slam.program import ProgramSpec
 from slamtrials.validation.replica import UNKNOWN_AS_WALL, Replica, blocked_frames, laser_config_for, world_from_map
 
 __all__ = [
@@ -81,7 +82,9 @@ class ValidationSettings:
     Attributes
     ----------
     algorithm, preset, overrides:
-        The SLAM algorithm and its configuration (as ``slamtrials slam``).
+        The SLAM algorithm and its configuration (as ``slamtrials slam``); with ``program``, its label.
+    program:
+        An external SLAM program to validate instead of a registered algorithm.
     runs:
         Number of replicas (seeds ``0 .. runs-1``), at least 1.
     reference_seed:
@@ -93,6 +96,7 @@ class ValidationSettings:
     algorithm: str = "gmapping"
     preset: str | None = None
     overrides: dict[str, Any] | None = None
+    program: ProgramSpec | None = None
     runs: int = 5
     reference_seed: int = 0
     tolerance: float = DEFAULT_TOLERANCE
@@ -260,6 +264,7 @@ class ValidationResult:
             "algorithm": s.algorithm,
             "preset": s.preset,
             "overrides": s.overrides or {},
+            "program": s.program.model_dump(mode="json") if s.program else None,
             "reference_seed": s.reference_seed,
             "tolerance_s": s.tolerance,
             "profile": self.profile.model_dump(mode="json"),
@@ -368,7 +373,9 @@ def run_replica(plan: ValidationPlan, seed: int) -> ReplicaResult:
     rng = np.random.default_rng(run_streams(seed).simulator)
     replica = plan.replica
     record = simulate_path(replica.world, replica.t, replica.truth, plan.config, rng)
-    slam = run_over_recording(record, s.algorithm, preset=s.preset, overrides=s.overrides, seed=seed)
+    from slamtrials.programrun import run_offline
+
+    slam = run_offline(record, s.algorithm, preset=s.preset, overrides=s.overrides, program=s.program, seed=seed)
     relations = plan.relations()
     estimate = evaluate_relations(slam.trajectory, relations, tolerance=RUN_TOLERANCE)
     odometry = evaluate_relations(Trajectory(t=record.t, poses=record.odometry), relations, tolerance=RUN_TOLERANCE)
@@ -447,10 +454,13 @@ def validate(
         except ValueError as exc:
             raise ConfigError(str(exc)) from None
     check_belong(record, relations, s.tolerance, log=log, relations_source=relations_source)
-    resolve_config(get_algorithm(s.algorithm), preset=s.preset, overrides=s.overrides)
+    if s.program is None:
+        resolve_config(get_algorithm(s.algorithm), preset=s.preset, overrides=s.overrides)
     if reference is None:
-        reference = run_over_recording(
-            record, s.algorithm, preset=s.preset, overrides=s.overrides, seed=s.reference_seed
+        from slamtrials.programrun import run_offline
+
+        reference = run_offline(
+            record, s.algorithm, preset=s.preset, overrides=s.overrides, program=s.program, seed=s.reference_seed
         )
     real_slam = RunErrors.of(
         evaluate_relations(reference.trajectory, relations, tolerance=s.tolerance, allow_outside=True)

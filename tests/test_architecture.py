@@ -23,11 +23,14 @@ ALLOWED = {
     "trial": {"geometry", "record", "worlds", "sim", "slam", "explore"},
     # validation composes sim, slam and metric like a trial (DESIGN.md, "Realism"), and calibration for the
     # split-half check (fit on one half of a log, validate on the other); it computes only
-    "validation": {"geometry", "record", "worlds", "sim", "slam", "metric", "calibration"},
+    # and external for a program under validation (the one place it starts a process)
+    "validation": {"geometry", "record", "worlds", "sim", "slam", "metric", "calibration", "external"},
     "metric": {"geometry", "record"},
     "calibration": {"geometry", "record", "worlds", "sim", "slam", "metric"},
     "io": {"geometry", "record", "worlds"},
-    "campaign": {"geometry", "record", "worlds", "sim", "slam", "explore", "trial", "metric", "io"},
+    # external runs SLAM programs: writes their input and reads their output through io, starts processes
+    "external": {"geometry", "record", "worlds", "slam", "io"},
+    "campaign": {"geometry", "record", "worlds", "sim", "slam", "explore", "trial", "metric", "io", "external"},
     "report": {"geometry", "record", "worlds", "metric", "io", "campaign", "calibration"},
 }
 #: Top-level modules that compose layers like the CLI does (no layer may import them).
@@ -72,7 +75,7 @@ MACHINE_DEPENDENT = {
     "linalg",
 }
 #: Layers whose numbers end up in runs, maps and files, and must be the same on every machine.
-REPRODUCIBLE = COMPUTING | {"worlds", "io", "campaign"}
+REPRODUCIBLE = COMPUTING | {"worlds", "io", "external", "campaign"}
 
 
 def _layer_of(path: Path) -> str:

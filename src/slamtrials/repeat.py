@@ -216,7 +216,7 @@ def _one_run(record: RunRecord, relations: Relations, settings: RepeatSettings, 
     s = settings
     started = time.perf_counter()
     if s.program is not None:
-        from slamtrials.programrun import run_program
+        from slamtrials.external import run_program
 
         ran = run_program(record, s.program, seed)
         trajectory, updates, occupancy = (

@@ -36,6 +36,7 @@ import numpy as np
 
 from slamtrials.atomicfile import atomic_write_text
 from slamtrials.errors import ConfigError, FormatError
+from slamtrials.external import ProgramRun
 from slamtrials.record import OccupancyGrid, RunRecord, Trajectory
 from slamtrials.slam.offline import SlamRun, run_over_recording
 
@@ -44,6 +45,8 @@ __all__ = [
     "run_slam",
     "write_slam_outputs",
     "write_estimate_files",
+    "write_program_outputs",
+    "PROGRAM_OUTPUT_FILES",
     "load_recording",
     "OUTPUT_FILES",
     "SLAM_FILE",
@@ -217,3 +220,67 @@ def load_recording(path: str | Path) -> RunRecord:
 
     truth = TRUTH_TOPIC if TRUTH_TOPIC in bag_topics(path) else None
     return run_from_bag(path, truth_topic=truth)
+
+
+#: Files :func:`write_program_outputs` writes, in order (``slam.json`` last).
+PROGRAM_OUTPUT_FILES = (
+    "trajectory.tum",
+    "trajectory.clf",
+    "trajectory.log",
+    "map.yaml",
+    "map.pgm",
+    "map.png",
+    "program.tum",
+    "program_stderr.txt",
+    "slam.json",
+)
+
+
+def write_program_outputs(
+    run: ProgramRun, record: RunRecord, out_dir: str | Path, *, source: str = "", overwrite: bool = False
+) -> list[Path]:
+    """Write :data:`PROGRAM_OUTPUT_FILES` into ``out_dir`` (created if needed); return the paths written.
+
+    ``trajectory.tum``, ``.clf``, ``.log`` and the map are those of ``slamtrials slam``
+    (:func:`slamtrials.slamrun.write_estimate_files`), with one pose per frame; ``program.tum`` holds
+    the poses the program wrote, in the run's time base; ``program_stderr.txt`` the last lines of its
+    stderr; ``slam.json`` the program, the command, the seed, the time origin and the pose counts.
+
+    Raises
+    ------
+    ConfigError
+        ``out_dir`` already holds SLAM outputs and ``overwrite`` is False.
+    """
+    from slamtrials.io.tum import write_tum
+
+    out = Path(out_dir)
+    if (out / SLAM_FILE).exists() and not overwrite:
+        raise ConfigError(f"{out}: already holds SLAM outputs; choose another --out or pass --overwrite")
+    out.mkdir(parents=True, exist_ok=True)
+    per_frame = Trajectory(t=np.asarray(record.t, dtype=np.float64), poses=run.estimate)
+    written = write_estimate_files(out, record, per_frame, run.estimate, run.occupancy)
+    written.append(write_tum(out / "program.tum", run.trajectory))
+    written.append(atomic_write_text(out / "program_stderr.txt", "".join(f"{line}\n" for line in run.stderr_tail)))
+    a = run.alignment
+    summary = {
+        "algorithm": run.spec.label,
+        "program": run.spec.model_dump(mode="json"),
+        "command": run.command,
+        "seed": run.seed,
+        "input": source,
+        "frames": len(record),
+        "seconds_total": run.seconds,
+        "time_origin_s": run.time_origin_s,
+        "poses_written": a.poses_read,
+        "frames_at_a_pose": a.frames_at_pose,
+        "frames_carried_by_odometry": a.frames_carried,
+        "map": {
+            "shape": list(run.occupancy.grid.shape),
+            "resolution": run.occupancy.resolution,
+            "origin": [float(v) for v in run.occupancy.origin],
+            "drawn": "the scans at the estimated poses",
+        },
+        "trajectory_clf": "first pose triple = the estimate at each frame, second = recorded odometry",
+    }
+    written.append(atomic_write_text(out / SLAM_FILE, json.dumps(summary, indent=2) + "\n"))
+    return [Path(p) for p in written]

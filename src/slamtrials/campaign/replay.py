@@ -180,7 +180,7 @@ def replay_slam(record: RunRecord, slam: SlamSettings, seed: int) -> RunRecord:
 
     The algorithm runs through :func:`slamtrials.slam.offline.run_over_recording`, seeded as in
     :func:`slamtrials.trial.run_trial` (:mod:`slamtrials.seeding`); a program through
-    :func:`slamtrials.programrun.run_program` (given the seed as ``{seed}``).
+    :func:`slamtrials.external.run_program` (given the seed as ``{seed}``).
 
     Raises
     ------
@@ -210,7 +210,7 @@ def replay_slam(record: RunRecord, slam: SlamSettings, seed: int) -> RunRecord:
 
 
 def _replay_program(record: RunRecord, program: ProgramSpec, seed: int) -> RunRecord:
-    from slamtrials.programrun import run_program
+    from slamtrials.external import run_program
 
     ran = run_program(record, program, seed)
     a = ran.alignment
@@ -384,7 +384,7 @@ def replay_campaign(
         recorded = _recorded_runs(src)
     config = replay_config(base, source, folder, algorithm, preset, params, program)
     if program is not None:
-        from slamtrials.programrun import check_program
+        from slamtrials.external import check_program
 
         check_program(program)
 

@@ -214,8 +214,8 @@ def _run_algorithm(
 
 
 def _run_program(spec: ProgramSpec, input_: Path, out: Path, seed: int, overwrite: bool) -> None:
-    from slamtrials.programrun import check_program, run_program, write_program_outputs
-    from slamtrials.slamrun import load_recording
+    from slamtrials.external import check_program, run_program
+    from slamtrials.slamrun import load_recording, write_program_outputs
 
     check_program(spec)  # before reading the input
     record = load_recording(input_)
@@ -299,7 +299,7 @@ def _repeat(
     if (out / "summary.json").exists() and not overwrite:
         raise ConfigError(f"{out}: already holds a repeated experiment; choose another --out or pass --overwrite")
     if program is not None:
-        from slamtrials.programrun import check_program
+        from slamtrials.external import check_program
 
         check_program(program)  # fail before reading the input
     else:

@@ -175,7 +175,7 @@ def validate(
 
     chosen = resolve_profile_option(DEFAULT_PROFILE if profile is None else profile)
     if spec is not None:
-        from slamtrials.programrun import check_program
+        from slamtrials.external import check_program
 
         check_program(spec)  # fail before reading the log
     else:

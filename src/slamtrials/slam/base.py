@@ -112,6 +112,15 @@ def register_algorithm(cls: _Class) -> _Class:
         ``cls`` lacks part of the :class:`SlamAlgorithm` contract, its ``Config`` is not a pydantic model,
         or its ``PRESETS`` is not a dict of dicts.
     """
+    checked = _checked(cls)
+    ALGORITHMS[checked.name] = checked
+    return cls
+
+
+def _checked(cls: Any) -> type[SlamAlgorithm]:
+    """``cls`` when it meets the :class:`SlamAlgorithm` contract (else ConfigError naming what it lacks)."""
+    if not isinstance(cls, type):
+        raise ConfigError(f"{cls!r} is not a SLAM algorithm class")
     missing = [member for member in _CONTRACT if member not in dir(cls)]
     if missing:
         raise ConfigError(
@@ -125,8 +134,7 @@ def register_algorithm(cls: _Class) -> _Class:
     if not isinstance(presets, dict) or not all(isinstance(v, dict) for v in presets.values()):
         raise ConfigError(f"SLAM algorithm {name!r}: PRESETS must map preset names to parameter dicts")
     # Checked above: the class now meets the SlamAlgorithm contract.
-    ALGORITHMS[name] = cast("type[SlamAlgorithm]", cls)
-    return cls
+    return cast("type[SlamAlgorithm]", cls)
 
 
 def _entry_points() -> dict[str, Any]:
@@ -139,9 +147,10 @@ def known_algorithms() -> list[str]:
 
 
 def get_algorithm(name: str) -> type[SlamAlgorithm]:
-    """The algorithm class called ``name``: registered, or published under :data:`ENTRY_POINT_GROUP`.
+    """The algorithm class called ``name``: registered, published under :data:`ENTRY_POINT_GROUP`, or
+    named by reference: ``package.module:Class`` (an importable module) or ``path/to/file.py:Class``.
 
-    An entry-point class is checked and registered on first use.
+    An entry-point or referenced class is checked and registered (under ``name``) on first use.
 
     Raises
     ------
@@ -149,6 +158,12 @@ def get_algorithm(name: str) -> type[SlamAlgorithm]:
         No algorithm has that name (the message lists the known ones), or its entry point fails to load.
     """
     if name in ALGORITHMS:
+        return ALGORITHMS[name]
+    if ":" in name:
+        try:
+            ALGORITHMS[name] = _checked(_load_reference(name))
+        except ConfigError as exc:
+            raise ConfigError(str(exc) if str(exc).startswith("SLAM algorithm") else f"{name!r}: {exc}") from None
         return ALGORITHMS[name]
     found = _entry_points().get(name)
     if found is None:
@@ -161,6 +176,46 @@ def get_algorithm(name: str) -> type[SlamAlgorithm]:
         raise ConfigError(f"entry point {name!r} = {found.value} is not a SLAM algorithm class named {name!r}")
     register_algorithm(cls)
     return cast("type[SlamAlgorithm]", cls)  # register_algorithm checked the contract
+
+
+def _load_reference(reference: str) -> Any:
+    """The class ``reference`` names: ``package.module:Class`` (importable) or ``path/to/file.py:Class``.
+
+    Raises
+    ------
+    ConfigError
+        The module or file cannot be loaded, or holds no such attribute.
+    """
+    import hashlib
+    import importlib
+    import importlib.util
+    import sys
+    from pathlib import Path
+
+    where, _, attribute = reference.rpartition(":")
+    if not where or not attribute.isidentifier():
+        raise ConfigError(f"SLAM algorithm {reference!r}: expected 'package.module:Class' or 'file.py:Class'")
+    try:
+        if where.endswith(".py") or "/" in where or "\\" in where:
+            path = Path(where).expanduser().absolute()
+            if not path.is_file():
+                raise ConfigError(f"SLAM algorithm {reference!r}: no such file {path}")
+            module_name = "slamtrials_plugin_" + hashlib.sha1(str(path).encode()).hexdigest()[:12]
+            spec = importlib.util.spec_from_file_location(module_name, path)
+            if spec is None or spec.loader is None:
+                raise ConfigError(f"SLAM algorithm {reference!r}: {path} is not a Python file")
+            module = importlib.util.module_from_spec(spec)
+            sys.modules[module_name] = module
+            spec.loader.exec_module(module)
+        else:
+            module = importlib.import_module(where)
+    except ConfigError:
+        raise
+    except Exception as exc:  # a plug-in's import error must not become a traceback
+        raise ConfigError(f"SLAM algorithm {reference!r} failed to load: {type(exc).__name__}: {exc}") from None
+    if not hasattr(module, attribute):
+        raise ConfigError(f"SLAM algorithm {reference!r}: {where} has no {attribute!r}")
+    return getattr(module, attribute)
 
 
 def _allowed(model: type[BaseModel], parameter: str) -> str:

@@ -8,6 +8,8 @@ of the estimate), as the ``odometry`` baseline's ``gmapping`` preset does.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -53,7 +55,7 @@ def map_of_estimate(
     moved, turned = 0.0, 0.0
     for k in range(len(estimate)):
         if k > 0:
-            moved += float(np.hypot(steps[k - 1, 0], steps[k - 1, 1]))
+            moved += math.hypot(steps[k - 1, 0], steps[k - 1, 1])
             turned += abs(float(steps[k - 1, 2]))
         if k == 0 or moved >= linear_update or turned >= angular_update:
             grid.integrate_frame(estimate[k], scans[k], laser, max_urange=max_urange)

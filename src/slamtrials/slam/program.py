@@ -3,7 +3,7 @@ one pose per frame (:func:`align_to_frames`).
 
 A program is evaluated offline: slamtrials writes the recording (odometry and laser only) in the format
 the program reads, runs its command, reads the trajectory it writes and scores it. Running it is the
-job of :mod:`slamtrials.programrun` (files and processes); this module holds the pure parts.
+job of :mod:`slamtrials.external` (files and processes); this module holds the pure parts.
 
 A program rarely writes a pose for every frame: scan matchers report a pose when they process a scan,
 and that may be every few frames or at times of their own. :func:`align_to_frames` gives every frame

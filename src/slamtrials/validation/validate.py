@@ -373,7 +373,7 @@ def run_replica(plan: ValidationPlan, seed: int) -> ReplicaResult:
     rng = np.random.default_rng(run_streams(seed).simulator)
     replica = plan.replica
     record = simulate_path(replica.world, replica.t, replica.truth, plan.config, rng)
-    from slamtrials.programrun import run_offline
+    from slamtrials.external import run_offline
 
     slam = run_offline(record, s.algorithm, preset=s.preset, overrides=s.overrides, program=s.program, seed=seed)
     relations = plan.relations()
@@ -457,7 +457,7 @@ def validate(
     if s.program is None:
         resolve_config(get_algorithm(s.algorithm), preset=s.preset, overrides=s.overrides)
     if reference is None:
-        from slamtrials.programrun import run_offline
+        from slamtrials.external import run_offline
 
         reference = run_offline(
             record, s.algorithm, preset=s.preset, overrides=s.overrides, program=s.program, seed=s.reference_seed

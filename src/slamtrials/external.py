@@ -1,5 +1,8 @@
-"""Running an external SLAM program over a recording: the library behind ``slamtrials slam --program``,
-``campaign replay --program`` and ``validate --program``.
+"""Running an external SLAM program over a recording: what ``slamtrials slam --program``, ``campaign
+replay --program`` and ``validate --program`` run.
+
+A layer of its own below ``io`` and ``slam`` (DESIGN.md): it writes files and starts processes, and
+``campaign`` and ``validation`` call it for runs whose SLAM is a program.
 
 :func:`run_program` writes the recording in the program's input format (odometry and laser only: no
 ground truth, no start pose, no scores; :func:`slamtrials.io.transfer.export_record` with
@@ -43,10 +46,9 @@ __all__ = [
     "run_program",
     "run_offline",
     "check_program",
-    "write_program_outputs",
+    "read_program_output",
     "time_origin_ns",
     "STDERR_LINES",
-    "PROGRAM_OUTPUT_FILES",
 ]
 
 #: Lines of the program's stderr kept with a run (the last ones).
@@ -143,6 +145,25 @@ def check_program(spec: ProgramSpec, cwd: str | Path | None = None) -> None:
         raise ConfigError(f"program {word!r} of the command not found on PATH")
 
 
+def read_program_output(path: Path, output_format: str) -> Trajectory:
+    """The trajectory a program wrote: a TUM file, or a CARMEN log's laser lines (their first pose triple;
+    a pose-only log's second, as the Freiburg tools read one), at their timestamps.
+
+    Raises
+    ------
+    FormatError
+        The file does not parse in that format (naming the line).
+    """
+    if output_format == "tum":
+        from slamtrials.io.tum import read_tum
+
+        return read_tum(path)
+    from slamtrials.io.carmen import read_carmen
+
+    laser = read_carmen(path, ranges=False).laser
+    return Trajectory(t=laser.t, poses=laser.odometry if laser.pose_only else laser.pose)
+
+
 def _tail(path: Path) -> tuple[str, ...]:
     try:
         text = path.read_text(encoding="utf-8", errors="replace")
@@ -231,9 +252,7 @@ def run_program(
     ProgramError
         The program failed, timed out, wrote nothing, or wrote a trajectory that does not parse or fit.
     """
-    from slamtrials.evaluation import read_estimate_file
     from slamtrials.io.transfer import export_record
-    from slamtrials.io.tum import read_tum
     from slamtrials.slam.estimatemap import map_of_estimate
 
     if len(record) == 0:
@@ -256,7 +275,7 @@ def run_program(
                 stderr_tail=tail,
             )
         try:
-            written = read_tum(output_path) if spec.output == "tum" else read_estimate_file(output_path)
+            written = read_program_output(output_path, spec.output)
             alignment = align_to_frames(written, record.t, record.odometry, time_shift=origin_ns * 1e-9)
         except SlamtrialsError as exc:
             problem = str(exc).replace(str(output_path), "{output}")
@@ -276,74 +295,6 @@ def run_program(
         time_origin_s=origin_ns * 1e-9,
         stderr_tail=tail,
     )
-
-
-#: Files :func:`write_program_outputs` writes, in order (``slam.json`` last).
-PROGRAM_OUTPUT_FILES = (
-    "trajectory.tum",
-    "trajectory.clf",
-    "trajectory.log",
-    "map.yaml",
-    "map.pgm",
-    "map.png",
-    "program.tum",
-    "program_stderr.txt",
-    "slam.json",
-)
-
-
-def write_program_outputs(
-    run: ProgramRun, record: RunRecord, out_dir: str | Path, *, source: str = "", overwrite: bool = False
-) -> list[Path]:
-    """Write :data:`PROGRAM_OUTPUT_FILES` into ``out_dir`` (created if needed); return the paths written.
-
-    ``trajectory.tum``, ``.clf``, ``.log`` and the map are those of ``slamtrials slam``
-    (:func:`slamtrials.slamrun.write_estimate_files`), with one pose per frame; ``program.tum`` holds
-    the poses the program wrote, in the run's time base; ``program_stderr.txt`` the last lines of its
-    stderr; ``slam.json`` the program, the command, the seed, the time origin and the pose counts.
-
-    Raises
-    ------
-    ConfigError
-        ``out_dir`` already holds SLAM outputs and ``overwrite`` is False.
-    """
-    import json
-
-    from slamtrials.atomicfile import atomic_write_text
-    from slamtrials.io.tum import write_tum
-    from slamtrials.slamrun import SLAM_FILE, write_estimate_files
-
-    out = Path(out_dir)
-    if (out / SLAM_FILE).exists() and not overwrite:
-        raise ConfigError(f"{out}: already holds SLAM outputs; choose another --out or pass --overwrite")
-    out.mkdir(parents=True, exist_ok=True)
-    per_frame = Trajectory(t=np.asarray(record.t, dtype=np.float64), poses=run.estimate)
-    written = write_estimate_files(out, record, per_frame, run.estimate, run.occupancy)
-    written.append(write_tum(out / "program.tum", run.trajectory))
-    written.append(atomic_write_text(out / "program_stderr.txt", "".join(f"{line}\n" for line in run.stderr_tail)))
-    a = run.alignment
-    summary = {
-        "algorithm": run.spec.label,
-        "program": run.spec.model_dump(mode="json"),
-        "command": run.command,
-        "seed": run.seed,
-        "input": source,
-        "frames": len(record),
-        "seconds_total": run.seconds,
-        "time_origin_s": run.time_origin_s,
-        "poses_written": a.poses_read,
-        "frames_at_a_pose": a.frames_at_pose,
-        "frames_carried_by_odometry": a.frames_carried,
-        "map": {
-            "shape": list(run.occupancy.grid.shape),
-            "resolution": run.occupancy.resolution,
-            "origin": [float(v) for v in run.occupancy.origin],
-            "drawn": "the scans at the estimated poses",
-        },
-        "trajectory_clf": "first pose triple = the estimate at each frame, second = recorded odometry",
-    }
-    written.append(atomic_write_text(out / SLAM_FILE, json.dumps(summary, indent=2) + "\n"))
-    return [Path(p) for p in written]
 
 
 def run_offline(

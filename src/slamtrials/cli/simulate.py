@@ -4,12 +4,16 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
 from slamtrials.cli.common import make_console, say_profile
 from slamtrials.errors import ConfigError
+
+if TYPE_CHECKING:
+    from slamtrials.metric.relationset import RelationSet
+    from slamtrials.record import RunRecord
 
 
 def simulate(
@@ -41,6 +45,9 @@ def simulate(
     ] = None,
 ) -> None:
     """Simulate the robot driving through WAYPOINTS (or a --tour) and record laser, odometry and ground truth.
+
+    The run folder also gets its relation set (relations.npz, drawn with the run's seed), so every
+    estimate of the run (slam, slam --program, evaluate --estimate) is scored on the same relations.
 
     Prints the error profile it simulates with (``profile: realistic`` by default) on stderr first.
     """
@@ -80,13 +87,32 @@ def simulate(
     wall = time.perf_counter() - started
     record.metadata.update(world_source=str(world), wall_time_s=round(wall, 3))
     write_run(out, record)
+    relations = record_relation_set(out, record, seed)
     save_run_figure(the_world, record, RunFolder(out).picture, title=f"{the_world.name}, seed {seed}")
     console = make_console()
     duration = float(record.t[-1] - record.t[0])
     console.print(
         f"{out}: {len(record)} frames, {duration:.1f} s simulated in {wall:.2f} s "
-        f"({duration / max(wall, 1e-9):.0f}x real time), outcome {record.metadata.get('outcome', '?')}"
+        f"({duration / max(wall, 1e-9):.0f}x real time), outcome {record.metadata.get('outcome', '?')}; "
+        f"relation set: {len(relations)} relations (seed {seed}), on which every estimate of it is scored",
+        soft_wrap=True,
+        highlight=False,
     )
+
+
+def record_relation_set(out: Path, record: RunRecord, seed: int) -> RelationSet:
+    """Draw the run's relation set (the campaign's default sampling, sized on the odometry, the run's seed)
+    and store it as the folder's ``relations.npz``, so that every estimate of the run is scored on it."""
+    from slamtrials.campaign.config import MetricSettings
+    from slamtrials.campaign.relationsetfile import write_relation_set
+    from slamtrials.campaign.score import run_relation_set
+    from slamtrials.io.runfolder import RunFolder
+
+    files = RunFolder(out)
+    files.relation_set.unlink(missing_ok=True)  # an --overwrite'n run's old set is not this run's
+    relation_set = run_relation_set(out, record, seed, MetricSettings())
+    write_relation_set(files.relation_set, relation_set)
+    return relation_set
 
 
 def register(app: typer.Typer) -> None:

@@ -126,7 +126,7 @@ def _checked(cls: Any) -> type[SlamAlgorithm]:
         raise ConfigError(
             f"SLAM algorithm class {cls.__qualname__} lacks {', '.join(missing)} (see slamtrials.slam.SlamAlgorithm)"
         )
-    name, config, presets = cls.name, cls.Config, cls.PRESETS
+    name, config, presets = (getattr(cls, member) for member in ("name", "Config", "PRESETS"))
     if not isinstance(name, str) or not name:
         raise ConfigError(f"SLAM algorithm class {cls.__qualname__}: name must be a non-empty string, got {name!r}")
     if not (isinstance(config, type) and issubclass(config, BaseModel)):

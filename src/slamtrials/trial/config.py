@@ -33,7 +33,8 @@ class SlamSettings(BaseModel):
     algorithm:
         Registry or entry-point name (``slamtrials.slam``).
     preset:
-        One of the algorithm's presets, or ``None`` for its defaults.
+        One of the algorithm's presets, or ``None`` for its defaults; when left out, ``paper`` for an
+        algorithm that has such a preset, else ``None``.
     params:
         Parameter overrides applied after the preset.
     program:
@@ -48,6 +49,19 @@ class SlamSettings(BaseModel):
     preset: str | None = Field("paper", description="preset of the algorithm, or null for its defaults")
     params: dict[str, Any] = Field(default_factory=dict, description="parameter overrides")
     program: ProgramSpec | None = Field(None, description="an external SLAM program, run offline over recorded runs")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _paper_preset_if_any(cls, data: Any) -> Any:
+        """Without a ``preset`` key: the algorithm's ``paper`` preset if it has one, else its defaults."""
+        if isinstance(data, dict) and "preset" not in data and data.get("algorithm") not in (None, "gmapping"):
+            try:
+                presets = get_algorithm(str(data["algorithm"])).PRESETS
+            except ConfigError:
+                return data  # the unknown algorithm is named later, by resolved()
+            if "paper" not in presets:
+                data = {**data, "preset": None}
+        return data
 
     @model_validator(mode="before")
     @classmethod
@@ -76,7 +90,8 @@ class SlamSettings(BaseModel):
             raise ConfigError(
                 f"slam.program ({self.program.label}) runs offline, over recorded runs: use it with "
                 "'slamtrials slam --program', 'campaign replay SOURCE --program' or 'validate --program'; "
-                "a trial explores with a registered algorithm"
+                "a program that explores online is the algorithm 'program' (slam: {algorithm: program, "
+                "params: {command: ...}})"
             )
 
 

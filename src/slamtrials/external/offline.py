@@ -1,9 +1,6 @@
 """Running an external SLAM program over a recording: what ``slamtrials slam --program``, ``campaign
 replay --program`` and ``validate --program`` run.
 
-A layer of its own below ``io`` and ``slam`` (DESIGN.md): it writes files and starts processes, and
-``campaign`` and ``validation`` call it for runs whose SLAM is a program.
-
 :func:`run_program` writes the recording in the program's input format (odometry and laser only: no
 ground truth, no start pose, no scores; :func:`slamtrials.io.transfer.export_record` with
 ``truth=False``) into a scratch folder, runs the command of its

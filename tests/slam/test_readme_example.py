@@ -17,6 +17,7 @@ from slamtrials.slam import ALGORITHMS, OdometrySlam
 from slamtrials.worlds import World
 
 GUIDE = Path(__file__).resolve().parents[2] / "docs" / "guide.md"
+EXAMPLE = GUIDE.parent / "examples" / "dead_reckoning.py"
 
 
 def _section_blocks(language: str) -> list[str]:
@@ -28,7 +29,8 @@ def _section_blocks(language: str) -> list[str]:
 @pytest.fixture
 def readme_algorithm():
     namespace: dict = {"__name__": "readme_example"}
-    exec(compile(_section_blocks("python")[0], str(GUIDE), "exec"), namespace)  # noqa: S102 - our own guide
+    assert _section_blocks("python")[0].strip() == f'--8<-- "docs/examples/{EXAMPLE.name}"'  # the guide shows it
+    exec(compile(EXAMPLE.read_text(encoding="utf-8"), str(EXAMPLE), "exec"), namespace)  # noqa: S102 - our own example
     yield namespace["DeadReckoning"]
     ALGORITHMS.pop("dead-reckoning", None)
 

@@ -52,3 +52,14 @@ def test_the_tutorial_runs_as_written(tmp_path, monkeypatch):
     assert summary["algorithm"] == "program:odometry_program.py"
     online = json.loads((tmp_path / "runs" / "online" / "run.json").read_text())
     assert online["config"]["slam"]["algorithm"] == "program"
+
+
+def test_the_readme_shows_the_tutorials_commands():
+    """The README's "Evaluate your own SLAM" commands are the tutorial's, so the test above runs them."""
+    readme = (REPO / "README.md").read_text(encoding="utf-8").split("## Evaluate your own SLAM", 1)[1]
+    block = re.findall(r"```sh\n(.*?)```", readme, flags=re.S)[0].replace("\\\n", " ")
+    shown = [shlex.split(line.split("#", 1)[0]) for line in block.splitlines() if line.startswith("slamtrials ")]
+    assert len(shown) == 4
+    run = [["slamtrials", *words] for words, _ in _commands()]
+    for words in shown:
+        assert words in run, words

@@ -6,7 +6,8 @@ are fed offline to the new algorithm, seeded like the trial's own SLAM stream (t
 estimate), and the estimate is scored on the source run's own relation set
 (:func:`~slamtrials.campaign.score.run_relation_set`), so each replayed run and its source are compared
 on the same relations. Each replayed run becomes a complete run folder of the new campaign:
-``frames.npz`` (the source frames with the new estimate), ``estimate.tum``, the new map,
+``frames.npz`` (the new estimate; the recorded frames stay in the source run folder, which ``run.json``
+names as ``frames_from``, so a replay costs no copy of them), ``estimate.tum``, the new map,
 ``relations.npz`` (the source's set) and a ``run.json`` whose ``replay`` entry names the source run
 folder, the algorithm and its configuration.
 
@@ -268,7 +269,12 @@ def replay_one(task: ReplayTask) -> RunResult:
         "metric": task.metric.model_dump(mode="json"),
         **task.extra,
     }
-    publish_run(task.campaign, task.world, task.index, lambda folder: write_scored_run(folder, record, score))
+    publish_run(
+        task.campaign,
+        task.world,
+        task.index,
+        lambda folder: write_scored_run(folder, record, score, frames_from=task.source),
+    )
     return outcome(task.world, task.index, record, score, started)
 
 

@@ -81,14 +81,15 @@ def worker_name() -> str:
     return f"{socket.gethostname()}:{os.getpid()}"
 
 
-def write_scored_run(folder: Path, record: RunRecord, score: RunScore) -> None:
-    """Write the relation set, then the run folder (``run.json`` last) into ``folder``."""
+def write_scored_run(folder: Path, record: RunRecord, score: RunScore, *, frames_from: str | None = None) -> None:
+    """Write the relation set, then the run folder (``run.json`` last) into ``folder``; ``frames_from``: the
+    run folder holding the recorded frames (a replay's source; see :func:`slamtrials.io.runfolder.write_run`)."""
     from slamtrials.campaign.relationsetfile import write_relation_set
     from slamtrials.io.layout import RunFolder
     from slamtrials.io.runfolder import write_run
 
     write_relation_set(RunFolder(folder).relation_set, score.relation_set)
-    write_run(folder, record)
+    write_run(folder, record, frames_from=frames_from)
 
 
 def outcome(task_world: str, index: int, record: RunRecord, score: RunScore, started: float) -> RunDone:

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import os
 import shlex
-import shutil
 import signal
 import subprocess
 import tempfile
@@ -53,7 +52,6 @@ STDERR_LINES = 20
 
 _INPUT_NAMES = {"carmen": "input.clf", "bag": "input.bag", "bag2": "input_bag2"}
 _OUTPUT_NAMES = {"tum": "output.tum", "carmen": "output.clf"}
-_SHELL_WORDS = {"cd", "exec", "env", "export", "set", "time", "nice", "timeout", "!", "(", "{", "if", "for", "while"}
 
 
 @dataclass(frozen=True, eq=False)
@@ -117,7 +115,7 @@ def _first_word(spec: ProgramSpec) -> str | None:
     for word in words:
         if "=" in word.split("/", 1)[0]:
             continue  # VAR=value before the program
-        return None if word in _SHELL_WORDS else word
+        return word
     return None
 
 
@@ -138,7 +136,10 @@ def check_program(spec: ProgramSpec, cwd: str | Path | None = None) -> None:
         if not path.is_file():
             raise ConfigError(f"program {word!r} of the command not found (no such file from {base})")
         return
-    if shutil.which(word) is None:
+    found = subprocess.run(  # the shell's own lookup: builtins (".", "ulimit", ...), keywords and PATH
+        ["/bin/sh", "-c", 'command -v -- "$1" >/dev/null', "sh", word], cwd=base, stdin=subprocess.DEVNULL
+    )
+    if found.returncode != 0:
         raise ConfigError(f"program {word!r} of the command not found on PATH")
 
 

@@ -7,6 +7,8 @@ as ``estimate.tum``, and ``online`` float64 [T, 3] (what the algorithm returned 
 ``run.json`` holds the laser geometry, the run's metadata (world, seed, drawn odometry bias, outcome,
 timings, resolved config) and the versions that produced it.
 A run with a final SLAM map also has ``map.yaml`` + ``map.pgm`` (ROS map_server) and ``map.png``.
+A replayed run refers to its source run's frames instead of copying them: its ``frames.npz`` holds
+``t`` and the estimates, and ``run.json`` names the source (``frames_from``).
 
 Every file is written atomically and ``run.json`` is written last, so a folder with a ``run.json`` is a
 complete run; a crash mid-write leaves a folder that :func:`read_run` rejects rather than misreads.
@@ -16,6 +18,7 @@ from __future__ import annotations
 
 import io
 import json
+import os
 import platform
 import zipfile
 import zlib
@@ -33,7 +36,10 @@ from slamtrials.io.mapfile import read_map, write_map, write_map_png
 from slamtrials.io.tum import write_tum
 from slamtrials.record import LaserGeometry, RunRecord, Trajectory
 
-__all__ = ["write_run", "read_run", "RunFolder", "RUN_FORMAT", "RUN_FORMATS_READ"]
+__all__ = ["write_run", "read_run", "RunFolder", "RUN_FORMAT", "RUN_FORMATS_READ", "FRAMES_FROM"]
+
+#: ``run.json`` key of a replayed run: where its recorded frames are (``{"path": relative, "absolute": ...}``).
+FRAMES_FROM = "frames_from"
 
 #: Format tag of run.json as written now. Version 2 (this one): the trial config's ``explore`` section
 #: holds no robot fields (they are ``sim.robot``'s) and ``campaign.metric`` the whole sampling rule.
@@ -70,17 +76,27 @@ def json_default(value: Any) -> Any:
     raise TypeError(f"cannot store {type(value).__name__} as JSON")
 
 
-def write_run(folder: str | Path, record: RunRecord) -> Path:
+def write_run(folder: str | Path, record: RunRecord, *, frames_from: str | Path | None = None) -> Path:
     """Write ``record`` as a run folder (created if needed) and return the folder's path.
 
     ``frames.npz`` is compressed; ``run.json`` is written last and marks the run complete. An existing
     run in ``folder`` is replaced file by file, each replacement atomic.
+
+    ``frames_from``: the run folder that already holds ``record``'s recorded frames (a replay's source
+    run). ``frames.npz`` then holds only ``t`` and the estimates, and ``run.json`` names that folder
+    (relative to this one, and absolute) under :data:`FRAMES_FROM`; :func:`read_run` reads the frames
+    from there. The source must hold the same times as ``record``.
     """
     files = RunFolder(folder)
     folder = files.path
     folder.mkdir(parents=True, exist_ok=True)
     files.run_json.unlink(missing_ok=True)  # the folder is incomplete until run.json is back
     arrays = {name: np.asarray(getattr(record, name), dtype=dtype) for name, (dtype, _) in _ARRAYS.items()}
+    reference = None
+    if frames_from is not None:
+        source = Path(frames_from).absolute()
+        reference = {"path": os.path.relpath(source, folder.absolute()), "absolute": str(source)}
+        arrays = {"t": arrays["t"]}
     if record.estimate is not None:
         arrays["estimate"] = np.asarray(record.estimate, dtype=np.float64).reshape(len(record), 3)
         write_tum(files.estimate, Trajectory(t=arrays["t"], poses=arrays["estimate"]))
@@ -109,8 +125,10 @@ def write_run(folder: str | Path, record: RunRecord) -> Path:
         "frames": len(record),
         "beams": int(record.scans.shape[1]) if record.scans.ndim == 2 else 0,
         "laser": record.laser.to_dict(),
-        **record.metadata,
+        **{k: v for k, v in record.metadata.items() if k != FRAMES_FROM},
     }
+    if reference is not None:
+        doc[FRAMES_FROM] = reference
     atomic_write_text(files.run_json, json.dumps(doc, indent=2, default=json_default) + "\n")
     return folder
 
@@ -135,14 +153,53 @@ def _read_run_json(path: Path) -> dict[str, Any]:
     return doc
 
 
-def _read_frames(path: Path) -> dict[str, np.ndarray]:
+def _load_npz(path: Path) -> dict[str, np.ndarray]:
     if not path.is_file():
         raise FormatError(path, "missing: every run folder has frames.npz")
     try:
         with np.load(path, allow_pickle=False) as npz:
-            arrays = {name: npz[name] for name in npz.files if name in _ARRAYS or name in _ESTIMATES}
+            return {name: npz[name] for name in npz.files if name in _ARRAYS or name in _ESTIMATES}
     except (zipfile.BadZipFile, zlib.error, ValueError, OSError, EOFError, io.UnsupportedOperation) as exc:
         raise FormatError(path, f"not a readable .npz archive ({exc})") from None
+
+
+def _source_folder(files: RunFolder, reference: Any) -> Path:
+    """The folder a replay's ``frames_from`` names: relative to the run folder, else the absolute path."""
+    if not isinstance(reference, dict) or not isinstance(reference.get("path"), str):
+        raise FormatError(files.run_json, f"field '{FRAMES_FROM}' must be an object with a 'path'")
+    for candidate in (files.path / reference["path"], Path(str(reference.get("absolute", "")))):
+        if str(candidate) and RunFolder(candidate).is_complete():
+            return candidate.resolve()
+    raise FormatError(
+        files.run_json,
+        f"its recorded frames are those of the run {reference.get('absolute') or reference['path']}, which is not "
+        "there any more (moved or deleted?): a replayed run needs its source campaign beside it",
+    )
+
+
+def _recorded_frames(files: RunFolder, doc: dict[str, Any], depth: int = 0) -> dict[str, np.ndarray]:
+    """The recorded arrays of a run folder: its own ``frames.npz``, or its source's for a replayed run."""
+    arrays = _load_npz(files.frames)
+    reference = doc.get(FRAMES_FROM)
+    if reference is None:
+        return _checked_frames(files.frames, arrays)
+    if depth > 16:
+        raise FormatError(files.run_json, f"'{FRAMES_FROM}' references go on for more than 16 runs")
+    source = RunFolder(_source_folder(files, reference))
+    recorded = _recorded_frames(source, _read_run_json(source.run_json), depth + 1)
+    if "t" not in arrays or not np.array_equal(arrays["t"], recorded["t"]):
+        raise FormatError(
+            files.frames,
+            f"its times are not those of its source run {source.path}: the source changed since the replay",
+        )
+    recorded = {k: v for k, v in recorded.items() if k not in _ESTIMATES}
+    for name in _ESTIMATES:
+        if name in arrays:
+            recorded[name] = arrays[name]
+    return _checked_frames(files.frames, recorded)
+
+
+def _checked_frames(path: Path, arrays: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     for name, (dtype, last) in _ARRAYS.items():
         if name not in arrays:
             raise FormatError(path, f"array '{name}' is missing")
@@ -176,13 +233,13 @@ def read_run(folder: str | Path) -> RunRecord:
     if not folder.is_dir():
         raise FormatError(folder, "not a run folder (no such directory)")
     doc = _read_run_json(files.run_json)
-    arrays = _read_frames(files.frames)
+    arrays = _recorded_frames(files, doc)
     if arrays["scans"].shape[1] != doc.get("beams", arrays["scans"].shape[1]):
         raise FormatError(files.run_json, f"says {doc['beams']} beams but frames.npz has {arrays['scans'].shape[1]}")
     try:
         laser = LaserGeometry.from_dict(doc.pop("laser"))
     except ValueError as exc:
         raise FormatError(files.run_json, f"field 'laser': {exc}") from None
-    metadata = {k: v for k, v in doc.items() if k not in ("format", "frames", "beams")}
+    metadata = {k: v for k, v in doc.items() if k not in ("format", "frames", "beams", FRAMES_FROM)}
     slam_map = read_map(files.map) if files.map.is_file() else None
     return RunRecord(**arrays, laser=laser, metadata=metadata, map=slam_map)

@@ -40,7 +40,8 @@ __all__ = [
 
 #: The placeholders a command may hold: ``{input}`` (the recording written for the program),
 #: ``{output}`` (where it writes its trajectory), ``{seed}`` (the run's seed) and ``{workdir}`` (an
-#: empty scratch folder, also the command's working directory).
+#: empty scratch folder for the program's own files; the command runs in the folder slamtrials was
+#: started in, so relative paths in it mean what they mean there).
 PLACEHOLDERS = ("input", "output", "seed", "workdir")
 
 #: Words that start a program rather than name it (the label takes the next word).
@@ -60,9 +61,9 @@ class ProgramSpec(BaseModel):
     Attributes
     ----------
     command:
-        Shell command template (run by ``/bin/sh -c`` in an empty scratch folder, stdin closed). It
-        must hold ``{input}`` and ``{output}``, and may hold ``{seed}`` and ``{workdir}``; each is
-        replaced by a shell-quoted value. Write ``{{`` and ``}}`` for literal braces.
+        Shell command template (run by ``/bin/sh -c`` in the folder slamtrials was started in, stdin
+        closed). It must hold ``{input}`` and ``{output}``, and may hold ``{seed}`` and ``{workdir}``;
+        each is replaced by a shell-quoted value. Write ``{{`` and ``}}`` for literal braces.
     input:
         The format slamtrials writes the recording in: ``carmen`` (a CARMEN log, ROBOTLASER1 and ODOM
         lines, odometry in both pose triples), ``bag`` (ROS 1) or ``bag2`` (ROS 2, MCAP). No ground
@@ -115,7 +116,11 @@ class ProgramSpec(BaseModel):
         named = [w for w in words if "=" not in w.split("/", 1)[0] and not w.startswith("-")]
         while len(named) > 1 and named[0].rsplit("/", 1)[-1].rstrip("0123456789.") in _INTERPRETERS:
             named = named[1:]
-        return "program:" + (named[0].rsplit("/", 1)[-1] if named else "program")
+        if not named:
+            return "program:program"
+        if any(c.isspace() for c in named[0]):  # sh -c '<script>': the interpreter names it
+            return "program:" + words[0].rsplit("/", 1)[-1]
+        return "program:" + named[0].rsplit("/", 1)[-1]
 
     def command_for(self, *, input: str, output: str, seed: int, workdir: str) -> str:
         """The command with every placeholder replaced by its shell-quoted value."""

@@ -376,9 +376,11 @@ def evaluate_run(
         Matching options. The run's odometry carries ground-truth timestamps without an
         estimated pose within ``tolerance`` (default 1 ms: the same frame) to the nearest estimated pose.
     write:
-        Write ``relations.txt`` and ``errors.npz``: into ``out``, by default a new folder
-        ``evaluations/<name>`` of the run (``<name>`` the estimate file's stem, ``estimate`` or
+        Write ``errors.npz`` (and, for relations sampled afresh, ``relations.txt``): into ``out``, by
+        default ``evaluations/<name>`` of the run (``<name>`` the estimate file's stem, ``estimate`` or
         ``odometry``), never over the run's own files (a campaign's relations stay as they were scored).
+        Scored on the run's own relation set, the same estimate's folder is replaced (the relations are
+        ``relations.npz``: no text copy); sampled afresh, a new folder ``<name>-2``, ``-3`` ... is made.
     out:
         Folder to write them into (created); it must not hold them already.
 
@@ -450,17 +452,27 @@ def evaluate_run(
         if estimate is not None
         else ("estimate" if record.estimate is not None else "odometry")
     )
-    target = RunFolder(Path(out) if out is not None else files.new_evaluation(name or "estimate"))
+    name = name or "estimate"
+    if out is not None:
+        target = RunFolder(Path(out))
+    elif stored:  # the result is a function of the estimate and the stored set: one folder per estimate
+        target = RunFolder(files.evaluations / name)
+    else:
+        target = RunFolder(files.new_evaluation(name))
     relations_path = target.relations
     if write:
-        if relations_path.exists():
-            raise ConfigError(f"{target.path}: already holds relations.txt; choose another --out")
-        written = (
-            write_relations(relations_path, relations),
-            write_errors(target.errors, relations, errors),
-        )
+        if out is not None and (target.relations.exists() or target.errors.exists()):
+            raise ConfigError(f"{target.path}: already holds an evaluation (errors.npz); choose another --out")
+        if stored:  # the relations are the run's relations.npz: no text copy of them
+            written = (write_errors(target.errors, relations, errors),)
+        else:
+            written = (
+                write_relations(relations_path, relations),
+                write_errors(target.errors, relations, errors),
+            )
     trans, rot = _summaries(errors)
-    label = f"{relations_path} ({drawn})" if write else drawn
+    as_text = write and not stored
+    label = f"{relations_path} ({drawn})" if as_text else drawn
     return EvaluationResult(
         relations,
         errors,
@@ -470,7 +482,7 @@ def evaluate_run(
         label,
         tolerance,
         sampled,
-        relations_path if write else None,
+        relations_path if as_text else None,
         written,
     )
 

@@ -153,7 +153,7 @@ def test_run_folder_samples_relations_and_writes_them(tmp_path):
     chosen = runner.invoke(app, ["evaluate", str(folder), "--seed", "3", "--out", str(tmp_path / "mine")])
     assert chosen.exit_code == 0 and (tmp_path / "mine" / "relations.txt").is_file()
     taken = runner.invoke(app, ["evaluate", str(folder), "--seed", "3", "--out", str(tmp_path / "mine")])
-    assert taken.exit_code == 2 and "already holds relations.txt" in taken.output
+    assert taken.exit_code == 2 and "already holds an evaluation" in taken.output
 
 
 def test_run_folder_is_scored_on_its_own_relation_set(tmp_path):
@@ -180,8 +180,12 @@ def test_run_folder_is_scored_on_its_own_relation_set(tmp_path):
     result = runner.invoke(app, ["evaluate", str(folder), "--estimate", str(other)])
     trans, _ = _summary_rows(result.output)
     assert trans[4] == len(score.relation_set) and trans[0] == pytest.approx(score.odometry.eps_t, abs=1e-6)
-    relations = read_relations(folder / "evaluations" / "other" / "relations.txt")
-    np.testing.assert_array_equal(relations.t1, record.t[score.relation_set.first])
+    # written: the errors on the run's own set, no text copy of its relations; again: the same folder
+    assert not (folder / "evaluations" / "other" / "relations.txt").exists()
+    with np.load(folder / "evaluations" / "other" / "errors.npz") as npz:
+        assert len(npz["translational"]) == len(score.relation_set)
+    again = runner.invoke(app, ["evaluate", str(folder), "--estimate", str(other)])
+    assert again.exit_code == 0 and sorted(p.name for p in (folder / "evaluations").iterdir()) == ["estimate", "other"]
     # asking for a sampling draws afresh
     fresh = runner.invoke(app, ["evaluate", str(folder), "--seed", "6"])
     assert "sampling:  pilot 500 pairs" in fresh.output and "precise rule" in fresh.output

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import io
 import logging
+import math
 from dataclasses import dataclass
 from enum import Enum
 from pathlib import Path
@@ -159,6 +160,17 @@ def _read_trajectory(path: Path, triple: PoseTriple, what: str) -> _Source:
     return _Source(trajectory, path, "tum", f"{path} (TUM, {len(trajectory)} poses)")
 
 
+def _shifted(source: _Source, time_offset: float) -> _Source:
+    """``source`` with ``time_offset`` seconds subtracted from its times (another time base's origin)."""
+    if not time_offset:
+        return source
+    if not math.isfinite(time_offset):
+        raise ConfigError(f"--time-offset must be a finite number of seconds, got {time_offset}")
+    moved = Trajectory(t=source.trajectory.t - float(time_offset), poses=source.trajectory.poses)
+    label = f"{source.label}, times minus {time_offset:g} s"
+    return _Source(moved, source.path, source.kind, label, source.line_name)
+
+
 def read_estimate_file(path: str | Path, triple: PoseTriple = PoseTriple.auto) -> Trajectory:
     """An estimated trajectory from a TUM file or a CARMEN log (its laser lines' pose triple ``triple``:
     by default the first, or the second of a pose-only log, as ``slamtrials evaluate --estimate`` reads it).
@@ -201,10 +213,14 @@ def _check_covers(source: _Source, run_t, run: Path, tolerance: float) -> None:
     t = source.trajectory.t
     if len(t) == 0 or t[0] > run_t[0] + tolerance or t[-1] < run_t[-1] - tolerance:
         span = f"{float(t[0])!r} to {float(t[-1])!r} s" if len(t) else "no poses"
+        shift = float(t[0] - run_t[0]) if len(t) else 0.0
+        hint = ""
+        if len(t) and abs(float(t[-1] - run_t[-1]) - shift) <= tolerance + 1e-9:
+            hint = f" (or written in another time base: --time-offset {shift:g})"
         raise FormatError(
             source.path,
             f"its poses span {span} but the run {run} spans {float(run_t[0])!r} to {float(run_t[-1])!r} s: "
-            "not an estimate of this run",
+            f"not an estimate of this run{hint}",
         )
 
 
@@ -290,6 +306,7 @@ def evaluate_files(
     interpolate: bool = False,
     squared: bool = False,
     allow_outside: bool = False,
+    time_offset: float = 0.0,
 ) -> EvaluationResult:
     """Evaluate an estimated trajectory file against a relations file (a real dataset).
 
@@ -307,6 +324,9 @@ def evaluate_files(
         Which pose triple of a CARMEN estimate to use (:class:`PoseTriple`; ``auto`` by default).
     tolerance, interpolate, squared, allow_outside:
         See :func:`slamtrials.metric.evaluate_relations`.
+    time_offset:
+        Seconds subtracted from the estimate's times (a program that wrote them in another time base,
+        e.g. a bag exported from 1 s on).
 
     Raises
     ------
@@ -317,7 +337,7 @@ def evaluate_files(
     from slamtrials.io.relations import read_relations
     from slamtrials.metric import evaluate_relations
 
-    estimate_source = _read_trajectory(Path(estimate), estimate_pose, "estimate")
+    estimate_source = _shifted(_read_trajectory(Path(estimate), estimate_pose, "estimate"), time_offset)
     sources = {"estimate": estimate_source}
     if odometry is not None:
         sources["odometry"] = _read_trajectory(Path(odometry), PoseTriple.second, "odometry")
@@ -355,6 +375,7 @@ def evaluate_run(
     interpolate: bool = False,
     write: bool = True,
     out: Path | None = None,
+    time_offset: float = 0.0,
 ) -> EvaluationResult:
     """Evaluate a run folder's estimate on the run's relation set, or on relations sampled from its truth.
 
@@ -383,6 +404,9 @@ def evaluate_run(
         ``relations.npz``: no text copy); sampled afresh, a new folder ``<name>-2``, ``-3`` ... is made.
     out:
         Folder to write them into (created); it must not hold them already.
+    time_offset:
+        Seconds subtracted from an estimate file's times (``slamtrials export`` writes a simulated run's
+        bag from 1 s on: an estimate in the bag's time base needs 1).
 
     Raises
     ------
@@ -408,7 +432,7 @@ def evaluate_run(
     if estimate is None and files.estimate.is_file():
         estimate = files.estimate
     if estimate is not None:
-        source = _read_trajectory(Path(estimate), estimate_pose, "estimate")
+        source = _shifted(_read_trajectory(Path(estimate), estimate_pose, "estimate"), time_offset)
         _check_covers(source, record.t, run, tolerance)
         _check_turns(source, odometry, run)
     elif record.estimate is not None:

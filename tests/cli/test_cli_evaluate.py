@@ -333,3 +333,18 @@ def test_the_estimate_of_another_run_of_the_same_length_is_refused(tmp_path, dri
     own = tmp_path / "run000.tum"
     write_tum(own, Trajectory(t=t, poses=truth))
     assert runner.invoke(app, ["evaluate", str(folder), "--estimate", str(own)]).exit_code == 0
+
+
+def test_an_estimate_in_another_time_base_is_mapped_by_time_offset(tmp_path):
+    """A program run by hand on an exported bag writes times from 1 s on: refused with the offset named,
+    and scored once --time-offset takes it away."""
+    folder, record = _run(tmp_path)
+    shifted = tmp_path / "bag_time.tum"
+    write_tum(shifted, Trajectory(t=record.t + 1.0, poses=record.truth))
+    refused = runner.invoke(app, ["evaluate", str(folder), "--estimate", str(shifted), "--seed", "1"])
+    assert refused.exit_code == 2 and "--time-offset 1" in refused.output
+    done = runner.invoke(
+        app, ["evaluate", str(folder), "--estimate", str(shifted), "--seed", "1", "--time-offset", "1"]
+    )
+    assert done.exit_code == 0, done.output
+    assert "times minus 1 s" in done.output and _summary_rows(done.output)[0][0] < 1e-9

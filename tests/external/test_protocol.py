@@ -272,10 +272,6 @@ def test_a_trajectory_row_at_another_time_is_named():
     assert "0.30000000000000004" in message, message
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="bug: parse_trajectory formats numpy scalars with !r, so numpy 2 writes 'np.float64(0.3)' in the message",
-)
 def test_the_row_at_another_time_is_named_with_plain_numbers():
     rows = [[t, 0, 0, 0] for t in TIMES.tolist()]
     rows[3][0] = 0.3

@@ -57,6 +57,13 @@ def evaluate(
             help="Pose triple of a CARMEN estimate: first (laser pose, e.g. SLAM-corrected; slamtrials' trajectory.clf) or second (raw odometry; what the Freiburg metricEvaluator reads). auto: second for a pose-only log (FLASER 0 lines, a Freiburg-style test log), else first.",
         ),
     ] = PoseTriple.auto,
+    time_offset: Annotated[
+        float,
+        typer.Option(
+            "--time-offset",
+            help="Seconds subtracted from the estimate's times: an estimate written in another time base (a bag from 'slamtrials export' of a simulated run starts at 1 s: --time-offset 1).",
+        ),
+    ] = 0.0,
     tolerance: Annotated[
         float | None,
         typer.Option(
@@ -82,7 +89,7 @@ def evaluate(
         typer.Option(
             "--out",
             "-o",
-            help="RUN: folder for relations.txt and errors.npz (default: a new RUN/evaluations/<name>/; the run's own files are never overwritten).",
+            help="RUN: folder for errors.npz, and relations.txt for relations sampled afresh (default: RUN/evaluations/<name>/; the run's own files are never overwritten).",
         ),
     ] = None,
     errors_out: Annotated[
@@ -169,6 +176,7 @@ def evaluate(
             tolerance=tolerance,
             interpolate=interpolate,
             out=out,
+            time_offset=time_offset,
         )
     else:
         if out is not None:
@@ -184,6 +192,7 @@ def evaluate(
             interpolate=interpolate,
             squared=squared,
             allow_outside=allow_outside,
+            time_offset=time_offset,
         )
     if errors_out is not None:
         written = write_errors(errors_out, result.relations, result.errors)

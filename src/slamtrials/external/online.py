@@ -63,7 +63,11 @@ class OnlineProgramConfig(BaseModel):
 class _Process:
     """The running program: its stdin, a line reader on its stdout with a timeout, its stderr file."""
 
-    def __init__(self, command: str):
+    #: Seconds between looks at whether the program has exited while its reply is awaited.
+    POLL = 0.2
+
+    def __init__(self, command: str, timeout: float):
+        self.timeout = timeout
         self.scratch = tempfile.TemporaryDirectory(prefix="slamtrials-online-")
         self.err_path = Path(self.scratch.name) / "stderr.txt"
         with open(self.err_path, "wb") as stderr:
@@ -84,25 +88,34 @@ class _Process:
             return ()
         return tuple(line.rstrip() for line in text.splitlines() if line.strip())[-20:]
 
-    def fail(self, problem: str) -> ProgramError:
-        code = self.popen.poll()
+    def fail(self, problem: str, code: int | None = None) -> ProgramError:
+        """The ProgramError of ``problem`` with the end of its stderr; the process group is killed."""
         tail = self.tail()
         said = f"; its stderr ends: {' | '.join(tail[-3:])}" if tail else ""
         self.close()
         return ProgramError(f"{problem}{said}", exit_code=code, stderr_tail=tail)
+
+    def _status(self) -> int | None:
+        """The exit status once the program has exited (within the reply timeout), else None."""
+        try:
+            return self.popen.wait(timeout=self.timeout)
+        except subprocess.TimeoutExpired:
+            return None
 
     def send(self, line: bytes, what: str) -> None:
         try:
             assert self.popen.stdin is not None
             self.popen.stdin.write(line)
             self.popen.stdin.flush()
-        except (BrokenPipeError, OSError):
-            raise self.fail(f"the program exited before {what} (status {self.popen.wait()})") from None
+        except (OSError, ValueError):  # a broken pipe, or a stream already closed
+            code = self._status()
+            raise self.fail(f"the program exited before {what} (status {code})", code) from None
 
-    def receive(self, timeout: float, what: str) -> bytes:
+    def receive(self, what: str) -> bytes:
+        """The next line of its stdout, within the reply timeout."""
         assert self.popen.stdout is not None
         fd = self.popen.stdout.fileno()
-        deadline = time.monotonic() + timeout
+        deadline = time.monotonic() + self.timeout
         while True:
             end = self._buffer.find(b"\n")
             if end >= 0:
@@ -111,28 +124,31 @@ class _Process:
                 return line
             remaining = deadline - time.monotonic()
             if remaining <= 0:
-                raise self.fail(f"the program did not answer {what} within {timeout:g} s")
-            ready, _, _ = select.select([fd], [], [], remaining)
+                raise self.fail(f"the program did not answer {what} within {self.timeout:g} s")
+            ready, _, _ = select.select([fd], [], [], min(remaining, self.POLL))
             if not ready:
+                code = self.popen.poll()  # exited, though a child of its may hold its stdout open
+                if code is not None:
+                    raise self.fail(f"the program exited before answering {what} (status {code})", code)
                 continue
             chunk = os.read(fd, 1 << 16)
             if not chunk:
-                raise self.fail(f"the program exited before answering {what} (status {self.popen.wait()})")
+                code = self._status()
+                raise self.fail(f"the program exited before answering {what} (status {code})", code)
             self._buffer += chunk
 
-    def finish(self, timeout: float) -> None:
+    def finish(self) -> None:
         """Close its stdin and wait for a zero exit status."""
         try:
             assert self.popen.stdin is not None
             self.popen.stdin.close()
         except OSError:
             pass
-        try:
-            code = self.popen.wait(timeout=timeout)
-        except subprocess.TimeoutExpired:
-            raise self.fail(f"the program did not exit within {timeout:g} s of the end") from None
+        code = self._status()
+        if code is None:
+            raise self.fail(f"the program did not exit within {self.timeout:g} s of the end")
         if code != 0:
-            raise self.fail(f"the program exited with status {code} at the end")
+            raise self.fail(f"the program exited with status {code} at the end", code)
         self.close()
 
     def close(self) -> None:
@@ -140,12 +156,12 @@ class _Process:
 
 
 def _kill_group(popen: subprocess.Popen, scratch: tempfile.TemporaryDirectory) -> None:
-    if popen.poll() is None:
-        try:
-            os.killpg(popen.pid, signal.SIGKILL)
-        except (ProcessLookupError, PermissionError):
-            pass
-        popen.wait()
+    """Kill the program's whole process group (children that outlived it too) and remove its scratch."""
+    try:
+        os.killpg(popen.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+    popen.wait()
     for stream in (popen.stdin, popen.stdout):
         try:
             if stream is not None:
@@ -171,17 +187,18 @@ class OnlineProgram:
     PRESETS: dict[str, dict[str, Any]] = {}
 
     def __init__(self, config: OnlineProgramConfig, laser: LaserGeometry):
-        if not config.command.strip():
-            raise ConfigError("slam.params.command: the program algorithm needs the command that starts it")
+        self.check_config(config)
         self.config = config
         self.laser = laser
         self._process: _Process | None = None
+        self._failure: ProgramError | None = None
         self.updates = 0
 
     def reset(self, rng: np.random.Generator) -> None:
         """Start the program afresh and send it ``start`` (its seed from ``rng``'s state, not a draw)."""
         if self._process is not None:
             self._process.close()
+        self._failure = None
         self._rng_state = rng.bit_generator.state
         self._seed = int(self._rng_state.get("state", {}).get("state", 0)) & 0xFFFFFFFF
         self._process = None
@@ -193,11 +210,49 @@ class OnlineProgram:
         self._final: Trajectory | None = None
         self.updates = 0
 
+    @classmethod
+    def check_config(cls, config: OnlineProgramConfig) -> None:
+        """Refuse a config without a command (called when a trial or campaign config is read)."""
+        if not config.command.strip():
+            raise ConfigError("params.command: the algorithm 'program' needs the command that starts the program")
+
     def _started(self, beams: int) -> _Process:
+        if self._failure is not None:
+            raise ProgramError(f"the program failed earlier ({self._failure}); reset() starts it again")
         if self._process is None:
-            self._process = _Process(self.config.command)
-            self._process.send(protocol.start_message(self.laser, beams, self._seed, self._rng_state), "start")
+            self._process = _Process(self.config.command, self.config.reply_timeout)
+            self._exchange(
+                lambda p: p.send(protocol.start_message(self.laser, beams, self._seed, self._rng_state), "start")
+            )
         return self._process
+
+    def _exchange(self, talk):
+        """Run ``talk(process)``; a ProgramError ends the program for good (until :meth:`reset`)."""
+        process = self._process
+        assert process is not None
+        try:
+            return talk(process)
+        except ProgramError as exc:
+            self._process, self._failure = None, exc
+            process.close()
+            raise
+
+    def _ask(self, line: bytes, what: str) -> dict[str, Any]:
+        """Send ``line``, read the reply and check it; a broken reply kills the program."""
+
+        def talk(process: _Process) -> dict[str, Any]:
+            process.send(line, what)
+            answer = process.receive(what)
+            try:
+                return protocol.parse_reply(answer, what)
+            except ProgramError as exc:
+                raise process.fail(str(exc)) from None
+
+        return self._exchange(talk)
+
+    def _checked(self, check):
+        """``check()``, a ProgramError from it killing the program."""
+        return self._exchange(lambda process: _or_fail(process, check))
 
     def process(self, frame: Reading) -> NDArray[np.float64]:
         """Send the frame; return the pose the program answers (map frame)."""
@@ -205,20 +260,19 @@ class OnlineProgram:
             raise ProgramError("the program's run has ended (trajectory() was read); reset() starts another")
         index = len(self._t)
         ranges = np.asarray(frame.ranges)
-        process = self._started(int(ranges.shape[0]))
+        self._started(int(ranges.shape[0]))
         what = f"frame {index}"
-        process.send(protocol.frame_message(index, frame), what)
-        try:
-            reply = protocol.parse_reply(process.receive(self.config.reply_timeout, what), what)
+        reply = self._ask(protocol.frame_message(index, frame), what)
+
+        def read() -> NDArray[np.float64]:
             pose = protocol.parse_pose(reply, what)
             if reply.get("map") is not None:
                 self._map = protocol.parse_map(reply["map"], what)
             if "updates" in reply:
                 self.updates = _count(reply["updates"], what)
-        except ProgramError as exc:
-            if exc.stderr_tail or self._process is None:
-                raise
-            raise process.fail(str(exc)) from None
+            return pose
+
+        pose = self._checked(read)
         self._t.append(float(frame.t))
         self._poses.append(pose)
         if self._map is None:
@@ -242,22 +296,25 @@ class OnlineProgram:
         """The final estimate of every frame: sends ``end`` once and reads the program's answer."""
         if self._final is not None:
             return self._final
+        if self._failure is not None:
+            raise ProgramError(f"the program failed earlier ({self._failure}); reset() starts it again")
         t = np.array(self._t, dtype=np.float64)
         poses = np.array(self._poses, dtype=np.float64).reshape(-1, 3)
         if self._process is None:
             self._final = Trajectory(t=t, poses=poses)
             return self._final
-        process = self._process
-        process.send(protocol.END_MESSAGE, "end")
-        reply = protocol.parse_reply(process.receive(self.config.reply_timeout, "end"), "end")
-        try:
+        reply = self._ask(protocol.END_MESSAGE, "end")
+
+        def read() -> NDArray[np.float64]:
+            final = poses
             if reply.get("trajectory") is not None:
-                poses = protocol.parse_trajectory(reply["trajectory"], t)
+                final = protocol.parse_trajectory(reply["trajectory"], t)
             if reply.get("map") is not None:
                 self._map = protocol.parse_map(reply["map"], "end")
-        except ProgramError as exc:
-            raise process.fail(str(exc)) from None
-        process.finish(self.config.reply_timeout)
+            return final
+
+        poses = self._checked(read)
+        self._exchange(lambda process: process.finish())
         self._process = None
         self._final = Trajectory(t=t, poses=poses)
         return self._final
@@ -267,3 +324,10 @@ def _count(value: Any, what: str) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or value < 0:
         raise ProgramError(f'protocol: "updates" in the reply to {what} must be a count, got {value!r}')
     return value
+
+
+def _or_fail(process: _Process, check):
+    try:
+        return check()
+    except ProgramError as exc:
+        raise process.fail(str(exc)) from None

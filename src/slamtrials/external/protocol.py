@@ -175,6 +175,6 @@ def parse_trajectory(doc: Any, times: NDArray[np.float64]) -> NDArray[np.float64
     if not np.array_equal(rows[:, 0], times):
         k = int(np.argmax(rows[:, 0] != times))
         raise ProgramError(
-            f"protocol: the end reply's trajectory row {k} has t = {rows[k, 0]!r}, frame {k} is at {times[k]!r}"
+            f"protocol: the end reply's trajectory row {k} has t = {float(rows[k, 0])!r}, frame {k} is at {float(times[k])!r}"
         )
     return np.ascontiguousarray(rows[:, 1:])

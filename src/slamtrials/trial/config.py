@@ -82,7 +82,12 @@ class SlamSettings(BaseModel):
         """The algorithm's validated config, or the program (raises :class:`ConfigError` naming the bad parameter)."""
         if self.program is not None:
             return self.program
-        return resolve_config(get_algorithm(self.algorithm), preset=self.preset, overrides=self.params)
+        cls = get_algorithm(self.algorithm)
+        config = resolve_config(cls, preset=self.preset, overrides=self.params)
+        check = getattr(cls, "check_config", None)  # an algorithm's own checks across its parameters
+        if callable(check):
+            check(config)
+        return config
 
     def check_online(self) -> None:
         """Raise :class:`ConfigError` for a program: it runs over recorded runs only, not in a trial."""

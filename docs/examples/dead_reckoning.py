@@ -18,18 +18,18 @@ class DeadReckoning:
     PRESETS = {"coarse": {"resolution": 0.2}}
 
     class Config(BaseModel):
-        resolution: float = Field(0.05, gt=0.0, le=1.0)   # map cell size (m)
+        resolution: float = Field(0.05, gt=0.0, le=1.0)  # map cell size (m)
         occ_thresh: float = Field(0.25, ge=0.0, lt=1.0)
 
     def __init__(self, config, laser):
-        self.config, self.laser = config, laser           # laser: a LaserGeometry (angles, ranges, mount)
+        self.config, self.laser = config, laser  # laser: a LaserGeometry (angles, ranges, mount)
 
     def reset(self, rng):
         self.updates, self.times, self.poses = 0, [], []
         self.map = GridMap(self.config.resolution)
 
     def process(self, frame):
-        pose = np.asarray(frame.odometry, dtype=float)   # the odometry frame is the map frame
+        pose = np.asarray(frame.odometry, dtype=float)  # the odometry frame is the map frame
         self.map.integrate_frame(pose, frame.ranges, self.laser)
         self.updates += 1
         self.times.append(frame.t)

@@ -9,7 +9,9 @@ one (every ``map_update_interval`` seconds, as slam_gmapping does). The argument
 """
 
 import json
+import os
 import sys
+import time
 
 import numpy as np
 
@@ -19,6 +21,7 @@ from slamtrials.slam import get_algorithm, resolve_config
 
 
 def main(preset: str | None) -> None:
+    spent = 0.0  # seconds inside GMapping, written to $ONLINE_GMAPPING_SECONDS at the end if set (benchmarks)
     slam = None
     sent = None  # the map object last sent: GMapping publishes a new one every map_update_interval seconds
     for line in sys.stdin:
@@ -42,7 +45,9 @@ def main(preset: str | None) -> None:
         if kind == "frame":
             ranges = decode_ranges(message["ranges"])
             reading = Reading(t=message["t"], ranges=ranges, odometry=np.array(message["odometry"], dtype=np.float64))
+            started = time.perf_counter()
             pose = slam.process(reading)
+            spent += time.perf_counter() - started
             reply = {"pose": [float(v) for v in pose], "updates": int(slam.updates)}
             grid = slam.occupancy()
             if grid is not sent and grid.grid.size:
@@ -57,6 +62,9 @@ def main(preset: str | None) -> None:
         sys.stdout.write(json.dumps(reply) + "\n")
         sys.stdout.flush()
         if kind == "end":
+            if os.environ.get("ONLINE_GMAPPING_SECONDS"):
+                with open(os.environ["ONLINE_GMAPPING_SECONDS"], "w") as out:
+                    out.write(f"{spent!r}\n")
             return
 
 

@@ -51,7 +51,7 @@ def _invoke(*args):
 @pytest.mark.parametrize("to, name", [("bag", "run.bag"), ("bag2", "run_bag")])
 def test_bag_export_and_import_give_the_same_run(tmp_path, run_folder, to, name):
     bag = tmp_path / name
-    result = _invoke("export", run_folder, "--to", to, "--out", bag)
+    result = _invoke("export", run_folder, "--to", to, "--truth", "--out", bag)
     assert result.exit_code == 0, result.output
     assert "/base_scan" in result.output
     result = _invoke("import", bag, "--out", tmp_path / "back")
@@ -83,7 +83,7 @@ def test_tum_exports_truth_by_default_and_odometry_on_request(tmp_path, run_fold
 @pytest.mark.parametrize("compressed", [None, "gz", "bz2"])
 def test_carmen_export_and_import(tmp_path, run_folder, compressed):
     log = tmp_path / "run.clf"
-    result = _invoke("export", run_folder, "--to", "carmen", "--out", log)
+    result = _invoke("export", run_folder, "--to", "carmen", "--truth", "--out", log)
     assert result.exit_code == 0, result.output
     if compressed:
         opener = gzip.open if compressed == "gz" else bz2.open
@@ -138,9 +138,9 @@ def test_recording_without_ground_truth(tmp_path, run_folder):
     record = read_run(run_folder)
     record.truth[:] = np.nan  # a real robot: no ground truth topic in the bag
     bag = write_rosbag1(tmp_path / "robot.bag", record)
-    result = _invoke("import", bag, "--out", tmp_path / "robot")
-    assert result.exit_code == 2 and "--no-truth" in result.text
-    result = _invoke("import", bag, "--out", tmp_path / "robot", "--no-truth")
+    named = _invoke("import", bag, "--out", tmp_path / "robot", "--truth-topic", "/base_pose_ground_truth")
+    assert named.exit_code == 2 and "--no-truth" in named.text  # a topic asked for by name must be there
+    result = _invoke("import", bag, "--out", tmp_path / "robot")  # by default: read without ground truth
     assert result.exit_code == 0, result.output
     assert "WITHOUT ground truth" in result.text
     imported = read_run(tmp_path / "robot")
@@ -153,7 +153,7 @@ def test_recording_without_ground_truth(tmp_path, run_folder):
         ).exit_code
         == 0
     )
-    result = _invoke("export", tmp_path / "robot", "--to", "carmen", "--out", tmp_path / "r.clf")
+    result = _invoke("export", tmp_path / "robot", "--to", "carmen", "--truth", "--out", tmp_path / "r.clf")
     assert result.exit_code == 0 and "no ground truth" in result.text, result.output  # as a bag is written
     assert "TRUEPOS" not in (tmp_path / "r.clf").read_text()
 
@@ -161,8 +161,8 @@ def test_recording_without_ground_truth(tmp_path, run_folder):
 def test_option_mistakes_exit_2(tmp_path, run_folder):
     result = _invoke("export", run_folder, "--to", "bag", "--what", "odometry", "--out", tmp_path / "x.bag")
     assert result.exit_code == 2 and "--what" in result.output
-    result = _invoke("export", run_folder, "--to", "tum", "--no-truth", "--out", tmp_path / "x.tum")
-    assert result.exit_code == 2 and "--no-truth applies to --to carmen, bag and bag2" in result.text
+    result = _invoke("export", run_folder, "--to", "tum", "--truth", "--out", tmp_path / "x.tum")
+    assert result.exit_code == 2 and "--truth applies to --to carmen, bag and bag2" in result.text
     assert not (tmp_path / "x.tum").exists()
     assert _invoke("export", tmp_path / "nothing", "--to", "tum", "--out", tmp_path / "x.tum").exit_code == 2
     (tmp_path / "log.clf").write_text("ODOM 0 0 0 0 0 0 1.0 host 0.0\n")
@@ -180,11 +180,10 @@ def test_a_bag_without_truth_holds_nothing_a_robot_could_not_have_recorded(tmp_p
     """What a SLAM program is given: scans and odometry; no ground-truth topic, and no start pose, drawn
     bias, seed or scores in /slamtrials/run."""
     bag = tmp_path / name
-    result = _invoke("export", run_folder, "--to", to, "--no-truth", "--out", bag)
+    result = _invoke("export", run_folder, "--to", to, "--out", bag)  # the default: no ground truth
     assert result.exit_code == 0, result.output
     assert "without /base_pose_ground_truth" in result.text
-    assert _invoke("import", bag, "--out", tmp_path / "back").exit_code == 2  # no truth topic to read
-    result = _invoke("import", bag, "--out", tmp_path / "back", "--no-truth")
+    result = _invoke("import", bag, "--out", tmp_path / "back")  # no truth topic: read without ground truth
     assert result.exit_code == 0, result.output
     original, back = read_run(run_folder), read_run(tmp_path / "back")
     np.testing.assert_array_equal(back.scans, original.scans)

@@ -244,19 +244,17 @@ def _invoke(*args):
     return result
 
 
-def test_export_keeps_the_truth_by_default_and_no_truth_writes_none(tmp_path):
+def test_export_writes_the_truth_only_when_asked(tmp_path):
     record = _record()
     run = write_run(tmp_path / "run", record)
-    done = _invoke("export", run, "--to", "carmen", "--out", tmp_path / "with.clf")
+    done = _invoke("export", run, "--to", "carmen", "--truth", "--out", tmp_path / "with.clf")
     assert done.exit_code == 0 and "TRUEPOS lines with the ground truth" in done.text, done.output
     assert _invoke("import", tmp_path / "with.clf", "--out", tmp_path / "back").exit_code == 0
     back = read_run(tmp_path / "back")
     np.testing.assert_array_equal(back.truth, r6(record.truth))
     np.testing.assert_array_equal(back.odometry, r6(record.odometry))
 
-    done = _invoke(
-        "export", run, "--to", "carmen", "--carmen-kind", "FLASER", "--no-truth", "--out", tmp_path / "n.clf"
-    )
+    done = _invoke("export", run, "--to", "carmen", "--carmen-kind", "FLASER", "--out", tmp_path / "n.clf")
     assert done.exit_code == 0 and "no ground truth" in done.text, done.output
     text = (tmp_path / "n.clf").read_text()
     assert not re.search(r"^TRUEPOS", text, re.MULTILINE)
@@ -268,8 +266,8 @@ def test_export_keeps_the_truth_by_default_and_no_truth_writes_none(tmp_path):
 
 def test_no_truth_is_refused_for_tum(tmp_path):
     run = write_run(tmp_path / "run", _record(n=5))
-    result = _invoke("export", run, "--to", "tum", "--no-truth", "--out", tmp_path / "t.tum")
-    assert result.exit_code == 2 and "--no-truth applies to --to carmen, bag and bag2" in result.text
+    result = _invoke("export", run, "--to", "tum", "--truth", "--out", tmp_path / "t.tum")
+    assert result.exit_code == 2 and "--truth applies to --to carmen, bag and bag2" in result.text
 
 
 def test_import_of_uncovered_truepos_lines_is_one_line(tmp_path):

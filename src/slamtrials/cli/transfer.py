@@ -58,13 +58,13 @@ def export_run(
     carmen_kind: Annotated[
         str, typer.Option("--carmen-kind", help="For --to carmen: ROBOTLASER1 (geometry on every line) or FLASER.")
     ] = "ROBOTLASER1",
-    no_truth: Annotated[
+    truth: Annotated[
         bool,
         typer.Option(
-            "--no-truth",
-            help="For carmen and bags: no ground truth at all (what a SLAM program is given): no TRUEPOS lines, "
-            "no /base_pose_ground_truth, and a bag's /slamtrials/run without the run's start pose, errors and "
-            "scores. Default: the ground truth kept, so that import gives the run back.",
+            "--truth/--no-truth",
+            help="For carmen and bags: also write the ground truth (TRUEPOS lines; /base_pose_ground_truth and the "
+            "run's start pose, errors and scores in a bag's /slamtrials/run), so that import gives the run back. "
+            "Default: none, what a SLAM program may be given.",
         ),
     ] = False,
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace an existing --out.")] = False,
@@ -72,7 +72,8 @@ def export_run(
     """Export a run's laser, odometry and ground truth as a ROS bag (Stage topics), a CARMEN log or a TUM file.
 
     A CARMEN log's laser lines hold the laser's pose by odometry (first pose triple) and the odometry of
-    the base (second); the ground truth goes into TRUEPOS lines, or nowhere with --no-truth.
+    the base (second). The ground truth is written only with --truth: into TRUEPOS lines, or a bag's
+    ground-truth topic. Never give a program a log or bag exported with --truth.
     """
     from slamtrials.io.runfolder import read_run
     from slamtrials.io.transfer import export_record
@@ -81,8 +82,8 @@ def export_run(
         raise ConfigError("--what applies to --to tum only")
     if (time_origin is not None or compress) and to not in (ExportFormat.bag, ExportFormat.bag2):
         raise ConfigError("--time-origin-ns and --compress apply to --to bag and --to bag2 only")
-    if no_truth and to is ExportFormat.tum:
-        raise ConfigError("--no-truth applies to --to carmen, bag and bag2 (a TUM file holds one trajectory: --what)")
+    if truth and to is ExportFormat.tum:
+        raise ConfigError("--truth applies to --to carmen, bag and bag2 (a TUM file holds one trajectory: --what)")
     if out.exists() and not overwrite:
         raise ConfigError(f"{out}: already exists; choose another --out or pass --overwrite")
     record = read_run(run)
@@ -95,7 +96,7 @@ def export_run(
             time_origin_ns=time_origin,
             compress=compress,
             carmen_kind=carmen_kind,
-            truth=not no_truth,
+            truth=truth,
             overwrite=overwrite,
         )
     except ConfigError as exc:
@@ -123,7 +124,9 @@ def import_run(
     truth_topic: Annotated[
         str | None,
         typer.Option(
-            "--truth-topic", help="Bag: ground-truth nav_msgs/Odometry topic \\[default: /base_pose_ground_truth]."
+            "--truth-topic",
+            help="Bag: ground-truth nav_msgs/Odometry topic \\[default: /base_pose_ground_truth when the bag has it, "
+            "else no ground truth].",
         ),
     ] = None,
     no_truth: Annotated[
@@ -156,13 +159,16 @@ def import_run(
         raise ConfigError(f"{out}: already holds a run; choose another --out or pass --overwrite")
     kind = ImportFormat(detect_recording_format(source)) if fmt is ImportFormat.auto else fmt
     if kind is ImportFormat.bag:
-        from slamtrials.io.rosbag import ODOM_TOPIC, SCAN_TOPIC, TRUTH_TOPIC, run_from_bag
+        from slamtrials.io.rosbag import ODOM_TOPIC, SCAN_TOPIC, TRUTH_TOPIC, bag_topics, run_from_bag
 
+        if truth_topic is None and not no_truth:  # the default topic when the bag has it, else no truth
+            truth_topic = TRUTH_TOPIC if TRUTH_TOPIC in bag_topics(source) else None
+            no_truth = truth_topic is None
         record = run_from_bag(
             source,
             scan_topic=scan_topic or SCAN_TOPIC,
             odom_topic=odom_topic or ODOM_TOPIC,
-            truth_topic=None if no_truth else (truth_topic or TRUTH_TOPIC),
+            truth_topic=None if no_truth else truth_topic,
             use_tf=use_tf,
             pairing=pairing.value,
         )

@@ -1,8 +1,8 @@
 """Moving a run between the run folder and other formats: the library behind ``export`` and ``import``.
 
 Export writes a :class:`~slamtrials.record.RunRecord` as a ROS 1 bag, a ROS 2 bag (MCAP), a CARMEN log
-(first pose triple = the laser's pose by odometry, second = the odometry of the base, ground truth in
-TRUEPOS lines unless asked for none) or a TUM trajectory. Import reads a ROS bag or a CARMEN log (plain,
+(first pose triple = the laser's pose by odometry, second = the odometry of the base; the ground truth,
+only when asked for, in TRUEPOS lines) or a TUM trajectory. Import reads a ROS bag or a CARMEN log (plain,
 gzip or bzip2) back into a record. Functions return a one-line description of what they
 did for the caller to show; they never print.
 """
@@ -50,7 +50,7 @@ def export_record(
     time_origin_ns: int | None = None,
     compress: bool = False,
     carmen_kind: str = "ROBOTLASER1",
-    truth: bool = True,
+    truth: bool = False,
     overwrite: bool = False,
 ) -> str:
     """Write ``record`` to ``out`` in format ``to`` (one of :data:`EXPORT_FORMATS`); return a description.
@@ -65,13 +65,12 @@ def export_record(
     carmen_kind:
         For ``carmen``: ``"ROBOTLASER1"`` or ``"FLASER"``.
     truth:
-        For ``carmen``: write the ground truth as TRUEPOS lines (default, so that import gives the run
-        back; a run without ground truth at any frame is written without them, as a bag is written
-        without ``/base_pose_ground_truth``). False writes a log holding no ground truth at all, what a
-        SLAM program is given. For bags: False publishes no ``/base_pose_ground_truth`` and strips
-        ``/slamtrials/run`` to the recording's format, versions, frame and beam counts and laser
-        (:func:`sensor_only`): a run's metadata holds its true start pose, its drawn odometry bias and its
-        scores.
+        False (the default): a recording holding no ground truth at all, what a SLAM program may be
+        given: a CARMEN log without TRUEPOS lines; a bag without ``/base_pose_ground_truth`` and with
+        ``/slamtrials/run`` stripped to the recording's format, versions, frame and beam counts and laser
+        (:func:`sensor_only`: a run's metadata holds its true start pose, its drawn odometry bias and
+        its scores). True: the ground truth too (TRUEPOS lines; the topic and the whole metadata), so
+        that import gives the run back; a run without ground truth at any frame is written without it.
 
     Raises
     ------

@@ -3,7 +3,8 @@
 Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/bench_programs.py [--log mit-csail] [--repeats 3]``.
 
 On a log of the Freiburg benchmark (``$SLAMTRIALS_SHARED/data/<log>``), in this process and interleaved
-repeat by repeat: the built-in ``gmapping`` (slam_gmapping's defaults) and ``odometry``, and MRPT's
+repeat by repeat: the built-in ``gmapping`` (slam_gmapping's defaults), ``karto`` (slam_karto's) and
+``odometry``, and MRPT's
 ``icp-slam`` as an offline program (``docs/examples/mrpt/icp_slam.sh`` through
 :func:`slamtrials.external.run_program`: the log written as CARMEN, the program run, its trajectory read
 back and carried onto the frames). Each is scored with the Freiburg metric on the log's relations (0.1 s
@@ -60,14 +61,18 @@ def main() -> None:
     def gmapping():
         return run_over_recording(record, "gmapping", seed=0).trajectory.poses
 
+    def karto():
+        return run_over_recording(record, "karto", seed=0).trajectory.poses
+
     def odometry():
         return run_over_recording(record, "odometry", seed=0).trajectory.poses
 
     def icp_slam():
         return run_program(record, icp, 0).estimate
 
-    runs = {"gmapping": gmapping, "odometry": odometry, "icp-slam (program)": icp_slam}
+    runs = {"gmapping": gmapping, "karto": karto, "odometry": odometry, "icp-slam (program)": icp_slam}
     gmapping()  # warm-up: numba's kernels loaded
+    karto()
     times: dict[str, list[float]] = {name: [] for name in runs}
     scores: dict[str, tuple[float, float]] = {}
     for _ in range(args.repeats):

@@ -251,7 +251,7 @@ def _overview(data: CampaignData, done: pd.DataFrame) -> str:
     items = [
         ("campaign folder", str(data.folder)),
         ("kind", data.kind + (f" of {config.get('replay_of')}" if config.get("replay_of") else "")),
-        ("SLAM algorithm", f"{slam.get('algorithm')} (preset {slam.get('preset')}, params {slam.get('params') or {}})"),
+        ("SLAM algorithm", _slam_text(slam)),
         ("simulated sensors", _profile_text(config.get("sim", {}))),
         ("relations per run", _relations_text(config.get("metric", {}))),
         (
@@ -270,6 +270,17 @@ def _overview(data: CampaignData, done: pd.DataFrame) -> str:
         ("created", str(data.meta.get("created"))),
     ]
     return h.section("Overview", h.definition_list(items), h.notes(_notes(data, done), id="notes"), id="overview")
+
+
+def _slam_text(slam: dict) -> str:
+    """The provenance line of the SLAM settings: an algorithm with its preset and parameters, or a program."""
+    program = slam.get("program")
+    if program:
+        return (
+            f"{slam.get('algorithm')}: external program, offline (command {program.get('command')!r}, input "
+            f"{program.get('input')}, output {program.get('output')}, timeout {program.get('timeout')} s)"
+        )
+    return f"{slam.get('algorithm')} (preset {slam.get('preset')}, params {slam.get('params') or {}})"
 
 
 def _profile_text(sim: dict[str, Any]) -> str:

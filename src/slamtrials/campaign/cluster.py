@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import logging
 import os
+import signal
+import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
@@ -34,6 +36,21 @@ def check_workers(workers: int | None) -> int:
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ConfigError(f"workers must be a positive integer, got {workers!r}")
     return workers
+
+
+@contextmanager
+def _workers_ignore_ctrl_c() -> Iterator[None]:
+    """Ignore SIGINT while the local workers start, so that they inherit the ignoring: Ctrl-C in a terminal
+    reaches every process of the group, and the workers would each print a traceback; this process
+    handles it and shuts them down."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 @contextmanager
@@ -76,8 +93,12 @@ def dask_client(
 
     n = check_workers(workers)
     settings = {} if allowed_failures is None else {"distributed.scheduler.allowed-failures": int(allowed_failures)}
-    with dask.config.set(settings):
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0")
+    # the workers' own warnings (a task cancelled at shutdown, ...) only with -v: a run's failure is ours to tell
+    worker_logs = logging.WARNING if logging.getLogger().getEffectiveLevel() <= logging.INFO else logging.ERROR
+    with dask.config.set(settings), _workers_ignore_ctrl_c():
+        cluster = LocalCluster(
+            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=worker_logs
+        )
     try:
         client = Client(cluster)
     except BaseException:
@@ -86,6 +107,11 @@ def dask_client(
     log.info("started a local Dask cluster with %d worker processes (dashboard %s)", n, cluster.dashboard_link)
     try:
         yield client
+    except KeyboardInterrupt:
+        # Ctrl-C reached the workers too: their shutdown is expected, so the nanny's "still alive,
+        # killing" warnings are not shown; the caller prints one line
+        logging.getLogger("distributed").setLevel(logging.CRITICAL)
+        raise
     finally:
         client.close()
         cluster.close()

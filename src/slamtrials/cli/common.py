@@ -65,6 +65,9 @@ class ErrorReportingGroup(TyperGroup):
             where = f"{exc.filename}: " if exc.filename else ""
             typer.echo(f"error: {where}{exc.strerror or exc}", err=True)
             raise typer.Exit(EXIT_BAD_INPUT) from None
+        except KeyboardInterrupt:  # commands that can resume say how themselves, before this
+            typer.echo("interrupted", err=True)
+            raise typer.Exit(130) from None
 
 
 def _flags_as_flags(params: list) -> list:

@@ -98,3 +98,20 @@ def test_generate_writes_a_rosmap_and_one_summary_line(tmp_path):
 def test_bad_input_is_one_line_and_exit_2(args, words, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert_one_line_error(run(*args), *words)
+
+
+def test_show_refuses_to_draw_over_the_floor_plan_it_reads(tmp_path):
+    """A generated ROS map is office.yaml + office.png: drawing the picture to office.png would destroy it."""
+    plan = tmp_path / "office.yaml"
+    assert (
+        runner.invoke(
+            app, ["worlds", "generate", "--kind", "office", "--area", "150", "--seed", "3", "--out", str(plan)]
+        ).exit_code
+        == 0
+    )
+    image = tmp_path / "office.png"
+    before = image.read_bytes()
+    result = runner.invoke(app, ["worlds", "show", str(plan), "-o", str(image)])
+    assert result.exit_code == 2 and "is the floor plan itself" in result.output
+    assert image.read_bytes() == before
+    assert runner.invoke(app, ["worlds", "show", str(plan), "-o", str(tmp_path / "picture.png")]).exit_code == 0

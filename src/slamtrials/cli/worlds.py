@@ -84,8 +84,28 @@ def show(
         raise ConfigError(
             f"--out {out}: unknown picture format {out.suffix!r}; use one of {', '.join(FIGURE_SUFFIXES)}"
         )
+    if out.resolve() in _plan_files(world):
+        raise ConfigError(f"--out {out}: is the floor plan itself (the map's image); choose another picture name")
     save_world_figure(the_world, out, dpi=dpi)
     typer.echo(f"wrote {out}")
+
+
+def _plan_files(world: str) -> set[Path]:
+    """The files a floor plan named by path is read from: the file and, for a ROS map YAML, its image."""
+    path = Path(world)
+    if not path.is_file():
+        return set()
+    files = {path.resolve()}
+    if path.suffix.lower() in (".yaml", ".yml"):
+        import yaml
+
+        try:
+            doc = yaml.safe_load(path.read_text(encoding="utf-8"))
+        except (yaml.YAMLError, UnicodeDecodeError):
+            return files
+        if isinstance(doc, dict) and isinstance(doc.get("image"), str):
+            files.add((path.parent / doc["image"]).resolve())
+    return files
 
 
 @app.command("info")

@@ -1,0 +1,45 @@
+"""The tutorials of docs/tutorials run as written: every shell block of each page, in order, in one
+folder, by /bin/sh with the project's venv first on PATH (so a heredoc or a pipe runs as a user's
+shell runs it)."""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+TUTORIALS = REPO / "docs" / "tutorials"
+
+
+def _blocks(page: Path) -> list[str]:
+    return re.findall(r"```sh\n(.*?)```", page.read_text(encoding="utf-8"), flags=re.S)
+
+
+def _run(page: Path, folder: Path) -> None:
+    env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}"}
+    for block in _blocks(page):
+        done = subprocess.run(["/bin/sh", "-e", "-c", block], cwd=folder, env=env, capture_output=True, text=True)
+        assert done.returncode == 0, f"{page.name}:\n{block}\n{done.stdout[-3000:]}\n{done.stderr[-3000:]}"
+
+
+@pytest.mark.slow
+def test_your_buildings_then_compare(tmp_path):
+    _run(TUTORIALS / "your-buildings.md", tmp_path)
+    assert (tmp_path / "office-plan.png").is_file()
+    assert (tmp_path / "campaigns" / "mine" / "report" / "index.html").is_file()
+    summary = (tmp_path / "campaigns" / "mine" / "summary.csv").read_text()
+    assert "office" in summary
+    _run(TUTORIALS / "compare.md", tmp_path)
+    assert (tmp_path / "campaigns" / "mine-karto" / "report" / "compare-mine" / "compare.html").is_file()
+
+
+def test_every_tutorial_is_run_here():
+    """A new page needs its test: each page of docs/tutorials is named in this file."""
+    source = Path(__file__).read_text(encoding="utf-8")
+    for page in TUTORIALS.glob("*.md"):
+        assert page.name in source, f"{page.name} is not run by {Path(__file__).name}"

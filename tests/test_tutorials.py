@@ -38,6 +38,13 @@ def test_your_buildings_then_compare(tmp_path):
     assert (tmp_path / "campaigns" / "mine-karto" / "report" / "compare-mine" / "compare.html").is_file()
 
 
+@pytest.mark.slow
+def test_cluster(tmp_path):
+    _run(TUTORIALS / "cluster.md", tmp_path)
+    summary = (tmp_path / "campaigns" / "cluster" / "summary.csv").read_text()
+    assert "office_small_01" in summary and ",5," in summary.replace(" ", "")
+
+
 def test_every_tutorial_is_run_here():
     """A new page needs its test: each page of docs/tutorials is named in this file."""
     source = Path(__file__).read_text(encoding="utf-8")

@@ -26,7 +26,7 @@ from typing import Any, Literal
 import numpy as np
 
 from slamtrials.atomicfile import atomic_write, atomic_write_text
-from slamtrials.errors import ConfigError, MetricError
+from slamtrials.errors import ConfigError, MetricError, ProgramError
 from slamtrials.metric.divergence import DEFAULT_DIVERGENCE_FACTOR, Divergence, divergence
 from slamtrials.metric.matching import DEFAULT_TOLERANCE, relations_meet
 from slamtrials.metric.meaninterval import MeanInterval, positive_mean_interval
@@ -165,6 +165,9 @@ class RepeatedSlam:
         Where the recording came from.
     relations_source:
         Where the relations came from.
+    failed:
+        ``(seed, error)`` of the runs whose program failed (an external program only), in seed order;
+        the statistics are over the other runs.
     """
 
     settings: RepeatSettings
@@ -177,6 +180,7 @@ class RepeatedSlam:
     rule: str
     source: str
     relations_source: str
+    failed: tuple[tuple[int, str], ...] = ()
 
     @property
     def best(self) -> RepeatedRun:
@@ -292,14 +296,19 @@ def repeat_slam(
         relations_source=relations_source or "the relations",
     )
     done: dict[int, RepeatedRun] = {}
+    failed: dict[int, str] = {}
     rule = ""
     with dask_client(scheduler, workers) as client:
         shared = client.scatter(record, broadcast=True)
 
         def run_seeds(seeds: range, planned: int) -> None:
-            futures = [client.submit(_one_run, shared, relations, settings, seed, pure=False) for seed in seeds]
+            futures = {client.submit(_one_run, shared, relations, settings, seed, pure=False): seed for seed in seeds}
             for future in as_completed(futures):
-                run = future.result()
+                try:
+                    run = future.result()
+                except ProgramError as exc:  # the program failed on this run: a failed run, not a failed command
+                    failed[futures[future]] = str(exc)
+                    continue
                 done[run.seed] = run
                 if on_run is not None:
                     on_run(run, planned)
@@ -329,6 +338,10 @@ def repeat_slam(
                 planned = decision.needed
         else:
             run_seeds(range(settings.runs), settings.runs)
+    if len(done) < 2:
+        first = min(failed) if failed else None
+        why = f"; seed {first}: {failed[first]}" if first is not None else ""
+        raise ProgramError(f"only {len(done)} of {len(done) + len(failed)} runs finished, too few for statistics{why}")
     runs = tuple(done[s] for s in sorted(done))
     eps_t = [r.eps_t for r in runs]
     eps_r = [r.eps_r for r in runs]
@@ -345,6 +358,7 @@ def repeat_slam(
         rule=rule,
         source=source,
         relations_source=relations_source,
+        failed=tuple(sorted(failed.items())),
     )
 
 
@@ -396,6 +410,7 @@ def write_repeat_outputs(result: RepeatedSlam, out_dir: str | Path, *, overwrite
         "relations": result.relations_source,
         "runs": len(result.runs),
         "seeds": [r.seed for r in result.runs],
+        "failed": [{"seed": seed, "error": error} for seed, error in result.failed],
         "run_count_rule": result.rule,
         "confidence": result.settings.confidence,
         "translational_m": _stats_json(result.stats_t, result.interval_t),

@@ -176,3 +176,23 @@ def test_slam_program_repeated_on_a_dataset_scores_every_run_on_its_relations(ru
     )
     assert failing.exit_code == 2 and "exited with status 6" in failing.output, failing.output
     assert len(failing.output.strip().splitlines()) == 1 and not (failed / "summary.json").exists()
+
+
+@pytest.mark.slow
+def test_a_seed_the_program_fails_on_is_a_failed_run_and_the_others_count(run_folder, tmp_path):
+    from slamtrials.io.relations import write_relations
+    from slamtrials.metric import relations_between
+    from slamtrials.record import Trajectory
+
+    folder, record = run_folder
+    i = np.arange(0, len(record) - 10, 5)
+    rel = tmp_path / "relations.txt"
+    write_relations(rel, relations_between(Trajectory(t=record.t, poses=record.truth), i, i + 10))
+    command = f"if [ {{seed}} = 1 ]; then echo lost >&2; exit 7; fi; {ODOMETRY_COMMAND}"
+    out = tmp_path / "out"
+    args = ["slam", "-i", str(folder), "-o", str(out), "--program", command, "--runs", "3", "-r", str(rel)]
+    result = runner.invoke(app, [*args, "--workers", "1"])
+    assert result.exit_code == 0, result.output
+    assert "failed: seed 1: the program exited with status 7" in result.output and "lost" in result.output
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["seeds"] == [0, 2] and summary["failed"][0]["seed"] == 1

@@ -365,6 +365,8 @@ def format_repeat(result: RepeatedSlam) -> str:
         f"{d.factor:g} x median = {d.threshold:.6f} m; best seed {result.best.seed} ({result.best.eps_t:.6f} m), "
         f"worst seed {result.worst.seed} ({result.worst.eps_t:.6f} m)"
     )
+    for seed, error in result.failed:
+        lines.append(f"failed: seed {seed}: {error}")
     if result.rule:
         lines.append(result.rule)
     return "\n".join(lines)

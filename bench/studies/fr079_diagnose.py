@@ -1,6 +1,6 @@
 """Where and why GMapping goes wrong on a real log: the error along the chain of local relations.
 
-Run: ``SLAMTRIALS_SHARED=<shared> NUMBA_NUM_THREADS=1 .venv/bin/python bench/fr079_diagnose.py [--log fr079]
+Run: ``SLAMTRIALS_SHARED=<shared> NUMBA_NUM_THREADS=1 .venv/bin/python bench/studies/fr079_diagnose.py [--log fr079]
 [--seeds 0 1 2] [--set key=value ...] [--repair]``.
 
 The Freiburg relations of a log are of two kinds: local ones between consecutive reference scans (fr079:
@@ -24,6 +24,7 @@ import os
 import sys
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # bench/, for bench_real_logs
 
 import numpy as np  # noqa: E402
 

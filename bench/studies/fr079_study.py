@@ -1,6 +1,6 @@
 """GMapping on fr079: why slam_gmapping's defaults fail there, and which setting matters (issue 20, point 4).
 
-Run: ``SLAMTRIALS_SHARED=<shared> NUMBA_NUM_THREADS=1 .venv/bin/python bench/fr079_study.py [--seeds 5]
+Run: ``SLAMTRIALS_SHARED=<shared> NUMBA_NUM_THREADS=1 .venv/bin/python bench/studies/fr079_study.py [--seeds 5]
 [--first-seed 0] [--case NAME ...] [--list]`` (all cases, 5 seeds: about 25 minutes on one core). One
 core, one run after another (no Dask): each case is a named set of GMapping overrides (slam_gmapping's
 defaults otherwise), run with seeds 0..N-1 over ``<shared>/data/fr079`` and scored on ``fr079.relations``
@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # bench/, for bench_real_logs
 
 import numpy as np  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402

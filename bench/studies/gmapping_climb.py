@@ -1,6 +1,6 @@
 """Why GMapping's scan matcher costs more per update on noisy data: how far its hill climbing goes.
 
-Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/gmapping_climb.py [--world office_small_01] [--seed 1]
+Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/studies/gmapping_climb.py [--world office_small_01] [--seed 1]
 [--profiles paper realistic] [--sample 10]``.
 
 One trial per error profile (online GMapping with the ``paper`` preset, the paper's robot and laser, as
@@ -15,8 +15,10 @@ counted re-run must return the very poses the compiled matcher returned; the scr
 from __future__ import annotations
 
 import os
+import sys
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # bench/, for bench_trial
 
 import argparse  # noqa: E402
 import time  # noqa: E402

@@ -1,6 +1,6 @@
 """Where karto's sequential matcher errs in heading: per-node errors against a reference path (issue 23).
 
-Run: ``SLAMTRIALS_SHARED=<shared> NUMBA_NUM_THREADS=1 .venv/bin/python bench/karto_heading.py --log fr079
+Run: ``SLAMTRIALS_SHARED=<shared> NUMBA_NUM_THREADS=1 .venv/bin/python bench/studies/karto_heading.py --log fr079
 --reference GMAPPING_RUN/trajectory.tum [--set key=value ...] [--isolated] [--relations]``.
 
 The reference is a path that is locally right, e.g. GMapping's with ``linearUpdate 0.1`` (fr079: 0.045 m on
@@ -27,6 +27,7 @@ import os
 import sys
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # bench/, for bench_real_logs
 
 import numpy as np  # noqa: E402
 

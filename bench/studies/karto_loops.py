@@ -1,6 +1,6 @@
 """karto's loop closures in one trial: every candidate chain tried, its gates, and what it did to the online error.
 
-Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/karto_loops.py --world school_medium_01 --seed 3
+Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/studies/karto_loops.py --world school_medium_01 --seed 3
 [--profile paper] [--set loop_match_minimum_response_coarse=0.8 ...] [--all]``.
 
 The trial is the paper's set-up with karto online (its defaults, or ``--set`` overrides). Printed for each
@@ -14,8 +14,10 @@ optimization. A false closure shows as a jump of metres in both. Then how the tr
 from __future__ import annotations
 
 import os
+import sys
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # bench/, for bench_trial
 
 import argparse  # noqa: E402
 import math  # noqa: E402

@@ -1,6 +1,6 @@
 """Where a trial's time goes: one trial under cProfile, the functions with the most time.
 
-Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/profile_trial.py --world school_medium_01 --seed 2
+Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/studies/profile_trial.py --world school_medium_01 --seed 2
 [--algorithm karto] [--profile realistic] [--top 25]``.
 
 The trial is the paper's set-up with ``--algorithm`` online (``gmapping``: its ``paper`` preset; others:
@@ -13,8 +13,10 @@ cProfile adds a fixed cost per Python call, so the shares of Python-heavy code a
 from __future__ import annotations
 
 import os
+import sys
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # bench/, for bench_trial
 
 import argparse  # noqa: E402
 import cProfile  # noqa: E402

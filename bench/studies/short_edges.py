@@ -1,6 +1,6 @@
 """Where real short readings stand: how many of them are next to a depth edge of the reference map.
 
-Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/short_edges.py LOG [KEY=VALUE ...] [--every 5]
+Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/studies/short_edges.py LOG [KEY=VALUE ...] [--every 5]
 [--jump 0.3] [--short 0.3]``.
 
 GMapping (its defaults plus the ``KEY=VALUE`` overrides, seed 0) runs over the log; its final path and

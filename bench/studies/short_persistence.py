@@ -1,6 +1,6 @@
 """What the large laser residuals of a real log are: short against long, and how long short readings last.
 
-Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/short_persistence.py LOG --profile NAME [--set KEY=VALUE ...]
+Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/studies/short_persistence.py LOG --profile NAME [--set KEY=VALUE ...]
 [--seed 0] [--lags 1 3 10]``, e.g. ``../shared/data/fr079/fr079.clf.bz2 --profile fr079 --set
 linearUpdate=0.1`` or ``../shared/data/mit-csail/mit-csail.clf --profile mit-csail``.
 

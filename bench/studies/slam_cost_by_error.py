@@ -1,6 +1,6 @@
 """What in an error profile makes GMapping's updates cost more: one fixed tour, one error model changed at a time.
 
-Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/slam_cost_by_error.py [--worlds office_small_01
+Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/studies/slam_cost_by_error.py [--worlds office_small_01
 school_medium_01] [--seed 1] [--base realistic]``.
 
 A trial's cost with an error profile mixes two things: the explorer's path (a noisier map can make it
@@ -19,8 +19,10 @@ truth's), so a cheaper variant can be told from one that simply lost track.
 from __future__ import annotations
 
 import os
+import sys
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # bench/, for bench_trial
 
 import argparse  # noqa: E402
 import re  # noqa: E402

@@ -1,6 +1,6 @@
 """Where a trial's GMapping updates go: how many come before and after most of the map is known.
 
-Run: ``.venv/bin/python bench/trial_progress.py [--world school_medium_01] [--seed 1]``.
+Run: ``.venv/bin/python bench/studies/trial_progress.py [--world school_medium_01] [--seed 1]``.
 
 Runs one trial with the paper's set-up (:func:`slamtrials.trial.run_trial` defaults) and samples the
 free area known to the SLAM map every 5 s of simulated time. Prints, for 80 to 99 % of the final known
@@ -11,10 +11,14 @@ then. Update counts, not wall time: they do not depend on the machine.
 from __future__ import annotations
 
 import argparse
+import os
+import sys
 
-from bench_trial import resolve
-from slamtrials.trial import TrialProgress, run_trial
-from slamtrials.worlds import load_world
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # bench/, for bench_trial
+
+from bench_trial import resolve  # noqa: E402
+from slamtrials.trial import TrialProgress, run_trial  # noqa: E402
+from slamtrials.worlds import load_world  # noqa: E402
 
 FRACTIONS = (0.8, 0.9, 0.95, 0.98, 0.99)
 

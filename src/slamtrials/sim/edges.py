@@ -3,7 +3,7 @@
 Why. Real short readings crowd at the depth edges of the map (door frames, pillar sides, corridor
 openings): on both shared logs about 10 % of the beams have a neighbour within two beams whose wall is
 more than :data:`EDGE_MIN_STEP` nearer, and 13 to 15 % of those read that nearer wall (to 0.1 m), where a
-beam elsewhere almost never reads a neighbour's wall (``bench/short_edges.py``; docs/realism.md,
+beam elsewhere almost never reads a neighbour's wall (``bench/studies/short_edges.py``; docs/realism.md,
 "Assumptions"). A laser's spot is wider than the angle between its beams, and the reference that finds
 the edges is itself a little off; either way the reading lies on real geometry, not at a random place.
 

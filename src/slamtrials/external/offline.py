@@ -4,8 +4,8 @@ replay --program`` and ``validate --program`` run.
 :func:`run_program` writes the recording in the program's input format (odometry and laser only: no
 ground truth, no start pose, no scores; :func:`slamtrials.io.transfer.export_record` with
 ``truth=False``) into a scratch folder, runs the command of its
-:class:`~slamtrials.slam.program.ProgramSpec` there with ``/bin/sh -c`` (stdin closed, in its own
-process group), reads the trajectory it wrote, maps its times onto the run's and gives every frame an
+:class:`~slamtrials.slam.program.ProgramSpec` with ``/bin/sh -c`` in the caller's folder (stdin closed,
+in its own process group; ``{workdir}`` is an empty folder of its own), reads the trajectory it wrote, maps its times onto the run's and gives every frame an
 estimate (:func:`slamtrials.slam.program.align_to_frames`). The map is the scans traced at that
 estimate (:func:`slamtrials.slam.estimatemap.map_of_estimate`).
 

@@ -206,6 +206,7 @@ class OnlineProgram:
         self._poses: list[NDArray[np.float64]] = []
         self._map: OccupancyGrid | None = None
         self._drawn = GridMap(self.config.resolution)
+        self._drawn_grid: OccupancyGrid | None = None
         self._last_drawn: NDArray[np.float64] | None = None
         self._final: Trajectory | None = None
         self.updates = 0
@@ -287,10 +288,16 @@ class OnlineProgram:
                 return
         self._drawn.integrate_frame(pose, ranges, self.laser)
         self._last_drawn = pose
+        self._drawn_grid = None
 
     def occupancy(self) -> OccupancyGrid:
-        """The latest map the program sent, else the map drawn from its poses."""
-        return self._map if self._map is not None else self._drawn.occupancy()
+        """The latest map the program sent, else the map drawn from its poses (one object until the next
+        scan is traced into it: the explorer keeps its plans per map object)."""
+        if self._map is not None:
+            return self._map
+        if self._drawn_grid is None:
+            self._drawn_grid = self._drawn.occupancy()
+        return self._drawn_grid
 
     def trajectory(self) -> Trajectory:
         """The final estimate of every frame: sends ``end`` once and reads the program's answer."""

@@ -45,6 +45,19 @@ def test_cluster(tmp_path):
     assert "office_small_01" in summary and ",5," in summary.replace(" ", "")
 
 
+SHARED = Path(os.environ.get("SLAMTRIALS_SHARED", REPO.parent / "shared"))
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not (SHARED / "data" / "mit-csail" / "mit-csail.clf").is_file(), reason="no MIT CSAIL log")
+def test_calibrate(tmp_path):
+    (tmp_path / "work").mkdir()
+    (tmp_path / "shared").symlink_to(SHARED, target_is_directory=True)  # ../shared from the work folder
+    _run(TUTORIALS / "calibrate.md", tmp_path / "work")
+    assert "odometry" in (tmp_path / "work" / "mit-profile.yaml").read_text()
+    assert (tmp_path / "work" / "validation.json").is_file()
+
+
 def test_every_tutorial_is_run_here():
     """A new page needs its test: each page of docs/tutorials is named in this file."""
     source = Path(__file__).read_text(encoding="utf-8")

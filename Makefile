@@ -1,7 +1,7 @@
 # The two set-up commands of the README:
 #   make demo   create .venv, install slamtrials, run the main job (writes results/demo/)
 #   make test   create .venv, install slamtrials with its test tools, run the whole test suite
-#   make test-fast   the same without the tests marked slow (about 3.5 minutes on 2 cores, warm numba cache)
+#   make test-fast   the same without the tests marked slow (about 5 minutes on 2 cores, warm numba cache)
 PYTHON ?= $(shell command -v python3.11 || command -v python3)
 VENV   := .venv
 BIN    := $(VENV)/bin

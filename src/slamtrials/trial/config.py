@@ -72,7 +72,8 @@ class SlamSettings(BaseModel):
             if not isinstance(spec, ProgramSpec):
                 spec = ProgramSpec.model_validate(spec)
             given = {k: data[k] for k in ("algorithm", "preset", "params") if data.get(k) not in (None, {})}
-            given.pop("algorithm", None) if given.get("algorithm") == spec.label else None
+            if given.get("algorithm") == spec.label:  # as a stored config writes it back
+                del given["algorithm"]
             if given:
                 raise ValueError(f"slam.program replaces slam.{sorted(given)[0]}: give one or the other")
             data = {**data, "program": spec, "algorithm": spec.label, "preset": None, "params": {}}

@@ -196,18 +196,7 @@ def replay_slam(record: RunRecord, slam: SlamSettings, seed: int) -> RunRecord:
     estimate = result.estimate_per_frame(record)
     metadata = dict(record.metadata)
     metadata["slam_config"] = result.config.model_dump(mode="json")
-    return RunRecord(
-        t=record.t,
-        scans=record.scans,
-        odometry=record.odometry,
-        truth=record.truth,
-        stalled=record.stalled,
-        laser=record.laser,
-        metadata=metadata,
-        estimate=estimate,
-        map=result.occupancy,
-        online=result.online,
-    )
+    return replace(record, metadata=metadata, estimate=estimate, map=result.occupancy, online=result.online)
 
 
 def _replay_program(record: RunRecord, program: ProgramSpec, seed: int) -> RunRecord:
@@ -226,18 +215,7 @@ def _replay_program(record: RunRecord, program: ProgramSpec, seed: int) -> RunRe
         "frames_carried_by_odometry": a.frames_carried,
         "stderr_tail": list(ran.stderr_tail),
     }
-    return RunRecord(
-        t=record.t,
-        scans=record.scans,
-        odometry=record.odometry,
-        truth=record.truth,
-        stalled=record.stalled,
-        laser=record.laser,
-        metadata=metadata,
-        estimate=ran.estimate,
-        map=ran.occupancy,
-        online=ran.estimate,
-    )
+    return replace(record, metadata=metadata, estimate=ran.estimate, map=ran.occupancy, online=ran.estimate)
 
 
 def replay_one(task: ReplayTask) -> RunResult:

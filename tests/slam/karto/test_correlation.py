@@ -1,4 +1,5 @@
-"""The correlation kernel's sums over the search lattice equal the point-by-point response of each pose."""
+"""The correlation kernel's sums over the search lattice equal the point-by-point response of each pose,
+and points are read at Karto's flat index (a point beyond a row's end reads the padding or the next row)."""
 
 from __future__ import annotations
 
@@ -45,5 +46,28 @@ def test_the_nonzero_cells_walk_gives_the_same_sums():
     assert _evenly_spaced(cols) and not _evenly_spaced(np.array([3, 5, 8], dtype=np.int64))
     starts, nonzero_cols, values = _nonzero_rows(grid)
     assert starts[-1] == np.count_nonzero(grid) and np.array_equal(values, grid[grid != 0])
-    sparse = _totals_sparse(starts, nonzero_cols, values, rows, cols, dcol, drow)
+    sparse = _totals_sparse(starts, nonzero_cols, values, grid.shape[1], rows, cols, dcol, drow)
     assert np.array_equal(sparse, _totals(grid, rows, cols, dcol, drow)) and sparse.any()
+
+
+def test_a_point_beyond_a_rows_end_reads_the_padding_or_the_next_row_as_karto_does():
+    # Karto's grid rows are stored with a stride rounded up to a multiple of 8, and GetResponse reads
+    # data[position index + point offset] with only the flat index checked: a column past the row's end
+    # lands in the zero padding, or, past the stride, on the next row
+    grid = np.zeros((10, 16), dtype=np.uint8)  # 13 columns in use, padded to 16
+    grid[5, 2] = 100  # on the row after the position's
+    grid[4, 12] = 40  # the last column in use, on the position's row
+    drow = np.array([[0, 0, 0]])
+    dcol = np.array([[1, 4, 7]])  # from column 11: column 12, padding column 15, next row's column 2
+    assert _response(grid, 4, 11, dcol, drow, 0, 1.0) == 140.0
+    rows = np.array([4], dtype=np.int64)
+    cols = np.array([11], dtype=np.int64)
+    assert _totals(grid, rows, cols, dcol, drow)[0, 0, 0] == 140
+    starts, nonzero_cols, values = _nonzero_rows(grid)
+    wide_cols = np.arange(1, 13, 2, dtype=np.int64)  # a row of positions whose cells run onto the next row
+    sparse = _totals_sparse(starts, nonzero_cols, values, grid.shape[1], rows, wide_cols, dcol, drow)
+    assert np.array_equal(sparse, _totals(grid, rows, wide_cols, dcol, drow))
+    assert sparse[0, 0, 5] == 140  # position column 11
+    # off the whole array (before the first cell, after the last) nothing is read
+    assert _response(grid, 0, 0, np.array([[-1]]), np.array([[0]]), 0, 1.0) == 0.0
+    assert _response(grid, 9, 15, np.array([[1]]), np.array([[0]]), 0, 1.0) == 0.0

@@ -39,24 +39,27 @@ def _nodes(synthetic, odometry, times, **overrides):
     return [n.frame for n in karto.graph.nodes]
 
 
-def test_the_scan_gate_is_slam_toolboxs(synthetic):
-    # shouldProcessScan: the first scan passes, scans 2-4 never do; then at least 0.5 s and a base
-    # travel of sqrt(0.8) * 0.5 = 0.447 m since the last node, and no heading test at all
+def test_the_scan_gate_is_slam_toolboxs_and_karto_keeps_its_own_node_rule(synthetic):
+    # shouldProcessScan: the first scan passes, scans 2-4 never do; then at least 0.5 s and a base travel
+    # of sqrt(0.8) * 0.5 = 0.447 m since the last scan it let through (node or not), no heading test.
+    # Then Karto's HasMovedEnough with its own time interval (3600 s: slam_toolbox never passes its
+    # minimum_time_interval to the mapper): 0.5 m of laser travel or a 0.5 rad turn since the last node
     odometry = [
         (0.0, 0.0, 0.0),
         (1.0, 0.0, 0.0),  # 2nd scan: far enough, but too early in the count
         (2.0, 0.0, 0.0),
         (3.0, 0.0, 0.0),
-        (3.0, 0.0, 0.0),  # 5th: 3 m from the first node -> node
-        (3.0, 0.0, 1.5),  # turned 1.5 rad in place: no node
-        (3.0, 0.0, -1.5),
-        (3.46, 0.0, -1.5),  # 0.46 m: a node (>= 0.447 m, < 0.5 m)
-        (3.9, 0.0, -1.5),  # 0.44 m: not yet
-        (3.92, 0.0, -1.5),  # 0.46 m, but 0.3 s after the last node
-        (3.93, 0.0, -1.5),  # 0.47 m, 0.6 s after: node
+        (3.0, 0.0, 0.0),  # 5th: 3 m from the first scan -> through the gate, and a node
+        (3.0, 0.0, 1.5),  # turned 1.5 rad in place: the gate has no heading test
+        (3.46, 0.0, 1.5),  # 0.46 m (>= 0.447) through the gate; turned since the last node -> node
+        (3.9, 0.0, 1.5),  # 0.44 m: not through the gate
+        (3.92, 0.0, 1.5),  # 0.46 m: through the gate, but 0.46 m < 0.5 m from the last node: no node
+        (4.0, 0.0, 1.5),  # 0.54 m from the last node, but 0.08 m from the gate's last scan: refused
+        (4.4, 0.0, 1.5),  # 0.48 m from the gate's last scan, 0.94 m from the last node -> node
+        (4.9, 0.0, 1.5),  # 0.5 m, but 0.3 s after the gate's last scan
     ]
-    times = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 7.2, 7.3, 7.6]
-    assert _nodes(synthetic, odometry, times) == [0, 4, 7, 10]
+    times = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 7.2, 7.9, 8.5, 8.8]
+    assert _nodes(synthetic, odometry, times) == [0, 4, 6, 10]
 
 
 def test_without_the_gate_karto_makes_a_node_on_a_turn_or_after_its_time_interval(synthetic):

@@ -49,19 +49,29 @@ from slamtrials.geometry import compose, compose1, inverse, ominus, ominus1, wra
 from slamtrials.record import LaserGeometry, Reading, Trajectory
 from slamtrials.slam.base import OccupancyGrid, register_algorithm
 from slamtrials.slam.karto.config import KartoConfig
+from slamtrials.slam.karto.correlation import KT_TOLERANCE
 from slamtrials.slam.karto.graph import PoseGraph, ScanNode
 from slamtrials.slam.karto.loopclosure import find_loop_closure_chain, find_near_chains
 from slamtrials.slam.karto.mapbuild import NodeMap
 from slamtrials.slam.karto.optimize import information, optimize_pose_graph
-from slamtrials.slam.karto.scanmatch import MatcherSettings, MatchResult, ScanMatcher, points_in_map
+from slamtrials.slam.karto.scanmatch import (
+    MatcherSettings,
+    MatchResult,
+    ScanMatcher,
+    barycentre,
+    local_points,
+    scan_points,
+)
+from slamtrials.slam.karto.spa import optimize_spa
 
 __all__ = ["Karto", "LoopCheck"]
 
-_TOLERANCE = 1e-9
 #: slam_toolbox's gate: a scan passes when its squared travel is at least this share of the squared
 #: minimum travel distance ("within 10% for correction error"), and not before the fifth scan
 _GATE_DISTANCE_FACTOR = 0.8
 _GATE_FIRST_SCANS = 5
+#: Karto's own ``MinimumTimeInterval`` (s), which slam_toolbox's ``SMapper::configure`` never overrides
+_KARTO_DEFAULT_TIME_INTERVAL = 3600.0
 
 
 def _mat3(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -181,6 +191,7 @@ class Karto:
             "angle_variance_penalty": 0.349,
             "use_response_expansion": False,
             "max_laser_range": 12.0,
+            "optimizer": "spa",
         },
     }
 
@@ -240,6 +251,9 @@ class Karto:
         self._last_map_t = -math.inf
         self._t: list[float] = []
         self._odometry: list[NDArray[np.float64]] = []
+        # slam_toolbox's gate: time and odometry pose of the last scan it let through
+        self._gate_t = -math.inf
+        self._gate_odometry = np.zeros(3)
         self._anchor: list[int] = []
         self._estimates: list[NDArray[np.float64]] = []
         self._angles: NDArray[np.float64] | None = None
@@ -248,6 +262,10 @@ class Karto:
         # after sequential matching; Compute starts from it and overwrites it with its result), a pose
         # set on a node afterwards (AddEdges' weighted mean, a loop closure's match) is not seen by it.
         self._solver_poses: list[NDArray[np.float64]] = []
+        # per node: the pose its map-frame points and barycentre were computed at, and those
+        self._world: dict[
+            int, tuple[NDArray[np.float64], tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]]
+        ] = {}
 
     # ------------------------------------------------------------------ helpers
 
@@ -257,23 +275,41 @@ class Karto:
     def _base_pose(self, laser_pose: NDArray[np.float64]) -> NDArray[np.float64]:
         return compose1(laser_pose, self.unmount)
 
+    def _world_points(self, index: int) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """Node ``index``'s map-frame points ``x, y [B]`` and barycentre ``[2]`` (NaN if it has none),
+        computed as Karto does whenever a scan's pose is set (LocalizedRangeScan::Update); kept until the
+        node's pose changes."""
+        node = self.graph.nodes[index]
+        cached = self._world.get(index)
+        if cached is not None and np.array_equal(cached[0], node.pose):
+            return cached[1]
+        laser_pose = self._laser_pose(index)
+        x, y = scan_points(laser_pose, node.readings, self.laser.angle_min, self.laser.angle_increment)
+        points = (x, y, barycentre(x, y, node.within))
+        self._world[index] = (node.pose.copy(), points)
+        return points
+
     def _references(self) -> NDArray[np.float64]:
         """``[N, 2]`` every node's reference position: its points' barycentre or its laser position."""
         nodes = self.graph.nodes
-        laser = compose(np.array([n.pose for n in nodes]).reshape(-1, 3), self.mount)
-        offsets = np.zeros((len(nodes), 2))
+        references = compose(np.array([n.pose for n in nodes]).reshape(-1, 3), self.mount)[:, :2]
         if self.config.use_scan_barycenter:
-            for k, node in enumerate(nodes):
-                if node.barycenter is not None:
-                    offsets[k] = node.barycenter
-        c, s = stablemath.cos(laser[:, 2]), stablemath.sin(laser[:, 2])
-        return np.column_stack(
-            [laser[:, 0] + c * offsets[:, 0] - s * offsets[:, 1], laser[:, 1] + s * offsets[:, 0] + c * offsets[:, 1]]
-        )
+            for k in range(len(nodes)):
+                centre = self._world_points(k)[2]
+                if not np.isnan(centre[0]):
+                    references[k] = centre
+        return references
 
     def _points(self, indexes: list[int]) -> list[tuple[NDArray[np.float64], NDArray[np.float64]]]:
-        nodes = self.graph.nodes
-        return [points_in_map(self._laser_pose(i), nodes[i].lx, nodes[i].ly) for i in indexes]
+        return [self._world_points(i)[:2] for i in indexes]
+
+    def _own_points(
+        self, laser_pose: NDArray[np.float64], node: ScanNode
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """A scan's points in the frame of ``laser_pose``, as Karto's lookup tables take them: its map-frame
+        points at that pose, brought back into the laser frame."""
+        x, y = scan_points(laser_pose, node.readings, self.laser.angle_min, self.laser.angle_increment)
+        return local_points(laser_pose, x, y)
 
     def _match(
         self,
@@ -285,8 +321,8 @@ class Karto:
         penalize: bool,
         refine: bool = True,
     ) -> MatchResult:
-        node = self.graph.nodes[index]
-        return matcher.match(laser_pose, node.lx, node.ly, self._points(base), penalize=penalize, refine=refine)
+        lx, ly = self._own_points(laser_pose, self.graph.nodes[index])
+        return matcher.match(laser_pose, lx, ly, self._points(base), penalize=penalize, refine=refine)
 
     def _scan_node(
         self,
@@ -317,33 +353,42 @@ class Karto:
             ly=ly,
             barycenter=barycenter,
             ranges=np.asarray(ranges, dtype=np.float32),
+            readings=r,
+            within=within,
         )
 
     def _is_node(self, t: float, odometry: NDArray[np.float64]) -> bool:
         """slam_toolbox's scan gate (``shouldProcessScan``, when ``scan_throttle``), then Karto's
-        HasMovedEnough."""
+        HasMovedEnough against the last node."""
         c = self.config
         if not self.graph.nodes:
+            self._gate_t, self._gate_odometry = t, odometry
             return True
-        last = self.graph.nodes[-1]
         if c.scan_throttle:
             # the first scan passes; scans 2 to 4 (counted from 1) never do
             if len(self._t) + 1 < _GATE_FIRST_SCANS:
                 return False
-            if t - last.t < c.minimum_time_interval:
+            if t - self._gate_t < c.minimum_time_interval:
                 return False
-            dx, dy = odometry[0] - last.odometry[0], odometry[1] - last.odometry[1]
+            dx, dy = odometry[0] - self._gate_odometry[0], odometry[1] - self._gate_odometry[1]
             # "check moved enough, within 10% for correction error": base poses, distance only
             if dx * dx + dy * dy < _GATE_DISTANCE_FACTOR * c.minimum_travel_distance**2:
                 return False
-        if t - last.t >= c.minimum_time_interval:
+            # the gate's reference moves on every scan it lets through, node or not
+            self._gate_t, self._gate_odometry = t, odometry
+            # slam_toolbox hands the mapper every Karto parameter but this one, so Karto keeps its default
+            time_interval = _KARTO_DEFAULT_TIME_INTERVAL
+        else:
+            time_interval = c.minimum_time_interval
+        last = self.graph.nodes[-1]
+        if t - last.t >= time_interval:
             return True
         before = compose1(last.odometry, self.mount)
         now = compose1(odometry, self.mount)
         if abs(wrap_angle1(now[2] - before[2])) >= c.minimum_travel_heading:
             return True
         dx, dy = now[0] - before[0], now[1] - before[1]
-        return dx * dx + dy * dy >= c.minimum_travel_distance**2 - _TOLERANCE
+        return dx * dx + dy * dy >= c.minimum_travel_distance**2 - KT_TOLERANCE
 
     # ------------------------------------------------------------------ graph building (Karto's MapperGraph)
 
@@ -358,7 +403,7 @@ class Karto:
             dx, dy = reference[k, 0] - here[0], reference[k, 1] - here[1]
             if dx * dx + dy * dy < best:
                 closest, best = k, dx * dx + dy * dy
-        if closest >= 0 and best < self.config.link_scan_maximum_distance**2 + _TOLERANCE:
+        if closest >= 0 and best < self.config.link_scan_maximum_distance**2 + KT_TOLERANCE:
             self.graph.link(closest, index, self._base_pose(laser_mean), covariance)
 
     def _add_edges(self, index: int, covariance: NDArray[np.float64]) -> None:
@@ -378,7 +423,7 @@ class Karto:
             if len(chain) < c.loop_match_minimum_chain_size:
                 continue
             result = self._match(self.sequential, self._laser_pose(index), index, chain, penalize=False)
-            if result.response > c.link_match_minimum_response_fine - _TOLERANCE:
+            if result.response > c.link_match_minimum_response_fine - KT_TOLERANCE:
                 means.append(result.pose)
                 covariances.append(result.covariance)
                 self._link_chain(chain, index, result.pose, result.covariance)
@@ -388,7 +433,7 @@ class Karto:
     def _add_running(self, index: int) -> None:
         c = self.config
         self.running.append(index)
-        limit = c.scan_buffer_maximum_scan_distance**2 - _TOLERANCE
+        limit = c.scan_buffer_maximum_scan_distance**2 - KT_TOLERANCE
         while True:
             front, back = self._laser_pose(self.running[0]), self._laser_pose(self.running[-1])
             dx, dy = back[0] - front[0], back[1] - front[1]
@@ -401,7 +446,8 @@ class Karto:
         """CorrectPoses: optimize the whole graph from the solver's copy of the nodes and move every node."""
         edges = self.graph.edges
         started = time.perf_counter()
-        result = optimize_pose_graph(
+        solve = optimize_spa if self.config.optimizer == "spa" else optimize_pose_graph
+        result = solve(
             np.array(self._solver_poses, dtype=np.float64).reshape(-1, 3),
             np.array([e.source for e in edges]),
             np.array([e.target for e in edges]),
@@ -479,10 +525,10 @@ class Karto:
         node = self._scan_node(frame_index, t, odometry, predicted, ranges)
         covariance = np.eye(3)
         if c.use_scan_matching and self.graph.nodes:
+            laser_pose = compose1(predicted, self.mount)
             result = self.sequential.match(
-                compose1(predicted, self.mount),
-                node.lx,
-                node.ly,
+                laser_pose,
+                *self._own_points(laser_pose, node),
                 self._points(self.running),
                 penalize=True,
                 refine=True,

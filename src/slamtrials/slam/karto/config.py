@@ -7,13 +7,14 @@ slam_toolbox's YAML holds and the squaring happens where it is used, as in Karto
 Parameters that are not Karto's matcher or graph settings: ``resolution``, ``max_laser_range`` and
 ``map_update_interval`` (slam_toolbox's, for the published map and the range threshold),
 ``min_pass_through`` and ``occupancy_threshold`` (Karto's occupancy-grid rule, slam_toolbox's code
-defaults), and ``initial_pose`` (slamtrials' own, as for GMapping). slam_toolbox's Ceres options are
-not parameters: the optimizer is the one of :mod:`.optimize` (see docs/karto.md).
+defaults), ``initial_pose`` (slamtrials' own, as for GMapping) and ``optimizer`` (which program's
+pose-graph solver). slam_toolbox's Ceres options are not parameters (see docs/karto.md).
 """
 
 from __future__ import annotations
 
 import math
+from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
@@ -87,6 +88,10 @@ class KartoConfig(BaseModel):
         hits / crossings exceeds ``occupancy_threshold``.
     initial_pose:
         Map-frame base pose (x, y, theta) of the first scan; None: the first odometry pose.
+    optimizer:
+        The pose-graph solver run after each loop closure: ``ceres`` (slam_toolbox's CeresSolver set-up,
+        :mod:`.optimize`) or ``spa`` (slam_karto's SpaSolver, sparse_bundle_adjustment's ``doSPA(40)``,
+        :mod:`.spa`).
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True)
@@ -137,6 +142,8 @@ class KartoConfig(BaseModel):
     initial_pose: tuple[float, float, float] | None = Field(
         None, description="base pose of the first scan; None: first odometry pose"
     )
+
+    optimizer: Literal["ceres", "spa"] = Field("ceres", description="pose-graph solver: slam_toolbox's or slam_karto's")
 
     @field_validator("initial_pose")
     @classmethod

@@ -42,7 +42,8 @@ OCCUPIED_VALUE = 100
 MAX_VARIANCE = 500.0
 _DISTANCE_PENALTY_GAIN = 0.2
 _ANGLE_PENALTY_GAIN = 0.2
-_TOLERANCE = 1e-9  # Karto's KT_TOLERANCE
+#: Karto's KT_TOLERANCE (Math.h): the margin of its DoubleEqual and of its distance and response tests
+KT_TOLERANCE = 1e-6
 
 
 @njit(cache=True, nogil=True)
@@ -142,8 +143,12 @@ def add_points(grid, border, roi, ox, oy, inv_res, px, py, valid, kernel, box): 
 
 
 @njit(cache=True, nogil=True)
-def _lookup(lx, ly, heading0, angle_step, n_angles, inv_res):  # pragma: no cover - compiled
-    """Cell offsets ``[A, P]`` (columns, rows) of the points at each searched heading."""
+def _lookup(lx, ly, heading0, angle_step, n_angles, ox, oy, inv_res):  # pragma: no cover - compiled
+    """Cell offsets ``[A, P]`` (columns, rows) of the points at each searched heading.
+
+    As Karto's GridIndexLookup::ComputeOffsets, the rotated point is moved by the grid's origin and
+    back before it is rounded (WorldToGrid of offset + origin), which can round a point lying on a
+    cell's edge the other way."""
     n = lx.shape[0]
     dcol = np.empty((n_angles, n), dtype=np.int64)
     drow = np.empty((n_angles, n), dtype=np.int64)
@@ -152,35 +157,37 @@ def _lookup(lx, ly, heading0, angle_step, n_angles, inv_res):  # pragma: no cove
         c = math.cos(angle)
         s = math.sin(angle)
         for p in range(n):
-            dcol[a, p] = int(_round((c * lx[p] - s * ly[p]) * inv_res))
-            drow[a, p] = int(_round((s * lx[p] + c * ly[p]) * inv_res))
+            dcol[a, p] = int(_round(((c * lx[p] - s * ly[p]) + ox - ox) * inv_res))
+            drow[a, p] = int(_round(((s * lx[p] + c * ly[p]) + oy - oy) * inv_res))
     return dcol, drow
 
 
 @njit(cache=True, nogil=True)
 def _response(grid, row, col, dcol, drow, a, norm):  # pragma: no cover - compiled
-    height, width = grid.shape
+    height, width_step = grid.shape
+    size = height * width_step
     total = 0
     for p in range(dcol.shape[1]):
-        r = row + drow[a, p]
-        c = col + dcol[a, p]
-        if 0 <= r < height and 0 <= c < width:
-            total += grid[r, c]
+        flat = (row + drow[a, p]) * width_step + col + dcol[a, p]
+        if 0 <= flat < size:
+            total += grid[flat // width_step, flat % width_step]
     return total / norm
 
 
 @njit(cache=True, nogil=True)
 def _totals(grid, rows, cols, dcol, drow):  # pragma: no cover - compiled
     """int32 ``[A, Y, X]``: the sum of the grid values under the points at heading ``a`` from the position
-    in array row ``rows[y]`` and column ``cols[x]``; points off the array add nothing.
+    in array row ``rows[y]`` and column ``cols[x]``, each point read at its flat index (Karto's lookup:
+    module docstring).
 
     The same sums as :func:`_response` at every position, accumulated point by point over the whole
-    lattice of positions instead (integer sums, at most 100 per point: the order does not change them):
-    for one heading and point the cells read are a small window of the grid, read as a strided view
-    when the rows and columns are evenly spaced (they nearly always are) and the window lies on the
-    array, else row by row.
+    lattice of positions instead (integer sums, at most 100 per point: the order does not change them).
+    For one heading and point the cells read are a small window of the grid: a strided view when the
+    rows and columns are evenly spaced (they nearly always are) and the window neither leaves the array
+    nor runs past a row's end; else cell by cell.
     """
-    height, width = grid.shape
+    height, width_step = grid.shape
+    size = height * width_step
     n_angles, n_points = dcol.shape
     n_y = rows.shape[0]
     n_x = cols.shape[0]
@@ -188,37 +195,30 @@ def _totals(grid, rows, cols, dcol, drow):  # pragma: no cover - compiled
     even = _evenly_spaced(rows) and _evenly_spaced(cols)
     row_stride = rows[1] - rows[0] if n_y > 1 else 1
     col_stride = cols[1] - cols[0] if n_x > 1 else 1
-    # rows and cols are non-decreasing (rounding a growing sequence), so a point's window is on the array
-    # when its first and last row and column are
     for a in range(n_angles):
         for p in range(n_points):
             dr = drow[a, p]
             dc = dcol[a, p]
-            top = rows[0] + dr
-            first = cols[0] + dc
-            rows_inside = top >= 0 and rows[n_y - 1] + dr < height
-            inside = first >= 0 and cols[n_x - 1] + dc < width
-            if even and rows_inside and inside:
-                window = grid[top : top + row_stride * n_y : row_stride, first : first + col_stride * n_x : col_stride]
-                out2 = totals[a]
-                for iy in range(n_y):
-                    for ix in range(n_x):
-                        out2[iy, ix] += window[iy, ix]
-                continue
-            for iy in range(n_y):
-                r = rows[iy] + dr
-                if r < 0 or r >= height:
+            if even:
+                first = (rows[0] + dr) * width_step + cols[0] + dc
+                top = first // width_step
+                left = first - top * width_step
+                if top >= 0 and top + row_stride * (n_y - 1) < height and left + col_stride * (n_x - 1) < width_step:
+                    window = grid[
+                        top : top + row_stride * n_y : row_stride, left : left + col_stride * n_x : col_stride
+                    ]
+                    out2 = totals[a]
+                    for iy in range(n_y):
+                        for ix in range(n_x):
+                            out2[iy, ix] += window[iy, ix]
                     continue
-                line = grid[r]
+            for iy in range(n_y):
+                base = (rows[iy] + dr) * width_step + dc
                 out = totals[a, iy]
-                if inside:
-                    for ix in range(n_x):
-                        out[ix] += line[cols[ix] + dc]
-                else:
-                    for ix in range(n_x):
-                        c = cols[ix] + dc
-                        if 0 <= c < width:
-                            out[ix] += line[c]
+                for ix in range(n_x):
+                    flat = base + cols[ix]
+                    if 0 <= flat < size:
+                        out[ix] += grid[flat // width_step, flat % width_step]
     return totals
 
 
@@ -260,11 +260,12 @@ def _nonzero_rows(grid):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _totals_sparse(starts, nonzero_cols, values, rows, cols, dcol, drow):  # pragma: no cover - compiled
+def _totals_sparse(starts, nonzero_cols, values, width_step, rows, cols, dcol, drow):  # pragma: no cover - compiled
     """:func:`_totals` from the grid's nonzero cells (:func:`_nonzero_rows`), for evenly spaced ``cols``:
-    a point adds to the positions whose cell is one of the nonzero cells of its window's row (zeros add
-    nothing), so the row's nonzero cells between the window's first and last column are walked instead
-    of every cell of the window."""
+    a point adds to the positions whose cell is one of the nonzero cells it reads (zeros add nothing).
+    The cells one point reads from one row of positions are consecutive flat indexes, so they lie on one
+    or more consecutive array rows; each piece is walked over its row's nonzero cells instead of cell by
+    cell."""
     height = starts.shape[0] - 1
     n_angles, n_points = dcol.shape
     n_y = rows.shape[0]
@@ -274,23 +275,29 @@ def _totals_sparse(starts, nonzero_cols, values, rows, cols, dcol, drow):  # pra
     for a in range(n_angles):
         for p in range(n_points):
             dr = drow[a, p]
-            first = cols[0] + dcol[a, p]
-            last = cols[n_x - 1] + dcol[a, p]
+            dc = dcol[a, p]
             for iy in range(n_y):
-                r = rows[iy] + dr
-                if r < 0 or r >= height:
-                    continue
-                lo = starts[r]
-                hi = starts[r + 1]
-                if lo == hi or nonzero_cols[lo] > last or nonzero_cols[hi - 1] < first:
-                    continue
-                k = lo + np.searchsorted(nonzero_cols[lo:hi], first)
                 out = totals[a, iy]
-                while k < hi and nonzero_cols[k] <= last:
-                    offset = nonzero_cols[k] - first
-                    if offset % stride == 0:
-                        out[offset // stride] += values[k]
-                    k += 1
+                row_first = (rows[iy] + dr) * width_step + cols[0] + dc  # flat index read from position 0
+                start = 0
+                while start < n_x:
+                    flat = row_first + start * stride
+                    r = flat // width_step
+                    first = flat - r * width_step
+                    # positions start .. stop - 1 read array row r, columns first, first + stride, ...
+                    stop = min(n_x, start + (width_step - 1 - first) // stride + 1)
+                    last = first + (stop - 1 - start) * stride
+                    if 0 <= r < height:
+                        lo = starts[r]
+                        hi = starts[r + 1]
+                        if lo < hi and nonzero_cols[lo] <= last and nonzero_cols[hi - 1] >= first:
+                            k = lo + np.searchsorted(nonzero_cols[lo:hi], first)
+                            while k < hi and nonzero_cols[k] <= last:
+                                offset = nonzero_cols[k] - first
+                                if offset % stride == 0:
+                                    out[start + offset // stride] += values[k]
+                                k += 1
+                    start = stop
     return totals
 
 
@@ -335,7 +342,7 @@ def correlate(
     n_x = int(_round(search_offset * 2.0 / search_step)) + 1
     n_angles = int(_round(angle_offset * 2.0 / angle_step)) + 1
     heading0 = ctheta - angle_offset
-    dcol, drow = _lookup(lx, ly, heading0, angle_step, n_angles, inv_res)
+    dcol, drow = _lookup(lx, ly, heading0, angle_step, n_angles, ox, oy, inv_res)
     norm = float(n_points) * OCCUPIED_VALUE
     rows = np.empty(n_x, dtype=np.int64)
     cols = np.empty(n_x, dtype=np.int64)
@@ -347,7 +354,7 @@ def correlate(
     if height * width * 4 < n_angles * lx.shape[0] * n_x * n_x and _evenly_spaced(cols):
         # a large search on a small grid (the loop matcher): walk only the nonzero cells of each row
         starts, nonzero_cols, values = _nonzero_rows(grid)
-        totals = _totals_sparse(starts, nonzero_cols, values, rows, cols, dcol, drow)
+        totals = _totals_sparse(starts, nonzero_cols, values, width, rows, cols, dcol, drow)
     else:
         totals = _totals(grid, rows, cols, dcol, drow)
     responses = np.empty((n_x, n_x, n_angles))
@@ -357,7 +364,7 @@ def correlate(
             x = -search_offset + ix * search_step
             for a in range(n_angles):
                 response = totals[a, iy, ix] / norm
-                if penalize and abs(response) >= _TOLERANCE:
+                if penalize and abs(response) >= KT_TOLERANCE:
                     distance_penalty = 1.0 - _DISTANCE_PENALTY_GAIN * (x * x + y * y) / distance_variance
                     distance_penalty = max(distance_penalty, minimum_distance_penalty)
                     da = -angle_offset + a * angle_step
@@ -378,7 +385,7 @@ def correlate(
     for iy in range(n_x):
         for ix in range(n_x):
             for a in range(n_angles):
-                if abs(responses[iy, ix, a] - best) < _TOLERANCE:
+                if abs(responses[iy, ix, a] - best) < KT_TOLERANCE:
                     sum_x += cx + (-search_offset + ix * search_step)
                     sum_y += cy + (-search_offset + iy * search_step)
                     heading = heading0 + a * angle_step
@@ -408,8 +415,8 @@ def correlate(
                 angle = heading0 + a * angle_step
                 total += response
                 accumulated += (angle - best_angle) ** 2 * response
-        if total > _TOLERANCE:
-            if accumulated < _TOLERANCE:
+        if total > KT_TOLERANCE:
+            if accumulated < KT_TOLERANCE:
                 accumulated = angle_step * angle_step
             accumulated /= total
         else:
@@ -426,7 +433,7 @@ def _positional_covariance(
     for i in range(3):
         for j in range(3):
             covariance[i, j] = 1.0 if i == j else 0.0
-    if best < _TOLERANCE:
+    if best < KT_TOLERANCE:
         covariance[0, 0] = MAX_VARIANCE
         covariance[1, 1] = MAX_VARIANCE
         covariance[2, 2] = 4.0 * angle_step * angle_step
@@ -448,7 +455,7 @@ def _positional_covariance(
                 xx += (x - dx) ** 2 * response
                 xy += (x - dx) * (y - dy) * response
                 yy += (y - dy) ** 2 * response
-    if total > _TOLERANCE:
+    if total > KT_TOLERANCE:
         minimum = 0.1 * search_step * search_step
         multiplier = 1.0 / best
         covariance[0, 0] = max(xx / total, minimum) * multiplier
@@ -456,7 +463,7 @@ def _positional_covariance(
         covariance[1, 0] = xy / total * multiplier
         covariance[1, 1] = max(yy / total, minimum) * multiplier
         covariance[2, 2] = 4.0 * angle_step * angle_step
-    if abs(covariance[0, 0]) < _TOLERANCE:
+    if abs(covariance[0, 0]) < KT_TOLERANCE:
         covariance[0, 0] = MAX_VARIANCE
-    if abs(covariance[1, 1]) < _TOLERANCE:
+    if abs(covariance[1, 1]) < KT_TOLERANCE:
         covariance[1, 1] = MAX_VARIANCE

@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from slamtrials.geometry import compose1, ominus1
+from slamtrials.slam.karto.correlation import KT_TOLERANCE
 
 __all__ = ["ScanNode", "Edge", "PoseGraph", "rotate_covariance", "laser_pose"]
 
@@ -41,6 +42,10 @@ class ScanNode:
         float64 ``[2]`` mean of the points within the range threshold (laser frame), or None if none is.
     ranges:
         float32 ``[B]`` the readings (for the map).
+    readings:
+        float64 ``[B]`` the readings that give a point (m), NaN elsewhere (Karto's unfiltered points).
+    within:
+        bool ``[B]`` the readings within the range threshold (Karto's filtered points: the barycentre's).
     """
 
     frame: int
@@ -51,6 +56,8 @@ class ScanNode:
     ly: NDArray[np.float64]
     barycenter: NDArray[np.float64] | None
     ranges: NDArray[np.float32]
+    readings: NDArray[np.float64]
+    within: NDArray[np.bool_]
 
 
 @dataclass(frozen=True)
@@ -115,7 +122,7 @@ class PoseGraph:
     def near_linked(self, start: int, reference: NDArray[np.float64], max_distance: float) -> list[int]:
         """Karto's FindNearLinkedScans: breadth-first from ``start`` through edges, over the nodes whose
         reference position ``reference[i]`` (``[N, 2]``) lies within ``max_distance`` of start's."""
-        limit = max_distance * max_distance - 1e-9
+        limit = max_distance * max_distance - KT_TOLERANCE
         cx, cy = reference[start]
         seen = {start}
         queue = deque([start])

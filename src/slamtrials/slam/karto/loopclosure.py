@@ -16,11 +16,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from slamtrials.slam.karto.correlation import KT_TOLERANCE
 from slamtrials.slam.karto.graph import PoseGraph
 
 __all__ = ["find_near_chains", "find_loop_closure_chain"]
-
-_TOLERANCE = 1e-9
 
 
 def _squared_distance(reference: NDArray[np.float64], a: int, b: int) -> float:
@@ -33,7 +32,7 @@ def find_near_chains(
     graph: PoseGraph, new: int, reference: NDArray[np.float64], max_distance: float
 ) -> list[list[int]]:
     """Chains of consecutive nodes within ``max_distance`` (m) of node ``new`` (see the module)."""
-    limit = max_distance * max_distance + _TOLERANCE
+    limit = max_distance * max_distance + KT_TOLERANCE
     chains: list[list[int]] = []
     processed: set[int] = set()
     count = len(graph.nodes)
@@ -72,7 +71,7 @@ def find_loop_closure_chain(
 
     Returns the chain (empty when there is none left) and the index to continue from.
     """
-    limit = max_distance * max_distance + _TOLERANCE
+    limit = max_distance * max_distance + KT_TOLERANCE
     linked = set(graph.near_linked(new, reference, max_distance))
     chain: list[int] = []
     count = len(graph.nodes)

@@ -12,8 +12,9 @@ the sparse Cholesky of :mod:`.sparsechol` (no BLAS, so the same bits on every CP
 Ceres' TrustRegionMinimizer and Levenberg-Marquardt strategy with slam_toolbox's options: initial
 radius 1e4 (at most 1e8); a step whose model decrease is not positive (or whose system is not positive
 definite) is invalid, and three in a row end the run; otherwise the step is tried and the run ends,
-*without taking it*, when it is shorter than 1e-3 of the state (parameter tolerance; not in the first
-iteration, where Ceres does not know the state's norm yet) or changes the cost by at most 1e-3 of it
+*without taking it*, when it is shorter than 1e-3 of the state's norm (parameter tolerance; the raw
+coordinates of the free nodes, as Ceres takes them, so a map frame far from its origin stops runs
+sooner; not before the first taken step, when Ceres does not know the norm yet) or changes the cost by at most 1e-3 of it
 (function tolerance, taken or not); it is taken when its quality exceeds 1e-3, the quality being the
 larger of the decrease relative to the model's and the same against a lagging reference cost
 (non-monotonic steps, at most 3 in a row); the radius grows by ``1 / max(1/3, 1 - (2 q - 1)^3)`` after
@@ -336,8 +337,10 @@ def optimize_pose_graph(
         quality = steps.quality(new_cost, predicted)
         if quality > MIN_RELATIVE_DECREASE:
             x = candidate
-            relative = (x[1:] - x[0]).reshape(-1)  # the state measured from the fixed node: where the odometry
-            state_norm = math.sqrt(_dot(relative, relative))  # frame's origin lies must not matter
+            # Ceres' norm of the free parameters as they are, so where the map frame's origin lies
+            # matters: far from it (as on logs in world coordinates) the tolerance ends runs sooner
+            free = x[1:].reshape(-1)
+            state_norm = math.sqrt(_dot(free, free))
             linearized = True
             radius = min(MAX_RADIUS, radius / max(1.0 / 3.0, 1.0 - (2.0 * quality - 1.0) ** 3))
             decrease_factor = 2.0

@@ -15,9 +15,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 
 from slamtrials.slam.karto.correlation import (
+    KT_TOLERANCE,
     MAX_VARIANCE,
     add_points,
     correlate,
@@ -26,7 +28,7 @@ from slamtrials.slam.karto.correlation import (
     smear_kernel,
 )
 
-__all__ = ["MatchResult", "MatcherSettings", "ScanMatcher", "points_in_map"]
+__all__ = ["MatchResult", "MatcherSettings", "ScanMatcher", "local_points", "points_in_map", "scan_points"]
 
 
 @dataclass(frozen=True)
@@ -71,6 +73,62 @@ def points_in_map(
     return laser_pose[0] + c * lx - s * ly, laser_pose[1] + s * lx + c * ly
 
 
+@njit(cache=True, nogil=True)
+def scan_points(laser_pose, readings, angle_min, angle_increment):  # pragma: no cover - compiled
+    """Karto's point readings of a scan taken at ``laser_pose`` (LocalizedRangeScan::Update), with its
+    arithmetic: beam ``i`` at heading ``(theta + angle_min) + i angle_increment``, the point at
+    ``x + r cos(heading)``, ``y + r sin(heading)``.
+
+    ``laser_pose`` float64 ``[3]`` (map frame), ``readings`` float64 ``[B]`` ranges (m), NaN where a
+    beam has no point. Returns map-frame ``x, y`` float64 ``[B]``, NaN where a beam has none, and the
+    sequential sum of the points flagged in ``within`` is not taken here (see :func:`barycentre`).
+    """
+    n = readings.shape[0]
+    x = np.empty(n)
+    y = np.empty(n)
+    for i in range(n):
+        heading = (laser_pose[2] + angle_min) + i * angle_increment
+        x[i] = laser_pose[0] + readings[i] * math.cos(heading)
+        y[i] = laser_pose[1] + readings[i] * math.sin(heading)
+    return x, y
+
+
+@njit(cache=True, nogil=True)
+def barycentre(x, y, within):  # pragma: no cover - compiled
+    """Karto's barycentre: the sequential sum of the map-frame points flagged in ``within`` (bool
+    ``[B]``), divided by their count; float64 ``[2]``, NaN when none is."""
+    sx = 0.0
+    sy = 0.0
+    count = 0
+    for i in range(x.shape[0]):
+        if within[i]:
+            sx += x[i]
+            sy += y[i]
+            count += 1
+    out = np.full(2, np.nan)
+    if count:
+        out[0] = sx / count
+        out[1] = sy / count
+    return out
+
+
+@njit(cache=True, nogil=True)
+def local_points(laser_pose, x, y):  # pragma: no cover - compiled
+    """Map-frame points ``[B]`` brought back into the frame of ``laser_pose`` as Karto's
+    GridIndexLookup does it (Transform::InverseTransformPose): ``(c dx + s dy, -s dx + c dy)``."""
+    c = math.cos(laser_pose[2])
+    s = math.sin(laser_pose[2])
+    n = x.shape[0]
+    lx = np.empty(n)
+    ly = np.empty(n)
+    for i in range(n):
+        dx = x[i] - laser_pose[0]
+        dy = y[i] - laser_pose[1]
+        lx[i] = c * dx + s * dy
+        ly[i] = -s * dx + c * dy
+    return lx, ly
+
+
 class ScanMatcher:
     """A correlation grid and search space of one size (Karto's ScanMatcher::Create).
 
@@ -103,7 +161,9 @@ class ScanMatcher:
         self.kernel = smear_kernel(resolution, smear_deviation)
         self.border = self.kernel.shape[0] // 2 + 1
         size = self.roi + 2 * self.border
-        self.grid = np.zeros((size, size), dtype=np.uint8)
+        # Karto's Grid stores its rows with a stride rounded up to a multiple of 8 (AlignValue): the
+        # padding stays zero, and a point read beyond a row's end lands there or on the next row
+        self.grid = np.zeros((size, -(-size // 8) * 8), dtype=np.uint8)
         self._box = np.array([size, -1, size, -1], dtype=np.int64)  # written cells: rows, columns
 
     def _clear(self) -> None:
@@ -185,7 +245,7 @@ class ScanMatcher:
             mean,
             covariance,
         )
-        if s.use_response_expansion and abs(best) < 1e-9:
+        if s.use_response_expansion and abs(best) < KT_TOLERANCE:
             angle_offset = s.coarse_search_angle_offset
             for _ in range(3):
                 angle_offset += math.radians(20.0)
@@ -211,7 +271,7 @@ class ScanMatcher:
                     mean,
                     covariance,
                 )
-                if abs(best) >= 1e-9:
+                if abs(best) >= KT_TOLERANCE:
                     break
         if refine:
             center = mean.copy()

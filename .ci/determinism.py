@@ -19,8 +19,9 @@ CARMEN log (``gmapping/``, ``karto/``), and ``calibrate`` and ``validate`` (``re
 replica) over the first scans of that log (``calibration/``, ``validation/``); the log's parts only when
 the shared data is there: ``SLAMTRIALS_SHARED`` or ``../shared`` beside the repository. It then writes
 ``manifest.json``: the sha256 of every file, and of every array of an ``.npz`` file (a zip, whose bytes
-depend on the zlib that compressed it); JSON files are hashed without their wall-clock timings and
-software versions; ``timing.csv`` is left out.
+depend on the zlib that compressed it); JSON files are hashed without their wall-clock timings, software
+versions and ``cost`` objects (CPU time and memory of a run: measurements, not results); ``timing.csv``
+is left out.
 
 ``check`` fails (exit status 1) naming every file that differs between the two passes, or a regenerated
 catalog file that differs from the one bundled in the package. Usage::
@@ -63,6 +64,8 @@ LOG_SCANS, LOG_SEED = 300, 1
 CALIBRATION_SCANS, CALIBRATION_BOOTSTRAP, VALIDATION_RUNS = 600, 10, 1
 #: Keys of JSON outputs that hold wall-clock measurements or software versions, not results.
 _VOLATILE_WORDS = ("versions", "wall", "seconds", "realtime", "ms_per_frame")
+#: Keys of JSON outputs whose whole value is a measurement of the machine: a run's cost (CPU time, memory).
+_VOLATILE_KEYS = ("cost",)
 #: Files that hold only wall-clock measurements.
 _VOLATILE_FILES = {"timing.csv", MANIFEST}
 
@@ -75,9 +78,13 @@ def _sha256(data: bytes) -> str:
 
 
 def _without_volatile(value):
-    """A JSON value without the keys that name wall-clock timings or versions (at any depth)."""
+    """A JSON value without the keys that name wall-clock timings, versions or costs (at any depth)."""
     if isinstance(value, dict):
-        return {k: _without_volatile(v) for k, v in value.items() if not any(w in k.lower() for w in _VOLATILE_WORDS)}
+        return {
+            k: _without_volatile(v)
+            for k, v in value.items()
+            if k not in _VOLATILE_KEYS and not any(w in k.lower() for w in _VOLATILE_WORDS)
+        }
     if isinstance(value, list):
         return [_without_volatile(v) for v in value]
     return value

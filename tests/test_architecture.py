@@ -9,8 +9,9 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "src" / "slamtrials"
 
-#: Modules every layer may import: they hold no behaviour of any layer.
-UTILITIES = {"errors", "atomicfile", "__about__", "stablemath", "seeding", "compilewatch"}
+#: Modules every layer may import: they hold no behaviour of any layer (``cost`` and ``costmeter``: what a
+#: run cost in CPU time and memory, and the meter that reads the clocks and the kernel's counters).
+UTILITIES = {"errors", "atomicfile", "__about__", "stablemath", "seeding", "compilewatch", "cost", "costmeter"}
 
 #: Layer -> the slamtrials layers it may import (DESIGN.md, "Layers").
 ALLOWED = {

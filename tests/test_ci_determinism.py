@@ -27,6 +27,8 @@ def _outputs(folder: Path, *, wall_time: float, estimate_last: float = 3.0) -> P
                 "seed": 1,
                 "versions": {"numpy": "x"},
                 "trial": {"duration_s": 172.2, "wall_time_s": wall_time, "explorer": {"plan_seconds": wall_time}},
+                # a run's cost is a measurement of the machine, never a result
+                "cost": {"slam_cpu_s": wall_time, "slam_peak_mib": 40.0 + wall_time, "update_ms_p90": wall_time},
             }
         )
     )
@@ -34,7 +36,7 @@ def _outputs(folder: Path, *, wall_time: float, estimate_last: float = 3.0) -> P
     return folder
 
 
-def test_manifests_of_the_same_results_agree_whatever_the_wall_clock(tmp_path):
+def test_manifests_of_the_same_results_agree_whatever_the_wall_clock_and_the_cost(tmp_path):
     a = determinism.manifest_of(_outputs(tmp_path / "a", wall_time=1.5))
     b = determinism.manifest_of(_outputs(tmp_path / "b", wall_time=9.25))
     assert set(a) == {"trial/frames.npz[t]", "trial/frames.npz[estimate]", "trial/map.pgm", "trial/run.json"}

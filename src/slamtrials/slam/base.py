@@ -26,12 +26,14 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ValidationError
 
+from slamtrials.cost import ProcessUsage
 from slamtrials.errors import ConfigError
 from slamtrials.record import FREE, OCCUPIED, UNKNOWN, LaserGeometry, OccupancyGrid, Reading, Trajectory
 
 __all__ = [
     "OccupancyGrid",
     "SlamAlgorithm",
+    "ChildProcessAlgorithm",
     "ALGORITHMS",
     "ENTRY_POINT_GROUP",
     "register_algorithm",
@@ -91,6 +93,17 @@ class SlamAlgorithm(Protocol):
 
     def trajectory(self) -> Trajectory:
         """Timestamps (s) and pose estimates (map frame) of every frame processed since :meth:`reset`."""
+        ...
+
+
+@runtime_checkable
+class ChildProcessAlgorithm(Protocol):
+    """An algorithm that does its work in a child process (an external program run online): what that
+    process used is its cost, not the CPU time and memory of the calls into this object."""
+
+    def child_usage(self) -> ProcessUsage | None:
+        """What the child process started since the last ``reset`` used, once it has exited (after
+        ``trajectory()``); None before that, or when it was killed."""
         ...
 
 

@@ -2,24 +2,27 @@
 replays and every other place that feeds recorded frames to an algorithm.
 
 It seeds the algorithm by the convention of :mod:`slamtrials.seeding`, so a recording of a trial run
-with the trial's seed gives the trial's own estimate, bit for bit. It does no I/O.
+with the trial's seed gives the trial's own estimate, bit for bit, and measures what the run cost
+(:class:`~slamtrials.cost.RunCost`, :mod:`slamtrials.costmeter`). It does no I/O.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel
 
+from slamtrials.cost import RunCost
+from slamtrials.costmeter import CostMeter
 from slamtrials.errors import ConfigError
 from slamtrials.record import OccupancyGrid, Reading, RunRecord, Trajectory
 from slamtrials.seeding import check_seed, slam_rng
-from slamtrials.slam.base import get_algorithm, resolve_config
+from slamtrials.slam.base import ChildProcessAlgorithm, get_algorithm, resolve_config
 
 __all__ = ["SlamRun", "estimate_per_frame", "run_over_recording"]
 
@@ -48,6 +51,9 @@ class SlamRun:
         float64 ``[T]`` wall-clock seconds of each ``process`` call.
     updates:
         The algorithm's update count after the last frame.
+    cost:
+        CPU time and peak memory of the algorithm and of the whole run, and the time per update
+        (:class:`~slamtrials.cost.RunCost`); None where unknown (keyword only).
     """
 
     algorithm: str
@@ -59,6 +65,7 @@ class SlamRun:
     occupancy: OccupancyGrid
     timing: NDArray[np.float64]
     updates: int
+    cost: RunCost | None = field(default=None, kw_only=True)
 
     def estimate_per_frame(self, record: RunRecord) -> NDArray[np.float64]:
         """float64 ``[T, 3]``: the estimate at each frame of ``record`` (see :func:`estimate_per_frame`)."""
@@ -115,26 +122,39 @@ def run_over_recording(
         raise ConfigError("the recording has no frames")
     cls = get_algorithm(algorithm)
     config = resolve_config(cls, preset=preset, overrides=overrides)
+    meter = CostMeter()  # reads clocks and the kernel's memory counters: nothing flows back into the run
+    mark = meter.enter()
     slam = cls(config, record.laser)
     slam.reset(slam_rng(seed))
+    meter.leave(mark)
     total = len(record)
     timing = np.empty(total, dtype=np.float64)
     online = np.empty((total, 3), dtype=np.float64)
     for k in range(total):
         frame = Reading(t=float(record.t[k]), ranges=record.scans[k], odometry=record.odometry[k])
+        updates = slam.updates
         started = time.perf_counter()
+        mark = meter.enter()
         online[k] = slam.process(frame)
+        meter.leave(mark, update=slam.updates > updates)
         timing[k] = time.perf_counter() - started
         if on_frame is not None:
             on_frame(k, total)
+    mark = meter.enter()
+    trajectory = slam.trajectory()
+    occupancy = slam.occupancy()
+    meter.leave(mark)
     return SlamRun(
         algorithm=algorithm,
         preset=preset,
         config=config,
         seed=seed,
-        trajectory=slam.trajectory(),
+        trajectory=trajectory,
         online=online,
-        occupancy=slam.occupancy(),
+        occupancy=occupancy,
         timing=timing,
         updates=int(slam.updates),
+        cost=meter.finish(slam.child_usage(), in_child=True)
+        if isinstance(slam, ChildProcessAlgorithm)  # a program online: its cost is its process's
+        else meter.finish(),
     )

@@ -25,12 +25,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from slamtrials import stablemath
+from slamtrials.cost import COST_KEY
+from slamtrials.costmeter import CostMeter
 from slamtrials.errors import ConfigError
 from slamtrials.explore import Explorer, SnapshotTermination
 from slamtrials.record import Frame, OccupancyGrid, RunRecord
 from slamtrials.seeding import check_seed, run_streams
 from slamtrials.sim import Simulator
-from slamtrials.slam import get_algorithm
+from slamtrials.slam import ChildProcessAlgorithm, get_algorithm
 from slamtrials.trial.config import TrialConfig
 from slamtrials.trial.coverage import (
     known_free_area,
@@ -126,11 +128,14 @@ def run_trial(
     config.slam.check_online()
     slam_config = config.slam.resolved()
     started = time.perf_counter()
+    meter = CostMeter()  # reads clocks and the kernel's memory counters: nothing flows back into the run
 
     sim = Simulator(world, config.sim, np.random.default_rng(streams.simulator))
     laser = sim.laser
+    mark = meter.enter()
     slam = get_algorithm(config.slam.algorithm)(slam_config, laser)
     slam.reset(np.random.default_rng(streams.slam))
+    meter.leave(mark)
     explorer = Explorer(config.explore, config.robot_limits())
     reachable = world.reachable_by_disc(config.sim.robot.radius)
     reachable_area = world.area_of(reachable)
@@ -146,11 +151,16 @@ def run_trial(
     slam_seconds = 0.0
     while True:
         frames.append(frame)
+        updates = slam.updates
         tick = time.perf_counter()
+        mark = meter.enter()
         estimate = slam.process(frame.reading())  # the algorithm never sees the truth
+        meter.leave(mark, update=slam.updates > updates)
         slam_seconds += time.perf_counter() - tick
         online.append(np.array(estimate, dtype=np.float64))
+        mark = meter.enter()
         grid = slam.occupancy()
+        meter.leave(mark)
         reason = termination.check(frame.t, grid)
         if reason is not None:
             break
@@ -164,6 +174,7 @@ def run_trial(
         frame = sim.step(command)
 
     record = RunRecord.from_frames(frames, laser)
+    mark = meter.enter()
     trajectory = slam.trajectory()
     if len(trajectory) != len(record) or not np.array_equal(trajectory.t, record.t):
         raise ConfigError(
@@ -173,6 +184,7 @@ def run_trial(
     record.estimate = trajectory.poses
     record.online = np.stack(online)
     final_map: OccupancyGrid = slam.occupancy()
+    meter.leave(mark)
     record.map = final_map
     wall = time.perf_counter() - started
     duration = float(record.t[-1] - record.t[0])
@@ -201,11 +213,16 @@ def run_trial(
         explorer={k: (round(v, 3) if isinstance(v, float) else v) for k, v in vars(stats).items()},
         snapshots=tuple((round(t, 3), round(mse, 4)) for t, mse in termination.history),
     )
+    if isinstance(slam, ChildProcessAlgorithm):  # an external program: its cost is its process's
+        cost = meter.finish(slam.child_usage(), in_child=True)
+    else:
+        cost = meter.finish()
     record.metadata = {
         **sim.metadata,
         "seed": int(seed),
         "trial": summary.to_dict(),
         "config": config.model_dump(mode="json"),
         "slam_config": slam_config.model_dump(mode="json"),
+        COST_KEY: cost.to_dict(),
     }
     return record

@@ -1,0 +1,85 @@
+"""CostMeter: CPU time inside and outside the measured calls, the memory a call allocates, update times."""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from slamtrials.cost import CHILD_PROCESS, IN_PROCESS, ProcessUsage
+from slamtrials.costmeter import CostMeter, ResidentMemory, usage_of
+
+needs_proc = pytest.mark.skipif(ResidentMemory.open() is None, reason="no usable /proc/self/status and clear_refs")
+
+
+def _busy(seconds: float) -> None:
+    end = time.thread_time() + seconds
+    while time.thread_time() < end:
+        pass
+
+
+def test_cpu_time_of_the_calls_and_of_the_run_and_the_update_times():
+    meter = CostMeter(memory=False)
+    _busy(0.05)  # the run's own work, outside SLAM
+    for k in range(5):
+        mark = meter.enter()
+        _busy(0.004 if k % 2 else 0.001)
+        meter.leave(mark, update=k % 2 == 1)  # two calls made an update
+    cost = meter.finish()
+    assert cost.slam_process == IN_PROCESS and cost.updates_timed == 2
+    assert 0.010 <= cost.slam_cpu_s < 0.05
+    assert cost.run_cpu_s >= cost.slam_cpu_s + 0.05
+    assert cost.update_ms_p90 >= cost.update_ms_median >= 3.5  # wall time of the calls that updated
+    assert cost.slam_peak_mib is None and cost.run_peak_mib is None  # memory not asked for
+
+
+@needs_proc
+def test_the_memory_a_call_holds_at_its_peak_counts_for_slam_and_the_run():
+    meter = CostMeter()
+    held = []
+    mark = meter.enter()
+    held.append(np.ones(80 * 2**20 // 8))  # 80 MiB, touched
+    meter.leave(mark)
+    mark = meter.enter()
+    scratch = np.ones(40 * 2**20 // 8)  # 40 MiB more, freed within the call
+    del scratch
+    meter.leave(mark)
+    cost = meter.finish()
+    assert 110 <= cost.slam_peak_mib <= 140
+    assert cost.run_peak_mib >= cost.slam_peak_mib
+    assert cost.run_peak_mib >= 120  # the process's whole resident memory at that peak
+
+
+@needs_proc
+def test_memory_touched_outside_the_calls_is_the_run_s_not_slam_s():
+    meter = CostMeter()
+    mark = meter.enter()
+    meter.leave(mark)
+    outside = np.ones(60 * 2**20 // 8)
+    del outside
+    cost = meter.finish()
+    assert cost.slam_peak_mib < 20
+    assert cost.run_peak_mib > 60
+
+
+def test_a_child_s_usage_makes_the_slam_figures_and_adds_to_the_run_s():
+    meter = CostMeter()
+    mark = meter.enter()
+    meter.leave(mark, update=True)
+    cost = meter.finish(ProcessUsage(cpu_s=2.5, peak_mib=30.0), in_child=True)
+    assert cost.slam_process == CHILD_PROCESS and cost.slam_cpu_s == 2.5 and cost.slam_peak_mib == 30.0
+    assert cost.run_cpu_s >= 2.5 and cost.updates_timed == 1
+    if cost.run_peak_mib is not None:
+        assert cost.run_peak_mib > 30.0
+    unknown = CostMeter().finish(None, in_child=True)
+    assert unknown.slam_cpu_s is None and unknown.slam_peak_mib is None and unknown.slam_process == CHILD_PROCESS
+
+
+def test_usage_of_a_rusage_is_seconds_and_mib():
+    class Rusage:
+        ru_utime, ru_stime = 1.25, 0.25
+        ru_maxrss = 2048 * 1024 if sys.platform == "darwin" else 2048  # 2 MiB
+
+    assert usage_of(Rusage()) == ProcessUsage(cpu_s=1.5, peak_mib=2.0)

@@ -7,7 +7,8 @@ ground truth, no start pose, no scores; :func:`slamtrials.io.transfer.export_rec
 :class:`~slamtrials.slam.program.ProgramSpec` with ``/bin/sh -c`` in the caller's folder (stdin closed,
 in its own process group; ``{workdir}`` is an empty folder of its own), reads the trajectory it wrote, maps its times onto the run's and gives every frame an
 estimate (:func:`slamtrials.slam.program.align_to_frames`). The map is the scans traced at that
-estimate (:func:`slamtrials.slam.estimatemap.map_of_estimate`).
+estimate (:func:`slamtrials.slam.estimatemap.map_of_estimate`). The program's cost is its process's
+``rusage`` (:func:`slamtrials.external.childwait.wait_with_usage`): :attr:`ProgramRun.cost`.
 
 Time base: a CARMEN log carries the run's own times. A bag does too when the run's first time is at
 least 1 s (a real log's stamps); a run that starts at 0 s (every simulated run) is written from 1 s
@@ -32,7 +33,10 @@ from pathlib import Path
 
 import numpy as np
 
+from slamtrials.cost import ProcessUsage, RunCost
+from slamtrials.costmeter import CostMeter
 from slamtrials.errors import ConfigError, ProgramError, SlamtrialsError
+from slamtrials.external.childwait import wait_with_usage
 from slamtrials.record import OccupancyGrid, RunRecord, Trajectory
 from slamtrials.slam.offline import SlamRun, run_over_recording
 from slamtrials.slam.program import FrameAlignment, ProgramSpec, align_to_frames
@@ -78,6 +82,10 @@ class ProgramRun:
         Seconds added to the run's times in the input (0, or 1 for a bag of a run starting at 0 s).
     stderr_tail:
         The last :data:`STDERR_LINES` lines of its stderr.
+    cost:
+        CPU time and peak memory of the program (its process's ``rusage``) and of the whole run (writing
+        the input, the program, reading its output, drawing the map); no time per update (the program
+        is timed as a whole). None only where a caller built the run without one.
     """
 
     spec: ProgramSpec
@@ -89,6 +97,7 @@ class ProgramRun:
     seconds: float
     time_origin_s: float
     stderr_tail: tuple[str, ...]
+    cost: RunCost | None = None
 
     @property
     def estimate(self) -> np.ndarray:
@@ -184,8 +193,11 @@ def _kill(process: subprocess.Popen) -> None:
     process.wait()
 
 
-def _run_command(command: str, cwd: Path, work: Path, timeout: float) -> tuple[float, tuple[str, ...]]:
-    """Run ``command``; return (seconds, stderr tail). Raises ProgramError on a failure of the program."""
+def _run_command(
+    command: str, cwd: Path, work: Path, timeout: float
+) -> tuple[float, tuple[str, ...], ProcessUsage | None]:
+    """Run ``command``; return (seconds, stderr tail, what its process used). Raises ProgramError on a
+    failure of the program."""
     out_log, err_log = work / "stdout.txt", work / "stderr.txt"
     started = time.perf_counter()
     with open(out_log, "wb") as stdout, open(err_log, "wb") as stderr:
@@ -198,7 +210,7 @@ def _run_command(command: str, cwd: Path, work: Path, timeout: float) -> tuple[f
             start_new_session=True,  # its own process group, so a timeout kills its children too
         )
         try:
-            code = process.wait(timeout=timeout)
+            code, usage = wait_with_usage(process, timeout)
         except subprocess.TimeoutExpired:
             _kill(process)
             tail = _tail(err_log)
@@ -213,7 +225,7 @@ def _run_command(command: str, cwd: Path, work: Path, timeout: float) -> tuple[f
     if code != 0:
         what = "was not found" if code == 127 else f"exited with status {code}"
         raise ProgramError(f"the program {what} after {seconds:.1f} s{_said(tail)}", exit_code=code, stderr_tail=tail)
-    return seconds, tail
+    return seconds, tail, usage
 
 
 def run_program(
@@ -255,6 +267,7 @@ def run_program(
 
     if len(record) == 0:
         raise ConfigError("the recording has no frames")
+    meter = CostMeter()
     run_dir = Path(cwd) if cwd is not None else Path.cwd()
     origin_ns = time_origin_ns(record, spec.input)
     with tempfile.TemporaryDirectory(prefix="slamtrials-program-", dir=scratch) as tmp:
@@ -265,7 +278,7 @@ def run_program(
         output_path = work / _OUTPUT_NAMES[spec.output]
         export_record(record, input_path, spec.input, truth=False, time_origin_ns=origin_ns)
         command = spec.command_for(input=str(input_path), output=str(output_path), seed=seed, workdir=str(workdir))
-        seconds, tail = _run_command(command, run_dir, work, spec.timeout)
+        seconds, tail, usage = _run_command(command, run_dir, work, spec.timeout)
         if not output_path.is_file() or output_path.stat().st_size == 0:
             raise ProgramError(
                 f"the program exited with status 0 after {seconds:.1f} s but wrote nothing to {{output}}{_said(tail)}",
@@ -282,6 +295,7 @@ def run_program(
             ) from None
     trajectory = Trajectory(t=np.asarray(written.t, dtype=np.float64) - origin_ns * 1e-9, poses=written.poses)
     occupancy = map_of_estimate(alignment.estimate, record.scans, record.laser, resolution=resolution)
+    cost = meter.finish(usage, in_child=True)
     return ProgramRun(
         spec=spec,
         seed=int(seed),
@@ -292,6 +306,7 @@ def run_program(
         seconds=seconds,
         time_origin_s=origin_ns * 1e-9,
         stderr_tail=tail,
+        cost=cost,
     )
 
 
@@ -309,8 +324,9 @@ def run_offline(
     :class:`~slamtrials.slam.offline.SlamRun`.
 
     For a program, the SlamRun's ``trajectory`` and ``online`` are its estimate at every frame, its
-    ``config`` the :class:`~slamtrials.slam.program.ProgramSpec`, ``updates`` the poses it wrote, and
-    ``timing`` NaN (a program is timed as a whole: the total is spread over no frame).
+    ``config`` the :class:`~slamtrials.slam.program.ProgramSpec`, ``updates`` the poses it wrote,
+    ``timing`` NaN (a program is timed as a whole: the total is spread over no frame) and ``cost`` the
+    program's (:attr:`ProgramRun.cost`).
 
     Raises
     ------
@@ -330,4 +346,5 @@ def run_offline(
         occupancy=ran.occupancy,
         timing=np.full(len(record), np.nan),
         updates=ran.alignment.poses_read,
+        cost=ran.cost,
     )

@@ -10,7 +10,8 @@ imports this module.
 :meth:`OnlineProgram.reset` starts the command (``/bin/sh -c``, its own process group, stderr to a
 scratch file) and sends ``start``; :meth:`process` sends a frame and waits at most ``reply_timeout``
 seconds for the reply; :meth:`trajectory` sends ``end``, reads the final trajectory and map, and waits
-for the program to exit. A program that exits early, answers late or breaks the protocol raises
+for the program to exit, reading what its process used (:meth:`OnlineProgram.child_usage`, the SLAM
+cost of a trial with a program). A program that exits early, answers late or breaks the protocol raises
 :class:`~slamtrials.errors.ProgramError` with the last lines of its stderr; its process group is killed.
 """
 
@@ -31,8 +32,10 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
+from slamtrials.cost import ProcessUsage
 from slamtrials.errors import ConfigError, ProgramError
 from slamtrials.external import protocol
+from slamtrials.external.childwait import wait_with_usage
 from slamtrials.geometry import ominus
 from slamtrials.record import LaserGeometry, OccupancyGrid, Reading, Trajectory
 from slamtrials.slam.gridmap import GridMap
@@ -79,6 +82,7 @@ class _Process:
                 start_new_session=True,
             )
         self._buffer = bytearray()
+        self.usage: ProcessUsage | None = None
         self._closer = weakref.finalize(self, _kill_group, self.popen, self.scratch)
 
     def tail(self) -> tuple[str, ...]:
@@ -96,11 +100,14 @@ class _Process:
         return ProgramError(f"{problem}{said}", exit_code=code, stderr_tail=tail)
 
     def _status(self) -> int | None:
-        """The exit status once the program has exited (within the reply timeout), else None."""
+        """The exit status once the program has exited (within the reply timeout), else None; what its
+        process used is kept in :attr:`usage`."""
         try:
-            return self.popen.wait(timeout=self.timeout)
+            code, usage = wait_with_usage(self.popen, self.timeout)
         except subprocess.TimeoutExpired:
             return None
+        self.usage = usage if usage is not None else self.usage
+        return code
 
     def send(self, line: bytes, what: str) -> None:
         try:
@@ -192,6 +199,7 @@ class OnlineProgram:
         self.laser = laser
         self._process: _Process | None = None
         self._failure: ProgramError | None = None
+        self._usage: ProcessUsage | None = None
         self.updates = 0
 
     def reset(self, rng: np.random.Generator) -> None:
@@ -209,6 +217,7 @@ class OnlineProgram:
         self._drawn_grid: OccupancyGrid | None = None
         self._last_drawn: NDArray[np.float64] | None = None
         self._final: Trajectory | None = None
+        self._usage = None
         self.updates = 0
 
     @classmethod
@@ -321,10 +330,19 @@ class OnlineProgram:
             return final
 
         poses = self._checked(read)
+        running = self._process
+        assert running is not None
         self._exchange(lambda process: process.finish())
+        self._usage = running.usage
         self._process = None
         self._final = Trajectory(t=t, poses=poses)
         return self._final
+
+    def child_usage(self) -> ProcessUsage | None:
+        """What the program's process used (CPU time and peak resident memory, with the descendants it
+        waited for), once it has exited at the end of the run (:meth:`trajectory`); None before, or for a
+        program that failed."""
+        return self._usage
 
 
 def _count(value: Any, what: str) -> int:

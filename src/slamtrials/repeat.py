@@ -9,7 +9,8 @@ sample standard deviation, a Student t confidence interval of the mean and the s
 diverged (error above 5 times the median). ``runs="auto"`` lets the paper's Section III-C rule choose
 the run count: 10 runs, then as many as ``N = z^2 s^2 / d^2`` asks for, up to a cap.
 
-:func:`write_repeat_outputs` writes ``runs.csv`` (one line per seed), ``summary.json``, the sorted
+:func:`write_repeat_outputs` writes ``runs.csv`` (one line per seed, with what it cost: SLAM CPU time,
+peak memory and time per update, :class:`~slamtrials.cost.RunCost`), ``summary.json``, the sorted
 per-run errors as a figure (the paper's Fig. 1 for a dataset) and the maps of the best and worst runs.
 This module composes io, slam, metric, campaign (the Dask client) and report, like the CLI; it does not print.
 """
@@ -26,6 +27,7 @@ from typing import Any, Literal
 import numpy as np
 
 from slamtrials.atomicfile import atomic_write, atomic_write_text
+from slamtrials.cost import COST_FIGURES, RunCost
 from slamtrials.errors import ConfigError, MetricError, ProgramError
 from slamtrials.metric.divergence import DEFAULT_DIVERGENCE_FACTOR, Divergence, divergence
 from slamtrials.metric.matching import DEFAULT_TOLERANCE, relations_meet
@@ -131,6 +133,8 @@ class RepeatedRun:
         Wall time of the algorithm (s).
     occupancy:
         The final map.
+    cost:
+        CPU time and peak memory of the algorithm (or the program's process) and time per update.
     """
 
     seed: int
@@ -140,6 +144,7 @@ class RepeatedRun:
     updates: int
     seconds: float
     occupancy: OccupancyGrid
+    cost: RunCost | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -223,14 +228,15 @@ def _one_run(record: RunRecord, relations: Relations, settings: RepeatSettings, 
         from slamtrials.external import run_program
 
         ran = run_program(record, s.program, seed)
-        trajectory, updates, occupancy = (
+        trajectory, updates, occupancy, cost = (
             Trajectory(t=record.t, poses=ran.estimate),
             ran.alignment.poses_read,
             ran.occupancy,
+            ran.cost,
         )
     else:
         result = run_over_recording(record, s.algorithm, preset=s.preset, overrides=s.overrides, seed=seed)
-        trajectory, updates, occupancy = result.trajectory, result.updates, result.occupancy
+        trajectory, updates, occupancy, cost = result.trajectory, result.updates, result.occupancy, result.cost
     seconds = time.perf_counter() - started
     errors = evaluate_relations(trajectory, relations, tolerance=s.tolerance, allow_outside=True)
     if len(errors) == 0:
@@ -243,6 +249,7 @@ def _one_run(record: RunRecord, relations: Relations, settings: RepeatSettings, 
         updates=updates,
         seconds=seconds,
         occupancy=occupancy,
+        cost=cost,
     )
 
 
@@ -380,9 +387,10 @@ def write_repeat_outputs(result: RepeatedSlam, out_dir: str | Path, *, overwrite
         raise ConfigError(f"{out}: already holds a repeated experiment; choose another --out or pass --overwrite")
     out.mkdir(parents=True, exist_ok=True)
     diverged = dict(zip((r.seed for r in result.runs), result.diverged.diverged.tolist()))
-    lines = ["seed,eps_t,eps_r,relations,updates,seconds,diverged\n"]
+    lines = [f"seed,eps_t,eps_r,relations,updates,seconds,diverged,{','.join(COST_COLUMNS)}\n"]
     lines += [
-        f"{r.seed},{r.eps_t!r},{r.eps_r!r},{r.relations},{r.updates},{r.seconds:.3f},{int(diverged[r.seed])}\n"
+        f"{r.seed},{r.eps_t!r},{r.eps_r!r},{r.relations},{r.updates},{r.seconds:.3f},{int(diverged[r.seed])},"
+        f"{_cost_cells(r.cost)}\n"
         for r in result.runs
     ]
     written = [atomic_write_text(out / "runs.csv", "".join(lines))]
@@ -421,11 +429,30 @@ def write_repeat_outputs(result: RepeatedSlam, out_dir: str | Path, *, overwrite
             "share": result.diverged.share,
             "seeds": [r.seed for r, d in zip(result.runs, result.diverged.diverged) if d],
         },
+        "cost": _mean_cost(result.runs),
         "best": {"seed": result.best.seed, "eps_t": result.best.eps_t},
         "worst": {"seed": result.worst.seed, "eps_t": result.worst.eps_t},
     }
     written.append(atomic_write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n"))
     return [Path(p) for p in written]
+
+
+#: Cost columns of ``runs.csv`` (:class:`~slamtrials.cost.RunCost`; empty where not measured).
+COST_COLUMNS = COST_FIGURES
+
+
+def _cost_cells(cost: RunCost | None) -> str:
+    values = [None if cost is None else getattr(cost, name) for name in COST_COLUMNS]
+    return ",".join("" if value is None else f"{value:.6g}" for value in values)
+
+
+def _mean_cost(runs: tuple[RepeatedRun, ...]) -> dict[str, float | None]:
+    """The mean of each cost figure over the runs that have it (``summary.json``'s ``cost``, not reproducible)."""
+    means: dict[str, float | None] = {}
+    for name in COST_COLUMNS:
+        values = [getattr(r.cost, name) for r in runs if r.cost is not None and getattr(r.cost, name) is not None]
+        means[f"{name}_mean"] = float(np.mean(values)) if values else None
+    return means
 
 
 def _stats_json(stats: EnvironmentStats, interval: MeanInterval) -> dict[str, float | str]:

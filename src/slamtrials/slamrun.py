@@ -18,7 +18,9 @@ registry (:mod:`slamtrials.slam`) and times every call; :func:`write_slam_output
 ``timing.csv``
     ``frame,t,seconds``: wall-clock seconds of each ``process`` call.
 ``slam.json``
-    algorithm, preset, resolved config, seed, input, totals; written last, so it marks complete outputs.
+    algorithm, preset, resolved config, seed, input, totals, and ``cost`` (CPU time and peak memory of
+    the algorithm and of the run, time per update: :class:`~slamtrials.cost.RunCost`, not reproducible);
+    written last, so it marks complete outputs.
 
 This module composes io and slam, like the CLI does; it does not print.
 """
@@ -35,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from slamtrials.atomicfile import atomic_write_text
+from slamtrials.cost import COST_KEY
 from slamtrials.errors import ConfigError, FormatError
 from slamtrials.external import ProgramRun
 from slamtrials.record import OccupancyGrid, RunRecord, Trajectory
@@ -128,6 +131,7 @@ def run_slam(
         occupancy=run.occupancy,
         timing=run.timing,
         updates=run.updates,
+        cost=run.cost,
         record=record,
         source=source,
     )
@@ -188,6 +192,7 @@ def write_slam_outputs(result: SlamResult, out_dir: str | Path, *, overwrite: bo
             "resolution": grid.resolution,
             "origin": [float(v) for v in grid.origin],
         },
+        **({COST_KEY: result.cost.to_dict()} if result.cost is not None else {}),
         "trajectory_clf": "first pose triple = SLAM estimate, second = recorded odometry",
         "trajectory_log": "FLASER 0 lines, SLAM estimate in both pose triples (the Freiburg metricEvaluator's input)",
     }
@@ -244,7 +249,8 @@ def write_program_outputs(
     ``trajectory.tum``, ``.clf``, ``.log`` and the map are those of ``slamtrials slam``
     (:func:`slamtrials.slamrun.write_estimate_files`), with one pose per frame; ``program.tum`` holds
     the poses the program wrote, in the run's time base; ``program_stderr.txt`` the last lines of its
-    stderr; ``slam.json`` the program, the command, the seed, the time origin and the pose counts.
+    stderr; ``slam.json`` the program, the command, the seed, the time origin, the pose counts and the
+    program's ``cost`` (its process's CPU time and peak memory).
 
     Raises
     ------
@@ -280,6 +286,7 @@ def write_program_outputs(
             "origin": [float(v) for v in run.occupancy.origin],
             "drawn": "the scans at the estimated poses",
         },
+        **({COST_KEY: run.cost.to_dict()} if run.cost is not None else {}),
         "trajectory_clf": "first pose triple = the estimate at each frame, second = recorded odometry",
     }
     written.append(atomic_write_text(out / SLAM_FILE, json.dumps(summary, indent=2) + "\n"))

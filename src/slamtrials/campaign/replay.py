@@ -9,7 +9,8 @@ on the same relations. Each replayed run becomes a complete run folder of the ne
 ``frames.npz`` (the new estimate; the recorded frames stay in the source run folder, which ``run.json``
 names as ``frames_from``, so a replay costs no copy of them), ``estimate.tum``, the new map,
 ``relations.npz`` (the source's set) and a ``run.json`` whose ``replay`` entry names the source run
-folder, the algorithm and its configuration.
+folder, the algorithm and its configuration, and whose ``cost`` is the replay's (the SLAM run over the
+recorded frames: :class:`~slamtrials.cost.RunCost`), not the source trial's.
 
 The new campaign's config is the source's with ``slam`` changed (:func:`replay_slam_settings`: the
 source's algorithm, preset and parameters, with the given overrides on top) and ``replay_of`` set to
@@ -47,6 +48,7 @@ from slamtrials.campaign.score import run_relation_set, score_run
 from slamtrials.campaign.store import CampaignStore, WorldInfo
 from slamtrials.campaign.summary import summarize_store, write_summary_csv
 from slamtrials.campaign.task import failure, outcome, write_scored_run
+from slamtrials.cost import COST_KEY, RunCost
 from slamtrials.errors import ConfigError, SlamtrialsError
 from slamtrials.record import RunRecord
 from slamtrials.slam.offline import run_over_recording
@@ -177,24 +179,25 @@ class ReplayTask:
 
 
 def replay_slam(record: RunRecord, slam: SlamSettings, seed: int) -> RunRecord:
-    """``record`` with the estimate and map of ``slam`` run over its frames with the run's ``seed``.
+    """``record`` with the estimate and map of ``slam`` run over its frames with the run's ``seed``, and
+    the cost of that run in its metadata (:data:`~slamtrials.cost.COST_KEY`, replacing the source's).
 
-    The algorithm runs through :func:`slamtrials.slam.offline.run_over_recording`, seeded as in
-    :func:`slamtrials.trial.run_trial` (:mod:`slamtrials.seeding`); a program through
-    :func:`slamtrials.external.run_program` (given the seed as ``{seed}``).
+        The algorithm runs through :func:`slamtrials.slam.offline.run_over_recording`, seeded as in
+        :func:`slamtrials.trial.run_trial` (:mod:`slamtrials.seeding`); a program through
+        :func:`slamtrials.external.run_program` (given the seed as ``{seed}``).
 
-    Raises
-    ------
-    ConfigError
-        A bad configuration, or an algorithm whose trajectory does not hold one pose per frame.
-    ProgramError
-        The program failed on the run.
+        Raises
+        ------
+        ConfigError
+            A bad configuration, or an algorithm whose trajectory does not hold one pose per frame.
+        ProgramError
+            The program failed on the run.
     """
     if slam.program is not None:
         return _replay_program(record, slam.program, seed)
     result = run_over_recording(record, slam.algorithm, preset=slam.preset, overrides=slam.params, seed=seed)
     estimate = result.estimate_per_frame(record)
-    metadata = dict(record.metadata)
+    metadata = _with_cost(record.metadata, result.cost)
     metadata["slam_config"] = result.config.model_dump(mode="json")
     return replace(record, metadata=metadata, estimate=estimate, map=result.occupancy, online=result.online)
 
@@ -204,7 +207,7 @@ def _replay_program(record: RunRecord, program: ProgramSpec, seed: int) -> RunRe
 
     ran = run_program(record, program, seed)
     a = ran.alignment
-    metadata = dict(record.metadata)
+    metadata = _with_cost(record.metadata, ran.cost)
     metadata["slam_config"] = program.model_dump(mode="json")
     metadata["program"] = {
         "command": ran.command,
@@ -216,6 +219,14 @@ def _replay_program(record: RunRecord, program: ProgramSpec, seed: int) -> RunRe
         "stderr_tail": list(ran.stderr_tail),
     }
     return replace(record, metadata=metadata, estimate=ran.estimate, map=ran.occupancy, online=ran.estimate)
+
+
+def _with_cost(metadata: dict[str, Any], cost: RunCost | None) -> dict[str, Any]:
+    """A copy of ``metadata`` whose cost is ``cost`` (none when None: never the source trial's)."""
+    copy = {k: v for k, v in metadata.items() if k != COST_KEY}
+    if cost is not None:
+        copy[COST_KEY] = cost.to_dict()
+    return copy
 
 
 def replay_one(task: ReplayTask) -> RunResult:

@@ -29,6 +29,9 @@ class RunDetails:
     se_t, se_r:
         Standard errors of ``eps_t`` (m) and ``eps_r`` (rad): the std of the per-relation errors over
         ``sqrt(N)`` (:func:`slamtrials.metric.standard_error`); None for runs stored by earlier versions.
+    slam_cpu_s, slam_peak_mib, run_cpu_s, run_peak_mib, update_ms_median, update_ms_p90:
+        What the run cost (:class:`~slamtrials.cost.RunCost`: CPU s, MiB, ms per update; not
+        reproducible); None where not measured and for runs stored by earlier versions.
     """
 
     frames: int
@@ -40,6 +43,12 @@ class RunDetails:
     relations_capped: bool
     se_t: float | None = None
     se_r: float | None = None
+    slam_cpu_s: float | None = None
+    slam_peak_mib: float | None = None
+    run_cpu_s: float | None = None
+    run_peak_mib: float | None = None
+    update_ms_median: float | None = None
+    update_ms_p90: float | None = None
 
 
 @dataclass(frozen=True)

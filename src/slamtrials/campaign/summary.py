@@ -12,7 +12,9 @@ confidence, failed_runs, terminations, eps_t_metric_share, eps_r_metric_share`` 
 asked for at its last decision, also where the cap stopped the world (``capped`` 1, ``capped_at`` the
 cap; empty otherwise); empty cells where a value is undefined; ``terminations`` as ``reason:count;...``; ``*_metric_share``: the metric's share of the
 between-run variance, :func:`slamtrials.metric.metric_noise_share`, empty for runs stored without
-standard errors).
+standard errors), then the mean cost per run, over the runs that recorded one (:mod:`slamtrials.campaign.costsummary`:
+``slam_cpu_s_mean, slam_peak_mib_mean, run_cpu_s_mean, run_peak_mib_mean, update_ms_median_mean,
+update_ms_p90_mean``: CPU s, MiB, ms per SLAM update; empty for runs of earlier versions; not reproducible).
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from slamtrials.atomicfile import atomic_write_text
+from slamtrials.campaign.costsummary import COST_CSV_COLUMNS, WorldCost, cost_csv_cells, world_cost
 from slamtrials.campaign.store import CampaignStore, RunRow
 from slamtrials.metric.noiseshare import metric_noise_share
 from slamtrials.metric.stats import EnvironmentStats, environment_stats
@@ -55,6 +58,7 @@ CSV_COLUMNS = (
     "terminations",
     "eps_t_metric_share",
     "eps_r_metric_share",
+    *COST_CSV_COLUMNS,
 )
 
 
@@ -86,6 +90,9 @@ class WorldSummary:
         The metric's share of the between-run variance of ``eps_t`` and ``eps_r``
         (:func:`~slamtrials.metric.metric_noise_share`); None when a run has no standard error (stored by
         an earlier version) or fewer than 2 runs are done.
+    cost:
+        The mean cost per done run (:class:`~slamtrials.campaign.costsummary.WorldCost`); None when no run
+        recorded one.
     """
 
     world: str
@@ -101,6 +108,7 @@ class WorldSummary:
     metric_share_t: float | None = None
     metric_share_r: float | None = None
     cap: int | None = None
+    cost: WorldCost | None = None
 
 
 def summarize_store(store: CampaignStore) -> list[WorldSummary]:
@@ -140,6 +148,7 @@ def summarize_store(store: CampaignStore) -> list[WorldSummary]:
                 share_t,
                 share_r,
                 settings.max_runs if world.capped else None,
+                world_cost(json.loads(r.details) for r in done if r.details),
             )
         )
     return rows
@@ -203,6 +212,7 @@ def write_summary_csv(folder: str | Path, rows: list[WorldSummary], confidence: 
                 terminations,
                 _number(row.metric_share_t),
                 _number(row.metric_share_r),
+                *cost_csv_cells(row.cost),
             ]
         )
     return atomic_write_text(Path(folder) / SUMMARY_FILE, text.getvalue())

@@ -9,7 +9,8 @@ atomically (:func:`slamtrials.campaign.runfiles.publish_run`):
 ``relations.npz`` (the run's relation set). ``run.json`` also holds, under ``campaign``, the world, run
 index, seed, ``eps_t``, ``eps_r``, their standard errors, the relation count, the scores of the online
 estimate and the odometry on the same relations, and the metric settings, besides the trial's own
-metadata (resolved trial config, termination reason, timings).
+metadata (resolved trial config, termination reason, timings) and its ``cost``
+(:class:`~slamtrials.cost.RunCost`, which the catalog's ``details`` keep too).
 
 It returns a :class:`~slamtrials.campaign.results.RunDone` that the driver stores. Errors that are
 properties of the run (a :class:`~slamtrials.errors.SlamtrialsError`, e.g. a start pose in a wall) come
@@ -32,6 +33,7 @@ from slamtrials.campaign.results import RunDetails, RunDone, RunFailed, RunResul
 from slamtrials.campaign.runfiles import publish_run, relative_run_folder
 from slamtrials.campaign.score import RunScore, score_run
 from slamtrials.campaign.worldset import load_world_cached
+from slamtrials.cost import RunCost
 from slamtrials.errors import SlamtrialsError
 from slamtrials.record import RunRecord
 from slamtrials.trial import TrialConfig, TrialSummary
@@ -95,6 +97,7 @@ def write_scored_run(folder: Path, record: RunRecord, score: RunScore, *, frames
 def outcome(task_world: str, index: int, record: RunRecord, score: RunScore, started: float) -> RunDone:
     """What the driver stores for a done run."""
     trial = TrialSummary.of(record)
+    cost = RunCost.of(record.metadata)
     relation_set = score.relation_set
     return RunDone(
         world=task_world,
@@ -118,6 +121,7 @@ def outcome(task_world: str, index: int, record: RunRecord, score: RunScore, sta
             relations_capped=bool(relation_set.capped),
             se_t=score.run.se_t,
             se_r=score.run.se_r,
+            **(cost.figures() if cost is not None else {}),
         ),
     )
 

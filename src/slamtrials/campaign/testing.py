@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from slamtrials.cost import COST_KEY, RunCost
 from slamtrials.geometry import compose
 from slamtrials.record import LaserGeometry, OccupancyGrid, RunRecord
 from slamtrials.trial import TrialSummary
@@ -45,6 +46,9 @@ class FakeTrial:
         Wall-clock seconds to pretend to work (for crash and speed-up tests).
     map_offset:
         ``(x m, y m, theta rad)``: the pose of the world frame in the map frame of the estimate.
+    cost:
+        A cost every run records (:class:`~slamtrials.cost.RunCost`), for tests of how costs are kept and
+        reported; None: no cost, as runs of earlier versions.
     """
 
     mean_t: float = 0.3
@@ -53,6 +57,7 @@ class FakeTrial:
     std_r: float = 0.01
     sleep: float = 0.0
     map_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    cost: RunCost | None = None
 
     def errors(self, seed: int) -> tuple[float, float]:
         """The ``(e_t, e_r)`` (m, rad) that the run with ``seed`` has."""
@@ -101,4 +106,6 @@ class FakeTrial:
                 stalled_frames=0,
             ).to_dict(),
         }
+        if self.cost is not None:
+            record.metadata[COST_KEY] = self.cost.to_dict()
         return record

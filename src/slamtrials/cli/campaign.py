@@ -22,6 +22,7 @@ from typing import Annotated
 import typer
 
 from slamtrials.cli.common import fmt_number, make_app, make_console, quiet_dask, sim_profile_line, table_one
+from slamtrials.cli.costtext import world_cost_line
 from slamtrials.cli.slam import ProgramInputOpt, ProgramOpt, ProgramOutputOpt, TimeoutOpt
 from slamtrials.errors import ConfigError
 
@@ -149,9 +150,9 @@ class _Progress:
 
 def _finish(console, result, config_confidence: float, title: str) -> None:
     console.print(summary_table(result.summary, config_confidence, title))
-    share = metric_share_line(result.summary)
-    if share:
-        console.print(share, highlight=False, soft_wrap=True)
+    for line in (metric_share_line(result.summary), world_cost_line(result.summary)):
+        if line:
+            console.print(line, highlight=False, soft_wrap=True)
     for note in result.notes:
         console.print(f"note: {note}", highlight=False, soft_wrap=True)
     console.print(
@@ -266,9 +267,9 @@ def status(folder: Annotated[Path, typer.Argument(help="Campaign folder.")]) -> 
         )
     console.print(table)
     console.print(summary_table(state.summary, config.runs.confidence, "Errors so far"))
-    share = metric_share_line(state.summary)
-    if share:
-        console.print(share, highlight=False, soft_wrap=True)
+    for line in (metric_share_line(state.summary), world_cost_line(state.summary)):
+        if line:
+            console.print(line, highlight=False, soft_wrap=True)
     if state.finished:
         progress = "finished"
     elif state.driver is False:

@@ -40,6 +40,7 @@ def demo(
     from slamtrials.campaign.cluster import check_workers
     from slamtrials.cli.campaign import EXIT_INTERRUPTED, _Progress, metric_share_line, summary_table
     from slamtrials.cli.common import quiet_dask, sim_profile_line
+    from slamtrials.cli.costtext import world_cost_line
     from slamtrials.demo import DEMO_WORLDS, demo_config, run_demo
 
     matplotlib.use("Agg")
@@ -68,9 +69,9 @@ def demo(
         raise typer.Exit(EXIT_INTERRUPTED) from None
     campaign = result.campaign
     console.print(summary_table(campaign.summary, result.confidence, f"Demo campaign {campaign.folder}"))
-    share = metric_share_line(campaign.summary)
-    if share:
-        console.print(share, highlight=False, soft_wrap=True)
+    for line in (metric_share_line(campaign.summary), world_cost_line(campaign.summary)):
+        if line:
+            console.print(line, highlight=False, soft_wrap=True)
     for note in campaign.notes:
         console.print(f"note: {note}", highlight=False, soft_wrap=True)
     console.print(

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal
 import typer
 
 from slamtrials.cli.common import make_console, quiet_dask
+from slamtrials.cli.costtext import run_cost_text
 from slamtrials.errors import ConfigError
 
 if TYPE_CHECKING:
@@ -211,6 +212,7 @@ def _run_algorithm(
         soft_wrap=True,
         highlight=False,
     )
+    console.print(run_cost_text(result.cost), soft_wrap=True, highlight=False)
 
 
 def _run_program(spec: ProgramSpec, input_: Path, out: Path, seed: int, overwrite: bool) -> None:
@@ -231,6 +233,7 @@ def _run_program(spec: ProgramSpec, input_: Path, out: Path, seed: int, overwrit
         soft_wrap=True,
         highlight=False,
     )
+    console.print(run_cost_text(run.cost), soft_wrap=True, highlight=False)
 
 
 def _nothing():
@@ -341,12 +344,19 @@ def _int_option(name: str, text: str) -> int:
 
 
 def format_repeat(result: RepeatedSlam) -> str:
-    """The per-run table and the summary of a repeated experiment (six decimals, as the Freiburg tool)."""
-    lines = [f"{'seed':>4}  {'eps_t (m)':>10}  {'eps_r (rad)':>11}  {'relations':>9}  {'updates':>7}  {'seconds':>7}"]
+    """The per-run table and the summary of a repeated experiment (six decimals, as the Freiburg tool); CPU s
+    and MiB: the SLAM algorithm's (or program's) CPU time and peak memory in the run (:class:`~slamtrials.cost.RunCost`)."""
+    lines = [
+        f"{'seed':>4}  {'eps_t (m)':>10}  {'eps_r (rad)':>11}  {'relations':>9}  {'updates':>7}  {'seconds':>7}  "
+        f"{'CPU s':>7}  {'MiB':>6}"
+    ]
     flagged = dict(zip((r.seed for r in result.runs), result.diverged.diverged.tolist()))
     for r in result.runs:
+        cpu = r.cost.slam_cpu_s if r.cost is not None else None
+        mib = r.cost.slam_peak_mib if r.cost is not None else None
         lines.append(
-            f"{r.seed:>4}  {r.eps_t:10.6f}  {r.eps_r:11.6f}  {r.relations:>9}  {r.updates:>7}  {r.seconds:7.1f}"
+            f"{r.seed:>4}  {r.eps_t:10.6f}  {r.eps_r:11.6f}  {r.relations:>9}  {r.updates:>7}  {r.seconds:7.1f}  "
+            f"{'-' if cpu is None else f'{cpu:.1f}':>7}  {'-' if mib is None else f'{mib:.0f}':>6}"
             + ("  diverged" if flagged[r.seed] else "")
         )
     st, sr, level = result.stats_t, result.stats_r, f"{100 * result.settings.confidence:g} %"

@@ -48,6 +48,8 @@ def trial(
     from slamtrials.campaign.profilefile import inline_profile_file
     from slamtrials.campaign.score import score_run
     from slamtrials.campaign.task import write_scored_run
+    from slamtrials.cli.costtext import run_cost_text
+    from slamtrials.cost import RunCost
     from slamtrials.io.runfolder import RunFolder
     from slamtrials.io.yamlfile import read_yaml_mapping
     from slamtrials.report.runplot import save_run_figure
@@ -96,6 +98,7 @@ def trial(
         soft_wrap=True,
         highlight=False,
     )
+    console.print(run_cost_text(RunCost.of(record.metadata)), soft_wrap=True, highlight=False)
     odometry = score.odometry
     console.print(
         f"error over {len(score.relation_set)} relations (relations.npz): translational {score.eps_t:.4f} m "

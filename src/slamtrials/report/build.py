@@ -6,7 +6,8 @@ the run folders), draws the paper's figures with :mod:`slamtrials.report.campaig
 ``<out>/index.html`` with every figure beside it in ``<out>/figures/`` as PNG (shown) and PDF (linked):
 
 * Table I: per world, runs, mean, standard deviation and confidence interval of ``eps_t`` (m) and
-  ``eps_r`` (rad), the metric's share of the between-run variance of each, and the outlier counts, with a
+  ``eps_r`` (rad), the metric's share of the between-run variance of each, the outlier counts and the
+  mean cost per run (SLAM CPU time, time per update, SLAM memory), with a
   paragraph saying what the share and the outlier column are (``<table id="summary-table">``, one row per
   world, in the campaign's order, which every figure keeps), and the paper's printed layout;
 * Fig. 1: each world's run errors, largest first, and all worlds' sorted curves;
@@ -17,6 +18,8 @@ the run folders), draws the paper's figures with :mod:`slamtrials.report.campaig
   trajectory drawn on the map (map frame) and the true one fitted onto it
   (:func:`slamtrials.report.alignment.align_truth`);
 * termination reasons and explored fraction of the runs;
+* what the runs cost: CPU time and peak memory of the SLAM algorithm and of the whole run, and the time
+  per SLAM update, per run and per world (:class:`slamtrials.cost.RunCost`; also in Table I);
 * every run (seed, status, errors, outlier marks), and the provenance: config, root seed, versions.
 
 A campaign that is still running, has failed or capped worlds, or no finished run yet still gives a page,
@@ -55,6 +58,7 @@ from slamtrials.errors import ConfigError, SlamtrialsError
 from slamtrials.io.layout import RunFolder
 from slamtrials.record import Trajectory
 from slamtrials.report import campaign_figures as cf
+from slamtrials.report import cost_figures as costf
 from slamtrials.report import html as h
 from slamtrials.report.compare import (
     A_BETTER,
@@ -176,6 +180,12 @@ def _num(value: Any, digits: int = 3) -> h.Cell:
 
 def _seconds(value: Any) -> h.Cell:
     """A time in seconds, rounded: one decimal below 10 s, whole seconds above."""
+    return h.Cell(h.fmt_seconds(value), numeric=True)
+
+
+def _amount(value: Any) -> h.Cell:
+    """A cost figure (s, ms or MiB), rounded as :func:`~slamtrials.report.html.fmt_seconds` rounds seconds;
+    ``-`` where not measured."""
     return h.Cell(h.fmt_seconds(value), numeric=True)
 
 
@@ -347,10 +357,20 @@ def _table_one(data: CampaignData, done: pd.DataFrame) -> str:
         *(["mean", "std", "\u00b1 CI", "metric share"] * 2),
         "outliers",
         "min \u2013 max " + SYMBOLS["eps_t"] + " (m)",
+        "CPU s",
+        "ms / update",
+        "MiB",
         "runs ended by",
         "note",
     ]
-    groups = [("", 3), (f"{SYMBOLS['eps_t']} (m)", 4), (f"{SYMBOLS['eps_r']} (rad)", 4), ("", 4)]
+    groups = [
+        ("", 3),
+        (f"{SYMBOLS['eps_t']} (m)", 4),
+        (f"{SYMBOLS['eps_r']} (rad)", 4),
+        ("", 2),
+        ("SLAM cost per run", 3),
+        ("", 2),
+    ]
     rows, classes = [], []
     reasons = done.groupby("world")["termination"].agg(lambda s: Counter(s.fillna("unknown"))) if len(done) else {}
     for _, w in data.worlds.iterrows():
@@ -379,6 +399,15 @@ def _table_one(data: CampaignData, done: pd.DataFrame) -> str:
                 numeric=True,
             )
         )
+        cells += [
+            _amount(w["slam_cpu_s_mean"]),
+            h.Cell(
+                _update_text(w["update_ms_median_mean"], w["update_ms_p90_mean"]),
+                numeric=True,
+                title="median / 90th percentile of the time per SLAM update (ms), mean over the runs",
+            ),
+            _amount(w["slam_peak_mib_mean"]),
+        ]
         counter = reasons.get(w["world"], {}) if len(done) else {}
         cells.append(", ".join(f"{k} {v}" for k, v in sorted(counter.items())))
         cells.append(w["note"] if isinstance(w["note"], str) else "")
@@ -389,10 +418,15 @@ def _table_one(data: CampaignData, done: pd.DataFrame) -> str:
         f"The paper's Table I: per world, the mean and sample standard deviation (divisor n \u2212 1) of the runs' "
         f"translational error {SYMBOLS['eps_t']} (m) and rotational error {SYMBOLS['eps_r']} (rad), and the half width "
         f"of the {_pct(confidence)} confidence interval of the mean. Runs: done (/ needed by the run-count rule when more, "
-        f"also where the cap stopped a world)."
+        f"also where the cap stopped a world). SLAM cost per run: the mean over the runs of the SLAM algorithm's CPU "
+        f"time (s), of its time per update (ms, median / 90th percentile) and of its peak memory (MiB), as the "
+        f"section on cost defines them; - where not measured."
     )
-    parts = [
-        h.table(header, rows, id="summary-table", caption=caption, row_classes=classes, groups=groups),
+    parts = [  # the caption above, as wide as the page: the table scrolls sideways when it is wider
+        f'<p class="explain" id="summary-caption">{h.esc(caption)}</p>',
+        '<div style="overflow-x:auto">'
+        + h.table(header, rows, id="summary-table", row_classes=classes, groups=groups)
+        + "</div>",
         _share_note(data),
         _outlier_note(data),
     ]
@@ -415,6 +449,13 @@ def _table_one(data: CampaignData, done: pd.DataFrame) -> str:
                 + "</div>"
             )
     return h.section("Table I: localization error per world", *parts, id="table-1")
+
+
+def _update_text(median: Any, p90: Any) -> str:
+    """``median / p90`` of the time per update (ms), ``-`` where not measured."""
+    if not (isinstance(median, (int, float)) and math.isfinite(median)):
+        return "-"
+    return f"{h.fmt_seconds(median)} / {h.fmt_seconds(p90)}"
 
 
 def _share_note(data: CampaignData) -> str:
@@ -832,6 +873,84 @@ def _termination(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame) ->
     return h.section(title, picture, table, id="termination")
 
 
+#: What each cost figure is, as the cost section explains it (:class:`slamtrials.cost.RunCost`).
+_COST_TEXT = (
+    "What the runs cost, measured as they ran (not reproducible: another run of the same campaign costs a little "
+    "more or less, so these figures are never part of a result's comparison). SLAM CPU: the CPU time (user + "
+    "system) of the SLAM algorithm in the run, its calls timed on the thread's CPU clock, or, for an external "
+    "program, its process's own (rusage). Run CPU: the whole run's (simulator, SLAM, explorer, coverage; with a "
+    "program, its process too). Time per update: the wall time of each SLAM call that made an update, its median "
+    "and 90th percentile per run. SLAM memory: the process's peak resident memory during the algorithm's calls "
+    "above what it held before the algorithm was built (the algorithm's maps, particles or graph and its "
+    "scratch), or an external program's peak resident memory. Run memory: the peak resident memory of the "
+    "worker process during the run (the Python runtime and libraries included). Tables give the means over "
+    "the runs; - where not measured (runs of earlier versions, or a platform without Linux's /proc)."
+)
+
+
+def _cost(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame) -> str:
+    title = "What the runs cost: CPU time and memory"
+    explain = f'<p class="explain" id="cost-note">{h.esc(_COST_TEXT)}</p>'
+    measured = done[np.isfinite(costf.cost_values(done, "slam_cpu_s"))] if len(done) else done
+    if measured.empty:
+        return h.section(title, explain, "<p>No finished run recorded its cost.</p>", id="cost")
+    worlds = _table_order(data, done)
+    fig = figs.new(min(max(12.0, 0.9 * len(worlds) + 6), 30), 3.8)
+    axes = fig.subplots(1, 3)
+    costf.draw_cost_per_world(axes[0], done, "slam_cpu_s", worlds, "SLAM CPU time per run (s)", legend=True)
+    costf.draw_update_times(axes[1], done, worlds)
+    costf.draw_cost_per_world(axes[2], done, "slam_peak_mib", worlds, "SLAM peak memory (MiB)")
+    picture = figs.save(
+        fig,
+        "cost",
+        "Left: the SLAM algorithm's CPU time in each run. Middle: each run's median time per SLAM update (points) "
+        "and its 90th percentile (crosses). Right: the SLAM algorithm's peak memory in each run. Bars: the world's "
+        "mean. Worlds in the order of Table I.",
+    )
+    rows = []
+    for world in worlds:
+        mine = done[done["world"] == world]
+        slam_cpu, run_cpu = costf.cost_values(mine, "slam_cpu_s"), costf.cost_values(mine, "run_cpu_s")
+        both = np.isfinite(slam_cpu) & np.isfinite(run_cpu) & (run_cpu > 0)
+        rows.append(
+            [
+                world,
+                h.Cell(str(int(np.isfinite(slam_cpu).sum())), numeric=True),
+                *[
+                    _amount(_mean(costf.cost_values(mine, name)))
+                    for name in ("slam_cpu_s", "run_cpu_s", "update_ms_median", "update_ms_p90")
+                ],
+                h.Cell(
+                    f"{100 * slam_cpu[both].sum() / run_cpu[both].sum():.0f} %" if both.any() else "-", numeric=True
+                ),
+                *[_amount(_mean(costf.cost_values(mine, name))) for name in ("slam_peak_mib", "run_peak_mib")],
+            ]
+        )
+    table = h.table(
+        [
+            "world",
+            "runs measured",
+            "SLAM CPU s",
+            "run CPU s",
+            "ms per update (median)",
+            "ms per update (p90)",
+            "SLAM share of the CPU",
+            "SLAM MiB",
+            "run MiB",
+        ],
+        rows,
+        id="cost-table",
+        caption="Means over the world's runs; SLAM share of the CPU: the runs' SLAM CPU time over their whole CPU time.",
+    )
+    return h.section(title, explain, picture, table, id="cost")
+
+
+def _mean(values: np.ndarray) -> float:
+    """The mean of the finite values, NaN for none."""
+    finite = values[np.isfinite(values)]
+    return float(finite.mean()) if len(finite) else math.nan
+
+
 def _runs_table(data: CampaignData) -> str:
     runs = data.runs
     rows, classes = [], []
@@ -850,6 +969,9 @@ def _runs_table(data: CampaignData) -> str:
                 _num(r["mapped"], 3),
                 _seconds(r["duration_s"]),
                 _seconds(r["wall_s"]),
+                _amount(r.get("slam_cpu_s")),
+                _amount(r.get("update_ms_median")),
+                _amount(r.get("slam_peak_mib")),
                 r["error"] if isinstance(r["error"], str) else "",
             ]
         )
@@ -867,13 +989,17 @@ def _runs_table(data: CampaignData) -> str:
             "explored",
             "sim s",
             "wall s",
+            "SLAM CPU s",
+            "ms per update",
+            "SLAM MiB",
             "error",
         ],
         rows,
         id="runs-table",
         row_classes=classes,
         caption="outlier in: the errors in which the run lies beyond its world's Tukey fences (see the outlier "
-        "column of Table I); sim s: simulated duration; wall s: the run's wall-clock time on its worker.",
+        "column of Table I); sim s: simulated duration; wall s: the run's wall-clock time on its worker; SLAM CPU s, "
+        "ms per update (median) and SLAM MiB: what the run cost (see the section on cost).",
     )
     return h.section(
         "Every run",
@@ -991,6 +1117,7 @@ def build_report(
         _fig3(figs, data, done, chosen, repeats, seed),
         _fig4(figs, data, done),
         _termination(figs, data, done),
+        _cost(figs, data, done),
         _runs_table(data),
         _provenance(data),
     ]
@@ -1003,6 +1130,7 @@ def build_report(
         ("fig-3", "Fig. 3"),
         ("fig-4", "Fig. 4"),
         ("termination", "Termination"),
+        ("cost", "Cost"),
         ("runs", "Runs"),
         ("provenance", "Provenance"),
     ]

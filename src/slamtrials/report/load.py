@@ -28,7 +28,9 @@ outlier_t,     the run is an outlier of its world (Tukey's fences, :func:`slamtr
 outlier_r      among the world's done runs); False unless done
 frames, ...    the entries of the catalog's ``details`` (frames, distance_m, observed_fraction,
                slam_updates, relation_std_t, relation_std_r, relations_capped, and se_t, se_r: the standard
-               errors of eps_t, eps_r, from this version on)
+               errors of eps_t, eps_r, and the run's cost: slam_cpu_s, slam_peak_mib, run_cpu_s,
+               run_peak_mib, update_ms_median, update_ms_p90, :class:`slamtrials.cost.RunCost`, from this
+               version on)
 ============== ======================================================================================
 
 ``worlds``: one row per world in campaign order: the catalog's ``worlds`` columns (``name`` as ``world``,
@@ -42,7 +44,10 @@ paper's Table I over the done runs (the columns of :func:`slamtrials.report.tabl
 the metric's share of the variance between the done runs (:func:`slamtrials.report.tables.metric_shares`,
 mean ``se^2`` over the variance of the run errors), NaN when a run has no standard error recorded
 (``se_t``, ``se_r``: runs of earlier versions) or for fewer than 2 runs. The intervals use the campaign's confidence and
-quantile (``runs.confidence``, ``runs.distribution``), as ``slamtrials campaign status`` prints them.
+quantile (``runs.confidence``, ``runs.distribution``), as ``slamtrials campaign status`` prints them. Last, the mean
+cost per done run (:mod:`slamtrials.campaign.costsummary`, as summary.csv): ``slam_cpu_s_mean``, ``slam_peak_mib_mean``,
+``run_cpu_s_mean``, ``run_peak_mib_mean``, ``update_ms_median_mean``, ``update_ms_p90_mean``, NaN where no run
+recorded that figure (runs of earlier versions).
 
 :func:`export_table` writes either table as CSV or Parquet.
 """
@@ -60,7 +65,9 @@ import numpy as np
 import pandas as pd
 
 from slamtrials.atomicfile import atomic_write, atomic_write_text
+from slamtrials.campaign.costsummary import COST_CSV_COLUMNS
 from slamtrials.campaign.store import DB_FILE, RUNS_DIR, STORE_FORMAT
+from slamtrials.cost import COST_FIGURES
 from slamtrials.errors import ConfigError, FormatError
 from slamtrials.metric.quantiles import Distribution
 from slamtrials.report.tables import METRICS, metric_shares, outlier_mask, world_summary
@@ -116,6 +123,7 @@ WORLD_COLUMNS = (
     *(f"{m}_{s}" for m in METRICS for s in _STATS),
     "confidence",
     *(f"{m}_metric_share" for m in METRICS),
+    *COST_CSV_COLUMNS,
 )
 #: The tables :func:`export_table` writes.
 TABLES = ("runs", "worlds")
@@ -310,6 +318,13 @@ def _worlds_frame(rows: list[tuple], runs: pd.DataFrame, config: dict[str, Any])
     for metric in METRICS:
         shares = metric_shares(done, metric) if len(done) else pd.Series(dtype="float64")
         worlds[f"{metric}_metric_share"] = worlds["world"].map(shares).astype("float64")
+    for name, column in zip(COST_FIGURES, COST_CSV_COLUMNS):
+        done_runs = runs[runs["status"] == "done"]
+        if name in done_runs.columns:
+            figures = pd.to_numeric(done_runs[name], errors="coerce").astype("float64")
+            worlds[column] = worlds["world"].map(figures.groupby(done_runs["world"]).mean()).astype("float64")
+        else:
+            worlds[column] = np.nan
     return worlds[list(WORLD_COLUMNS)]
 
 

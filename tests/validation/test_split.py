@@ -112,3 +112,43 @@ def test_cli_split_with_a_half_without_relations_or_with_a_profile_is_one_line_a
     result = runner.invoke(app, ["validate", str(LOG), "-r", str(RELATIONS), "--split", "--profile", "paper"])
     assert result.exit_code == 2 and "leave out --profile" in result.output
     assert not out.exists()
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not (LOG.is_file() and RELATIONS.is_file()), reason=f"no MIT CSAIL data in {DATA}")
+def test_mit_csail_split_half_with_a_program_fits_the_first_half_against_the_programs_estimate(tmp_path):
+    import shlex
+    import sys
+
+    from typer.testing import CliRunner
+
+    from slamtrials.cli.main import app
+
+    # a real program: slamtrials' own GMapping run as a separate process on the exported CARMEN log
+    slam = f"{shlex.quote(sys.executable)} -m slamtrials slam -i {{input}} --algorithm gmapping --out {{workdir}}/run"
+    command = f"{slam} && cp {{workdir}}/run/trajectory.tum {{output}}"
+    out = tmp_path / "split.json"
+    result = CliRunner().invoke(
+        app,
+        [
+            "validate",
+            str(LOG),
+            "-r",
+            str(RELATIONS),
+            "--split",
+            "--runs",
+            "1",
+            "--program",
+            command,
+            "--json",
+            str(out),
+        ],
+    )
+    assert result.exit_code == 0, result.output
+    assert "first half" in result.output and "second half" in result.output
+    text = " ".join(result.output.split())  # rich wraps long lines
+    assert "reference: program:slamtrials estimate (seed 0) and the map drawn from it" in text
+    import json
+
+    doc = json.loads(out.read_text())
+    assert doc["program"]["command"] == command and doc["profile"]["name"].endswith("first-half")

@@ -136,7 +136,8 @@ def validate(
 
     With --split the profile is fitted to the log's first half (``slamtrials calibrate --relations`` on
     the frames up to the middle of its time span and the relations within them), and the second half is
-    validated with it as a log of its own: both are printed.
+    validated with it as a log of its own: both are printed. With --program the first half's laser is
+    fitted against the program's estimate and the map drawn from it.
     """
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
@@ -150,8 +151,6 @@ def validate(
     spec = program_option(program, program_input, program_output, timeout)
     if spec is not None and (algorithm is not None or preset is not None or overrides):
         raise ConfigError("give --program or --algorithm (with --preset, --set), not both")
-    if spec is not None and split:
-        raise ConfigError("--split fits the laser against a registered algorithm's map; it does not take --program")
     algorithm = spec.label if spec is not None else (algorithm or "gmapping")
     options = ValidationSettings(
         algorithm=algorithm,

@@ -15,10 +15,18 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from slamtrials.calibration import Calibration, CalibrationSettings, calibrate, check_calibratable, slam_reference
+from slamtrials.calibration import (
+    Calibration,
+    CalibrationSettings,
+    Reference,
+    calibrate,
+    check_calibratable,
+    slam_reference,
+)
 from slamtrials.errors import CalibrationError, ConfigError
 from slamtrials.record import Relations, RunRecord
 from slamtrials.sim.config import ErrorProfile
+from slamtrials.slam.program import ProgramSpec
 from slamtrials.validation.validate import (
     ReplicaResult,
     Runner,
@@ -28,7 +36,15 @@ from slamtrials.validation.validate import (
     validate,
 )
 
-__all__ = ["LogHalves", "SplitValidation", "split_log", "record_frames", "relations_within", "split_validate"]
+__all__ = [
+    "LogHalves",
+    "SplitValidation",
+    "program_reference",
+    "split_log",
+    "record_frames",
+    "relations_within",
+    "split_validate",
+]
 
 #: Fewest relations a half must hold: fewer give no usable mean error.
 MIN_RELATIONS = 20
@@ -104,6 +120,16 @@ class SplitValidation:
     validation: ValidationResult
 
 
+def program_reference(record: RunRecord, program: ProgramSpec, seed: int) -> Reference:
+    """An external program's reference over ``record``: its estimate at every frame, and the map drawn
+    from that estimate (:func:`~slamtrials.slam.estimatemap.map_of_estimate`, as for any program)."""
+    from slamtrials.external import run_offline
+
+    run = run_offline(record, program.label, program=program, seed=seed)
+    source = f"{program.label} estimate (seed {seed}) and the map drawn from it"
+    return Reference.from_grid(run.estimate_per_frame(record), run.occupancy, source)
+
+
 def split_validate(
     record: RunRecord,
     relations: Relations,
@@ -118,7 +144,8 @@ def split_validate(
 ) -> SplitValidation:
     """Calibrate on the first half of ``record`` (by time) and validate the fitted profile on the second.
 
-    The first half's laser is fitted against ``settings.algorithm`` run over it with
+    The first half's laser is fitted against ``settings.algorithm`` (or ``settings.program``: its
+    estimate and the map drawn from it, :func:`program_reference`) run over it with
     ``settings.reference_seed`` (the same algorithm, settings and seed that give the real error on the
     second half), its odometry against its own relations (``calibrate --relations``); the calibration's
     bootstrap uses that seed too.
@@ -130,6 +157,8 @@ def split_validate(
         the log.
     CalibrationError
         The first half is too short or too still to calibrate from (the message says which half).
+    ProgramError
+        ``settings.program`` fails on the first half.
     """
     s = ValidationSettings() if settings is None else settings
     cal = CalibrationSettings() if calibration_settings is None else calibration_settings
@@ -141,7 +170,12 @@ def split_validate(
         )
     except CalibrationError as exc:
         raise CalibrationError(f"{log}, first half (to {halves.split_t:.1f} s): {exc}") from None
-    reference = slam_reference(halves.first, s.algorithm, preset=s.preset, overrides=s.overrides, seed=s.reference_seed)
+    if s.program is None:
+        reference = slam_reference(
+            halves.first, s.algorithm, preset=s.preset, overrides=s.overrides, seed=s.reference_seed
+        )
+    else:
+        reference = program_reference(halves.first, s.program, s.reference_seed)
     try:
         calibration = calibrate(
             halves.first,

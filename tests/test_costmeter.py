@@ -25,8 +25,10 @@ def test_cpu_time_of_the_calls_and_of_the_run_and_the_update_times():
     _busy(0.05)  # the run's own work, outside SLAM
     for k in range(5):
         mark = meter.enter()
+        tick = time.perf_counter()
         _busy(0.004 if k % 2 else 0.001)
-        meter.leave(mark, update=k % 2 == 1)  # two calls made an update
+        spent = time.perf_counter() - tick
+        meter.leave(mark, update_seconds=spent if k % 2 == 1 else None)  # two calls made an update
     cost = meter.finish()
     assert cost.slam_process == IN_PROCESS and cost.updates_timed == 2
     assert 0.010 <= cost.slam_cpu_s < 0.05
@@ -67,7 +69,7 @@ def test_memory_touched_outside_the_calls_is_the_run_s_not_slam_s():
 def test_a_child_s_usage_makes_the_slam_figures_and_adds_to_the_run_s():
     meter = CostMeter()
     mark = meter.enter()
-    meter.leave(mark, update=True)
+    meter.leave(mark, update_seconds=0.01)
     cost = meter.finish(ProcessUsage(cpu_s=2.5, peak_mib=30.0), in_child=True)
     assert cost.slam_process == CHILD_PROCESS and cost.slam_cpu_s == 2.5 and cost.slam_peak_mib == 30.0
     assert cost.run_cpu_s >= 2.5 and cost.updates_timed == 1

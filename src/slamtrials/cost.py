@@ -75,11 +75,12 @@ class RunCost:
         algorithm's calls (building it, ``reset``, ``process``, ``occupancy``, ``trajectory``); an external
         program: the child process's CPU time (its ``rusage``, with the descendants it waited for).
     slam_peak_mib:
-        Peak memory of the SLAM algorithm (MiB). In-process: the largest resident set size of the process
-        during the algorithm's calls above the one just before the algorithm was built (its maps,
-        particles or graph and the scratch of its updates; memory the rest of the run touched meanwhile
-        counts too, a few MiB of recorded frames and explorer maps in a trial); an external program: the
-        child's peak resident set size (``ru_maxrss``), its interpreter and libraries included.
+        Peak memory of the SLAM algorithm (MiB). In-process: the most resident memory the algorithm's
+        calls had added to the process (the pages they touched less those they gave back, summed over the
+        calls, plus the scratch of the call at its peak): its maps, particles or graph. Approximate:
+        resident pages are not allocations (the heap's fragments count), and a process's first run also
+        counts loading the algorithm's compiled kernels (:mod:`slamtrials.costmeter`). An external program: the child's
+        peak resident set size (``ru_maxrss``), its interpreter and libraries included.
     run_cpu_s:
         CPU seconds of the whole run: the thread that ran it (simulator, SLAM, explorer, coverage) plus,
         for an external program, the child's.

@@ -5,20 +5,26 @@ CPU time is the calling thread's (``time.thread_time``: right in a Dask worker t
 other threads of the process do). Memory is the kernel's count of the process's resident pages: Linux's
 ``VmHWM`` (the peak resident set size) and ``VmRSS`` from ``/proc/self/status``, the peak set back to the
 current size by writing ``5`` to ``/proc/self/clear_refs`` before each SLAM call and at the run's start,
-so each call's peak and the run's own peak are read apart from earlier runs of the same process. Where
-those files cannot be used (another OS, a sandbox) the memory figures are None.
+so each call's peak and the run's own peak are read apart from earlier runs of the same process. The
+algorithm's memory is what its calls add to the resident set (:class:`CostMeter`), after the C heap gave
+its free memory back at the run's start (:func:`release_free_heap`). Resident pages are not allocations
+(the heap's fragments count, memory reused costs no new page), and the first run in a process also
+counts loading the algorithm's compiled kernels: GMapping holding 51 MiB reads 63 to 76 MiB
+(bench/RESULTS.md, "Cost of a run"). Where those files cannot be used (another
+OS, a sandbox) the memory figures are None.
 
 Resident memory is the process's, not one thread's: a process that runs two runs at once in two threads
 (a Dask worker with ``--nthreads 2``) mixes their memory figures (slamtrials' local cluster runs one
 thread per worker process). Nothing measured here reaches the simulation or the algorithm: the meter
 only reads clocks and kernel counters around the calls, so results stay the same bit for bit.
 
-Cost: about 17 us per measured call (two reads of ``/proc/self/status``, one write), under 1 % of a
-trial (bench/bench_cost.py).
+Cost: about 15 us per measured call (two reads of ``/proc/self/status``, one write), one call a frame in a
+trial (``process`` and ``occupancy`` together): under 0.5 % of a trial (bench/bench_cost.py).
 """
 
 from __future__ import annotations
 
+import ctypes
 import os
 import sys
 import time
@@ -28,7 +34,7 @@ from typing import Any
 
 from slamtrials.cost import CHILD_PROCESS, IN_PROCESS, MIB, ProcessUsage, RunCost, update_times_ms
 
-__all__ = ["CostMeter", "CallMark", "usage_of", "ResidentMemory"]
+__all__ = ["CostMeter", "CallMark", "usage_of", "ResidentMemory", "release_free_heap"]
 
 
 class ResidentMemory:
@@ -77,6 +83,21 @@ class ResidentMemory:
         self._closer()
 
 
+def release_free_heap() -> None:
+    """Give the C heap's free memory back to the system (glibc's ``malloc_trim(0)``; nothing elsewhere).
+
+    Done at a run's start, so that memory earlier runs of the process freed but kept resident is not
+    silently reused by this run's algorithm (it would add no resident page, and the algorithm's memory
+    would read low). Freeing memory changes no value any computation sees.
+    """
+    try:
+        trim = ctypes.CDLL(None).malloc_trim
+    except (AttributeError, OSError):
+        return
+    trim.argtypes = [ctypes.c_size_t]
+    trim(0)
+
+
 def _close_all(*fds: int) -> None:
     for fd in fds:
         try:
@@ -92,10 +113,11 @@ def _kib(text: bytes, key: bytes) -> int:
 
 @dataclass(frozen=True)
 class CallMark:
-    """When a measured SLAM call began: wall clock and thread CPU clock (s)."""
+    """When a measured SLAM call began: the thread's CPU clock (s) and the process's resident set size
+    (KiB; None when memory is not measured)."""
 
-    wall: float
     cpu: float
+    resident_kib: int | None = None
 
 
 class CostMeter:
@@ -106,9 +128,18 @@ class CostMeter:
 
         meter = CostMeter()
         mark = meter.enter()
+        tick = time.perf_counter()
         pose = slam.process(reading)
-        meter.leave(mark, update=slam.updates > before)
+        spent = time.perf_counter() - tick
+        meter.leave(mark, update_seconds=spent if slam.updates > before else None)
         cost = meter.finish()
+
+    Consecutive calls (``process`` then ``occupancy``) may go between one ``enter`` and ``leave``.
+
+    The algorithm's memory is what its calls added to the process's resident set: each call's change of
+    the resident set size (pages touched, less pages given back) summed over the calls so far, and at its
+    largest the sum before a call plus that call's own peak above where it began. Memory the rest of the
+    run touches between the calls counts for the run only.
 
     Parameters
     ----------
@@ -117,42 +148,44 @@ class CostMeter:
     """
 
     def __init__(self, *, memory: bool = True):
+        if memory:
+            release_free_heap()
         self._memory = ResidentMemory.open() if memory else None
         self._run_peak_kib = 0
-        self._slam_base_kib: int | None = None
+        self._slam_held_kib = 0
         self._slam_peak_kib = 0
         self._slam_cpu = 0.0
         self._calls = 0
         self._updates: list[float] = []
         self._started_cpu = time.thread_time()
 
-    def _observe(self) -> int:
-        """Read the peak since the last reset into the run's peak; return it (KiB)."""
+    def _observe(self) -> tuple[int, int]:
+        """Read ``(peak since the last reset, current)`` resident set size (KiB); the peak goes into the run's."""
         assert self._memory is not None
         peak, current = self._memory.read()
-        if self._slam_base_kib is None:
-            self._slam_base_kib = current
         self._run_peak_kib = max(self._run_peak_kib, peak)
-        return peak
+        return peak, current
 
     def enter(self) -> CallMark:
         """Start measuring one call into the SLAM algorithm."""
+        resident = None
         if self._memory is not None:
-            self._observe()  # the peak of the stretch since the last call belongs to the run
+            _, resident = self._observe()  # the peak of the stretch since the last call belongs to the run
             self._memory.reset()
-        return CallMark(time.perf_counter(), time.thread_time())
+        return CallMark(time.thread_time(), resident)
 
-    def leave(self, mark: CallMark, *, update: bool = False) -> None:
-        """End measuring the call begun at ``mark``; ``update``: it made a SLAM update (its time counts
-        towards :attr:`~slamtrials.cost.RunCost.update_ms_median`)."""
-        cpu = time.thread_time()
-        wall = time.perf_counter()
-        self._slam_cpu += cpu - mark.cpu
+    def leave(self, mark: CallMark, *, update_seconds: float | None = None) -> None:
+        """End measuring the call begun at ``mark``. ``update_seconds``: the wall time (s) of the SLAM update
+        the call made (the caller times ``process`` itself), counted towards
+        :attr:`~slamtrials.cost.RunCost.update_ms_median`; None: the call made no update."""
+        self._slam_cpu += time.thread_time() - mark.cpu
         self._calls += 1
-        if update:
-            self._updates.append(wall - mark.wall)
-        if self._memory is not None:
-            self._slam_peak_kib = max(self._slam_peak_kib, self._observe())
+        if update_seconds is not None:
+            self._updates.append(update_seconds)
+        if self._memory is not None and mark.resident_kib is not None:
+            peak, current = self._observe()
+            self._slam_peak_kib = max(self._slam_peak_kib, self._slam_held_kib + peak - mark.resident_kib)
+            self._slam_held_kib += current - mark.resident_kib
 
     def finish(self, child: ProcessUsage | None = None, *, in_child: bool = False) -> RunCost:
         """The run's cost; the meter's files are closed.
@@ -168,8 +201,8 @@ class CostMeter:
             self._memory.close()
             self._memory = None
             run_peak = self._run_peak_kib / 1024.0
-            if self._slam_base_kib is not None and self._calls:
-                slam_peak = max(self._slam_peak_kib - self._slam_base_kib, 0) / 1024.0
+            if self._calls:
+                slam_peak = max(self._slam_peak_kib, 0) / 1024.0
         median, p90 = update_times_ms(self._updates)
         common: dict[str, Any] = {
             "update_ms_median": median,

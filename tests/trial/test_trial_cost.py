@@ -37,7 +37,7 @@ class NoMeter:
     def enter(self) -> None:
         return None
 
-    def leave(self, mark: object, *, update: bool = False) -> None:
+    def leave(self, mark: object, *, update_seconds: float | None = None) -> None:
         pass
 
     def finish(self, child: object = None, *, in_child: bool = False) -> RunCost:

@@ -880,10 +880,10 @@ _COST_TEXT = (
     "system) of the SLAM algorithm in the run, its calls timed on the thread's CPU clock, or, for an external "
     "program, its process's own (rusage). Run CPU: the whole run's (simulator, SLAM, explorer, coverage; with a "
     "program, its process too). Time per update: the wall time of each SLAM call that made an update, its median "
-    "and 90th percentile per run. SLAM memory: the process's peak resident memory during the algorithm's calls "
-    "above what it held before the algorithm was built (the algorithm's maps, particles or graph and its "
-    "scratch), or an external program's peak resident memory. Run memory: the peak resident memory of the "
-    "worker process during the run (the Python runtime and libraries included). Tables give the means over "
+    "and 90th percentile per run. SLAM memory: the most resident memory the algorithm's calls had added to the "
+    "process (its maps, particles or graph and the scratch of its updates; approximate: resident pages, not "
+    "allocations, and a worker's first run also counts loading the compiled kernels), or an external program's peak resident memory. Run memory: the peak resident memory of the "
+    "worker process during the run (the Python runtime and libraries included), plus a program's. Tables give the means over "
     "the runs; - where not measured (runs of earlier versions, or a platform without Linux's /proc)."
 )
 

@@ -133,11 +133,11 @@ def run_over_recording(
     for k in range(total):
         frame = Reading(t=float(record.t[k]), ranges=record.scans[k], odometry=record.odometry[k])
         updates = slam.updates
-        started = time.perf_counter()
         mark = meter.enter()
+        started = time.perf_counter()
         online[k] = slam.process(frame)
-        meter.leave(mark, update=slam.updates > updates)
         timing[k] = time.perf_counter() - started
+        meter.leave(mark, update_seconds=float(timing[k]) if slam.updates > updates else None)
         if on_frame is not None:
             on_frame(k, total)
     mark = meter.enter()

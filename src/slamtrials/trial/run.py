@@ -152,15 +152,14 @@ def run_trial(
     while True:
         frames.append(frame)
         updates = slam.updates
+        mark = meter.enter()
         tick = time.perf_counter()
-        mark = meter.enter()
         estimate = slam.process(frame.reading())  # the algorithm never sees the truth
-        meter.leave(mark, update=slam.updates > updates)
-        slam_seconds += time.perf_counter() - tick
+        spent = time.perf_counter() - tick
+        slam_seconds += spent
         online.append(np.array(estimate, dtype=np.float64))
-        mark = meter.enter()
         grid = slam.occupancy()
-        meter.leave(mark)
+        meter.leave(mark, update_seconds=spent if slam.updates > updates else None)
         reason = termination.check(frame.t, grid)
         if reason is not None:
             break

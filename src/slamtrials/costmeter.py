@@ -10,8 +10,8 @@ algorithm's memory is what its calls add to the resident set (:class:`CostMeter`
 its free memory back at the run's start (:func:`release_free_heap`). Resident pages are not allocations
 (the heap's fragments count, memory reused costs no new page), and the first run in a process also
 counts loading the algorithm's compiled kernels: GMapping holding 51 MiB reads 63 to 76 MiB
-(bench/RESULTS.md, "Cost of a run"). Where those files cannot be used (another
-OS, a sandbox) the memory figures are None.
+(bench/RESULTS.md, "Cost of a run"). Where those files cannot be used (another OS, a sandbox) the memory
+figures are None.
 
 Resident memory is the process's, not one thread's: a process that runs two runs at once in two threads
 (a Dask worker with ``--nthreads 2``) mixes their memory figures (slamtrials' local cluster runs one
@@ -194,7 +194,7 @@ class CostMeter:
         and the run's include it. ``in_child``: the SLAM algorithm ran in a child process whose usage is
         unknown (``child`` None): the SLAM figures are None rather than those of the calls.
         """
-        run_cpu: float | None = time.thread_time() - self._started_cpu
+        run_cpu = time.thread_time() - self._started_cpu
         run_peak = slam_peak = None
         if self._memory is not None:
             self._observe()
@@ -216,7 +216,7 @@ class CostMeter:
         return RunCost(
             slam_cpu_s=child.cpu_s,
             slam_peak_mib=child.peak_mib,
-            run_cpu_s=None if run_cpu is None else run_cpu + child.cpu_s,
+            run_cpu_s=run_cpu + child.cpu_s,
             run_peak_mib=None if run_peak is None else run_peak + child.peak_mib,
             **common,
             slam_process=CHILD_PROCESS,

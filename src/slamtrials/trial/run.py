@@ -114,7 +114,9 @@ def run_trial(
         through the first pose only), the mapped fraction and area of all free space connected to the
         start, distance travelled, total turning of the true heading, simulated
         duration, wall time, SLAM updates and the wall time spent in SLAM, explorer counters, snapshot
-        MSEs), ``seed``, ``world``, the drawn odometry ``bias`` and the resolved ``config``.
+        MSEs), ``seed``, ``world``, the drawn odometry ``bias``, the resolved ``config``, and ``cost``: what
+        the run cost (:class:`~slamtrials.cost.RunCost`: CPU time and peak memory of SLAM and of the whole
+        run, time per SLAM update), a measurement of the machine that no result depends on.
 
     Raises
     ------

@@ -875,16 +875,18 @@ def _termination(figs: _FigureWriter, data: CampaignData, done: pd.DataFrame) ->
 
 #: What each cost figure is, as the cost section explains it (:class:`slamtrials.cost.RunCost`).
 _COST_TEXT = (
-    "What the runs cost, measured as they ran (not reproducible: another run of the same campaign costs a little "
-    "more or less, so these figures are never part of a result's comparison). SLAM CPU: the CPU time (user + "
-    "system) of the SLAM algorithm in the run, its calls timed on the thread's CPU clock, or, for an external "
-    "program, its process's own (rusage). Run CPU: the whole run's (simulator, SLAM, explorer, coverage; with a "
-    "program, its process too). Time per update: the wall time of each SLAM call that made an update, its median "
-    "and 90th percentile per run. SLAM memory: the most resident memory the algorithm's calls had added to the "
-    "process (its maps, particles or graph and the scratch of its updates; approximate: resident pages, not "
-    "allocations, and a worker's first run also counts loading the compiled kernels), or an external program's peak resident memory. Run memory: the peak resident memory of the "
-    "worker process during the run (the Python runtime and libraries included), plus a program's. Tables give the means over "
-    "the runs; - where not measured (runs of earlier versions, or a platform without Linux's /proc)."
+    "What the runs cost, measured as they ran (not reproducible: another run of the same campaign costs a "
+    "little more or less, so these figures are never part of a result's comparison). SLAM CPU: the CPU time "
+    "(user + system) of the SLAM algorithm in the run, its calls timed on the thread's CPU clock, or, for an "
+    "external program, its process's own (rusage). Run CPU: the whole run's (simulator, SLAM, explorer, "
+    "coverage; with a program, its process too; in a replay, the SLAM algorithm's pass over the recorded "
+    "frames). Time per update: the wall time of each SLAM call that made an update, its median and 90th "
+    "percentile per run. SLAM memory: the most resident memory the algorithm's calls had added to the process"
+    " (its maps, particles or graph and the scratch of its updates; approximate: resident pages, not "
+    "allocations, and a worker's first run also counts loading the compiled kernels), or an external "
+    "program's peak resident memory. Run memory: the peak resident memory of the worker process during the "
+    "run (the Python runtime and libraries included), plus a program's. Tables give the means over the runs; "
+    "- where not measured (runs of earlier versions, or a platform without Linux's /proc)."
 )
 
 

@@ -1,6 +1,7 @@
 """Benchmark of ``karto``: time per node on real logs, and the optimizer's time against graph size.
 
-Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/bench_karto.py [--quick] [--log PATH ...]``. Prints
+Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/bench_karto.py [--quick] [--log PATH ...] [--preset P ...
+[--presets-only]]``. Prints
 Markdown tables; the latest figures are kept in docs/karto.md ("Speed").
 
 1. Real logs (default: the MIT CSAIL log of ``../shared/data``; ``--log`` adds others, also ``.gz`` or
@@ -135,13 +136,59 @@ def bench_optimizer(sizes: list[int]) -> None:
         )
 
 
+def bench_presets(logs: list[Path], presets: list[str]) -> None:
+    """karto over each log in each preset: SLAM CPU seconds per log and per node, and the SLAM's own peak
+    memory (:class:`~slamtrials.cost.RunCost`: what its calls added to the resident set), next to the
+    node count and CPU seconds the C++ original's reference run reports (../shared/data/karto-cpp; another
+    machine and session, so a guide, not a ratio)."""
+    from slamtrials.slamrun import run_slam
+
+    print("\n### karto per log and preset (SLAM CPU time, after a warm-up run that compiles)\n")
+    print(
+        "| log | preset | nodes | SLAM CPU s | CPU ms per node | SLAM peak MiB | "
+        "C++ reference (guide): nodes, loop CPU s, ms per node |"
+    )
+    print("|---|---|---:|---:|---:|---:|---|")
+    for log in logs:
+        record = load_recording(log)
+        name = log.name.split(".")[0]
+        for preset in presets:
+            run_slam(record, "karto", preset=preset, seed=0, source=str(log))  # compiles, warms the caches
+            result = run_slam(record, "karto", preset=preset, seed=0, source=str(log))
+            cost = result.cost
+            cpu = cost.slam_cpu_s if cost is not None and cost.slam_cpu_s is not None else float("nan")
+            mib = cost.slam_peak_mib if cost is not None and cost.slam_peak_mib is not None else float("nan")
+            guide = "-"
+            summary = SHARED / "data" / "karto-cpp" / name / f"{preset}.summary.json"
+            if summary.is_file():
+                import json
+
+                ref = json.loads(summary.read_text())
+                guide = f"{ref['nodes']}, {ref['loop_cpu_s']:.1f}, {1000 * ref['loop_cpu_s'] / ref['nodes']:.1f}"
+            print(
+                f"| {name} | {preset} | {result.updates} | {cpu:.1f} | {1000 * cpu / max(result.updates, 1):.1f} | "
+                f"{mib:.0f} | {guide} |"
+            )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="smaller optimizer graphs")
     parser.add_argument("--log", action="append", default=[], help="another CARMEN log (.clf or .clf.bz2)")
+    parser.add_argument(
+        "--preset",
+        action="append",
+        default=[],
+        help="also run the whole logs in this preset and report SLAM CPU and memory per log (repeatable)",
+    )
+    parser.add_argument("--presets-only", action="store_true", help="only the per-preset table")
     args = parser.parse_args()
     print(f"CPU: {cpu_model()}; NUMBA_NUM_THREADS={os.environ.get('NUMBA_NUM_THREADS')}")
     logs = [SHARED / "data" / "mit-csail" / "mit-csail.clf"] + [Path(p) for p in args.log]
+    if args.preset:
+        bench_presets([log for log in logs if log.exists()], args.preset)
+        if args.presets_only:
+            return
     for log in logs:
         if log.exists():
             bench_log(log)

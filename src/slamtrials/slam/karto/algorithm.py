@@ -262,6 +262,9 @@ class Karto:
         # after sequential matching; Compute starts from it and overwrites it with its result), a pose
         # set on a node afterwards (AddEdges' weighted mean, a loop closure's match) is not seen by it.
         self._solver_poses: list[NDArray[np.float64]] = []
+        # per node: its reference position (_references) and the pose object it was computed for
+        self._reference_rows = np.zeros((0, 2))
+        self._reference_poses: list[NDArray[np.float64]] = []
         # per node: the pose its map-frame points and barycentre were computed at, and those
         self._world: dict[
             int, tuple[NDArray[np.float64], tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]]
@@ -281,24 +284,40 @@ class Karto:
         node's pose changes."""
         node = self.graph.nodes[index]
         cached = self._world.get(index)
-        if cached is not None and np.array_equal(cached[0], node.pose):
+        if cached is not None and cached[0] is node.pose:  # a node's pose is replaced, never changed in place
             return cached[1]
         laser_pose = self._laser_pose(index)
         x, y = scan_points(laser_pose, node.readings, self.laser.angle_min, self.laser.angle_increment)
         points = (x, y, barycentre(x, y, node.within))
-        self._world[index] = (node.pose.copy(), points)
+        self._world[index] = (node.pose, points)
         return points
 
     def _references(self) -> NDArray[np.float64]:
-        """``[N, 2]`` every node's reference position: its points' barycentre or its laser position."""
+        """``[N, 2]`` every node's reference position: its points' barycentre or its laser position (a view
+        of a cache; rows are recomputed only for nodes whose pose was replaced since)."""
         nodes = self.graph.nodes
-        references = compose(np.array([n.pose for n in nodes]).reshape(-1, 3), self.mount)[:, :2]
-        if self.config.use_scan_barycenter:
-            for k in range(len(nodes)):
+        n = len(nodes)
+        if self._reference_rows.shape[0] < n:
+            grown = np.zeros((max(2 * self._reference_rows.shape[0], n, 64), 2))
+            grown[: self._reference_rows.shape[0]] = self._reference_rows
+            self._reference_rows = grown
+        rows, poses = self._reference_rows, self._reference_poses
+        use_barycentre = self.config.use_scan_barycenter
+        for k in range(n):
+            node = nodes[k]
+            if k < len(poses) and poses[k] is node.pose:
+                continue
+            reference = compose1(node.pose, self.mount)[:2]
+            if use_barycentre:
                 centre = self._world_points(k)[2]
                 if not np.isnan(centre[0]):
-                    references[k] = centre
-        return references
+                    reference = centre
+            rows[k] = reference
+            if k < len(poses):
+                poses[k] = node.pose
+            else:
+                poses.append(node.pose)
+        return rows[:n]
 
     def _points(self, indexes: list[int]) -> list[tuple[NDArray[np.float64], NDArray[np.float64]]]:
         return [self._world_points(i)[:2] for i in indexes]

@@ -35,7 +35,8 @@ class ScanNode:
     odometry:
         float64 ``[3]`` base pose in the odometry frame.
     pose:
-        float64 ``[3]`` corrected base pose, map frame (changed by matching and optimisation).
+        float64 ``[3]`` corrected base pose, map frame (changed by matching and optimisation: always by
+        assigning a new array, never in place, so caches may key on the array itself).
     lx, ly:
         float64 ``[B]`` the scan's points in the laser frame (m), NaN where a beam has none.
     barycenter:

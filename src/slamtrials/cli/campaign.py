@@ -99,7 +99,14 @@ class _Progress:
     """
 
     def __init__(self, console, first: str | None = None):
-        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            Progress,
+            TextColumn,
+            TimeElapsedColumn,
+            TimeRemainingColumn,
+        )
 
         self.console = console
         self.progress = Progress(
@@ -108,6 +115,8 @@ class _Progress:
             MofNCompleteColumn(),
             TextColumn("{task.fields[status]}"),
             TimeElapsedColumn(),
+            # the time left for the runs the rule asks for so far (it may ask for more)
+            TimeRemainingColumn(),
             console=console,
             disable=not console.is_terminal,
         )

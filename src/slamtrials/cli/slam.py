@@ -278,7 +278,7 @@ def _repeat(
     overwrite: bool,
 ) -> None:
     """``slam --runs``: SLAM repeated on a dataset (:func:`slamtrials.repeat.repeat_slam`)."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
     from slamtrials.io.relations import read_relations
     from slamtrials.repeat import RepeatSettings, repeat_slam, write_repeat_outputs
@@ -316,6 +316,7 @@ def _repeat(
         TextColumn(f"{label} runs"),
         BarColumn(),
         MofNCompleteColumn(),
+        TimeRemainingColumn(),
         console=console,
         transient=True,
         disable=not console.is_terminal,

@@ -139,7 +139,7 @@ def validate(
     validated with it as a log of its own: both are printed. With --program the first half's laser is
     fitted against the program's estimate and the map drawn from it.
     """
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
     from slamtrials.io.relations import read_relations
     from slamtrials.slam import get_algorithm, resolve_config
@@ -198,6 +198,7 @@ def validate(
         TextColumn(f"{algorithm}: reference run, then replicas"),
         BarColumn(),
         MofNCompleteColumn(),
+        TimeRemainingColumn(),
         console=console,
         transient=True,
         disable=not console.is_terminal,

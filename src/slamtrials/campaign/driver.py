@@ -6,6 +6,8 @@ dies loses only its current run, which Dask runs again elsewhere), and records e
 it arrives (:func:`distributed.as_completed`, to which new futures are added as worlds advance). Worlds
 proceed concurrently: while one waits for the last runs of its batch, the others keep the workers busy;
 runs of larger worlds, which take longer, are started first.
+:func:`drive_lanes` does the same for several campaigns at once on one client (a study's cells), their runs
+in one queue and one priority order.
 A run that fails for good marks its world failed; the other worlds go on.
 """
 
@@ -23,7 +25,7 @@ from slamtrials.campaign.results import RunDone, RunFailed, RunResult
 from slamtrials.campaign.store import CampaignStore, WorldInfo
 from slamtrials.metric.runcount import RunCount
 
-__all__ = ["Plan", "Planner", "drive", "DriveCounts"]
+__all__ = ["Plan", "Planner", "drive", "drive_lanes", "Lane", "DriveCounts"]
 
 log = logging.getLogger(__name__)
 
@@ -80,6 +82,37 @@ def _priority(world: WorldInfo) -> int:
     return int(world.reachable_area) if math.isfinite(world.reachable_area) else 0
 
 
+@dataclass(frozen=True)
+class Lane:
+    """One campaign among several driven together on one Dask client (:func:`drive_lanes`).
+
+    Attributes
+    ----------
+    store:
+        The campaign's catalog (open, locked by the caller).
+    worlds:
+        Its worlds, in campaign order.
+    planner:
+        Decides its runs and builds their tasks.
+    retries:
+        Dask retries of each of its runs.
+    on_event:
+        Called with its :class:`CampaignEvent` objects.
+    prefix:
+        Part of its task keys (``slamtrials-<prefix>-<world>-<index>-<token>``); unique per lane.
+    priority:
+        ``world -> Dask priority`` of the world's runs (higher starts first); default :func:`_priority`.
+    """
+
+    store: CampaignStore
+    worlds: Sequence[WorldInfo]
+    planner: Planner
+    retries: int
+    on_event: Callable[[CampaignEvent], None] | None = None
+    prefix: str = "run"
+    priority: Callable[[WorldInfo], int] | None = None
+
+
 def drive(
     store: CampaignStore,
     client: Any,
@@ -91,25 +124,39 @@ def drive(
     prefix: str = "run",
 ) -> DriveCounts:
     """Run every world to its end (see the module docstring); return the counts of this call."""
+    return drive_lanes(client, [Lane(store, worlds, planner, retries, on_event, prefix)])[0]
+
+
+def drive_lanes(client: Any, lanes: Sequence[Lane]) -> list[DriveCounts]:
+    """Run every world of every lane to its end on one client, their runs interleaved (one queue of
+    results, one Dask priority order over all lanes); return each lane's counts of this call."""
     from distributed import as_completed
 
-    emit = on_event or (lambda event: None)
     token = uuid.uuid4().hex[:8]
-    by_name = {w.name: w for w in worlds}
-    in_flight: dict[str, set[int]] = {w.name: set() for w in worlds}
-    failed: dict[str, str] = {}
-    targets: dict[str, int] = {}
-    futures: dict[Any, tuple[str, int]] = {}
+    # state per (lane, world name)
+    in_flight: dict[tuple[int, str], set[int]] = {
+        (k, w.name): set() for k, lane in enumerate(lanes) for w in lane.worlds
+    }
+    failed: dict[tuple[int, str], str] = {}
+    targets: dict[tuple[int, str], int] = {}
+    futures: dict[Any, tuple[int, str, int]] = {}
+    by_name = [{w.name: w for w in lane.worlds} for lane in lanes]
     queue = as_completed()
-    counts = DriveCounts()
+    counts = [DriveCounts() for _ in lanes]
 
-    def advance(world: WorldInfo, plan: Plan, results: dict) -> None:
-        targets[world.name] = plan.target
+    def emit(k: int, event: CampaignEvent) -> None:
+        if lanes[k].on_event is not None:
+            lanes[k].on_event(event)  # type: ignore[misc]
+
+    def advance(k: int, world: WorldInfo, plan: Plan, results: dict) -> None:
+        lane, key = lanes[k], (k, world.name)
+        targets[key] = plan.target
         if plan.final_status is not None:
-            store.record_world(
+            lane.store.record_world(
                 world.name, status=plan.final_status, target=plan.target, decision=plan.decision, note=plan.note
             )
             emit(
+                k,
                 CampaignEvent(
                     "world_done",
                     world.name,
@@ -117,70 +164,75 @@ def drive(
                     len(results),
                     status=plan.final_status,
                     message=plan.note or "",
-                )
+                ),
             )
             return
-        new = [i for i in plan.to_run if i not in in_flight[world.name]]
+        new = [i for i in plan.to_run if i not in in_flight[key]]
         if not new:
             return
-        tasks = [(i, *planner.task(world, i)) for i in new]
-        store.mark_submitted(world.name, [(i, seed) for i, _, _, seed in tasks])
-        store.record_world(world.name, status="running", target=plan.target, decision=plan.decision)
+        tasks = [(i, *lane.planner.task(world, i)) for i in new]
+        lane.store.mark_submitted(world.name, [(i, seed) for i, _, _, seed in tasks])
+        lane.store.record_world(world.name, status="running", target=plan.target, decision=plan.decision)
+        priority = (lane.priority or _priority)(world)
         for i, function, argument, _ in tasks:
             future = client.submit(
                 function,
                 argument,
-                key=f"slamtrials-{prefix}-{world.name}-{i}-{token}",
-                retries=retries,
+                key=f"slamtrials-{lane.prefix}-{world.name}-{i}-{token}",
+                retries=lane.retries,
                 pure=False,
-                priority=_priority(world),
+                priority=priority,
             )
-            futures[future] = (world.name, i)
-            in_flight[world.name].add(i)
+            futures[future] = (k, world.name, i)
+            in_flight[key].add(i)
             queue.add(future)
         log.info("%s: submitted runs %s (needs %d)", world.name, new, plan.target)
-        emit(CampaignEvent("batch", world.name, plan.target, len(results), message=f"runs {new[0]}..{new[-1]}"))
+        emit(k, CampaignEvent("batch", world.name, plan.target, len(results), message=f"runs {new[0]}..{new[-1]}"))
 
-    for world in worlds:
-        results = store.done_results(world.name)
-        plan = planner.plan(world, results)
-        emit(CampaignEvent("start", world.name, plan.target, len(results), status=plan.final_status or "pending"))
-        advance(world, plan, results)
+    for k, lane in enumerate(lanes):
+        for world in lane.worlds:
+            results = lane.store.done_results(world.name)
+            plan = lane.planner.plan(world, results)
+            emit(
+                k, CampaignEvent("start", world.name, plan.target, len(results), status=plan.final_status or "pending")
+            )
+            advance(k, world, plan, results)
 
     for future in queue:
-        name, index = futures.pop(future)
-        in_flight[name].discard(index)
+        k, name, index = futures.pop(future)
+        lane, key = lanes[k], (k, name)
+        in_flight[key].discard(index)
         try:
             result: RunResult = future.result()
         except Exception as exc:  # lost after its retries, or a bug: recorded, the other worlds go on
             result = RunFailed(world=name, index=index, error=f"{type(exc).__name__}: {exc}")
         finally:
             future.release()
-        world = by_name[name]
+        world = by_name[k][name]
         if isinstance(result, RunDone):
-            store.record_done(name, index, result)
-            counts.done += 1
-            results = store.done_results(name)
+            lane.store.record_done(name, index, result)
+            counts[k].done += 1
+            results = lane.store.done_results(name)
             emit(
+                k,
                 CampaignEvent(
-                    "run_done", name, targets[name], len(results), index=index, eps_t=result.eps_t, eps_r=result.eps_r
-                )
+                    "run_done", name, targets[key], len(results), index=index, eps_t=result.eps_t, eps_r=result.eps_r
+                ),
             )
         else:
             error = result.error
             log.warning("%s run %d failed: %s", name, index, error)
-            store.record_failed(name, index, error, worker=result.worker)
-            counts.failed += 1
-            failed.setdefault(name, f"run {index} failed: {error}")
-            results = store.done_results(name)
-            emit(CampaignEvent("run_failed", name, targets[name], len(results), index=index, message=error))
-        if name in failed:
-            if not in_flight[name]:
+            lane.store.record_failed(name, index, error, worker=result.worker)
+            counts[k].failed += 1
+            failed.setdefault(key, f"run {index} failed: {error}")
+            results = lane.store.done_results(name)
+            emit(k, CampaignEvent("run_failed", name, targets[key], len(results), index=index, message=error))
+        if key in failed:
+            if not in_flight[key]:
                 emit(
-                    CampaignEvent(
-                        "world_done", name, targets[name], len(results), status="failed", message=failed[name]
-                    )
+                    k,
+                    CampaignEvent("world_done", name, targets[key], len(results), status="failed", message=failed[key]),
                 )
             continue
-        advance(world, planner.plan(world, results), results)
+        advance(k, world, lane.planner.plan(world, results), results)
     return counts

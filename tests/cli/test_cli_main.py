@@ -136,3 +136,24 @@ def test_boolean_flags_are_shown_as_flags_in_every_help():
         assert "<bool>" not in result.output, words
     shown = runner.invoke(app, ["trial", "--help"], env={"COLUMNS": "120"}).output
     assert "--overwrite" in shown and "<int>" in shown
+
+
+def test_every_help_is_reflowed_to_the_terminal_and_cuts_no_word():
+    """A docstring's line breaks are not kept inside a paragraph (they left ragged lines), and a word
+    too long for its column (an option name, a path) is folded, never cut with an ellipsis."""
+    from slamtrials.cli.common import reflow
+
+    assert reflow("One two\nthree.\n\nA list:\n\n- a\n- b\n\n    indented\n    block") == (
+        "One two three.\n\nA list:\n\n- a\n- b\n\n    indented\n    block"
+    )
+    paths = list(_command_paths(typer.main.get_command(app)))
+    for words in paths:
+        for columns in ("60", "100"):
+            result = runner.invoke(app, [*words, "--help"], env={"COLUMNS": columns})
+            assert result.exit_code == 0, (words, result.output)
+            assert "…" not in result.output, (words, columns, result.output)
+    # the validate docstring's second paragraph wraps as one paragraph: no line ends mid-sentence early
+    result = runner.invoke(app, ["validate", "--help"], env={"COLUMNS": "100"})
+    text_lines = [line.strip() for line in result.output.splitlines() if line.strip() and "│" not in line]
+    long_enough = [line for line in text_lines[2:8] if not line.endswith((".", ":"))]
+    assert all(len(line) > 70 for line in long_enough), text_lines[:8]

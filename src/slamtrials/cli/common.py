@@ -33,6 +33,40 @@ __all__ = [
 EXIT_BAD_INPUT = 2
 
 
+def _fold_long_words_in_help() -> None:
+    """Make typer's help fold a word too long for its column instead of cutting it with an ellipsis (a
+    path such as ``/base_pose_ground_truth`` in a narrow terminal): the columns its tables create as rows
+    are added, and the texts of an option's help cell, get rich's ``overflow="fold"``."""
+    from rich.table import Table
+    from rich.text import Text
+    from typer import rich_utils
+
+    if getattr(rich_utils.Table, "folds_long_words", False):
+        return
+
+    class FoldingTable(Table):
+        folds_long_words = True
+
+        def add_row(self, *renderables, **kwargs):
+            while len(self.columns) < len(renderables):
+                self.add_column(overflow="fold")
+            super().add_row(*renderables, **kwargs)
+
+    class FoldingColumns(rich_utils.Columns):  # type: ignore[name-defined,misc]
+        def __init__(self, renderables=None, *args, **kwargs):
+            items = list(renderables or [])
+            for item in items:
+                if isinstance(item, Text):
+                    item.overflow = "fold"
+            super().__init__(items, *args, **kwargs)
+
+    rich_utils.Table = FoldingTable  # type: ignore[misc]
+    rich_utils.Columns = FoldingColumns  # type: ignore[misc]
+
+
+_fold_long_words_in_help()
+
+
 class ErrorReportingGroup(TyperGroup):
     """A command group that turns expected errors into one line and exit status 2.
 
@@ -48,6 +82,8 @@ class ErrorReportingGroup(TyperGroup):
         command = super().get_command(ctx, cmd_name)
         if command is not None and ctx is not None:  # the reference walks the tree without a context
             _flags_as_flags(command.get_params(ctx))
+        if command is not None and command.help:
+            command.help = reflow(command.help)
         return command
 
     def invoke(self, ctx):  # ctx: typer's (vendored) click Context
@@ -78,6 +114,28 @@ def _flags_as_flags(params: list) -> list:
         if getattr(param, "is_flag", False) and param.metavar is None:
             param.metavar = ""
     return params
+
+
+def _is_prose(paragraph: list[str]) -> bool:
+    """Whether a help paragraph's lines are running text (not a list, a table or an indented block)."""
+    for line in paragraph:
+        stripped = line.lstrip()
+        if (
+            line != stripped
+            or stripped[:2] in ("- ", "* ", "| ")
+            or stripped[:1] == "\b"
+            or stripped[:2].rstrip(".").isdigit()
+        ):
+            return False
+    return True
+
+
+def reflow(text: str) -> str:
+    """A docstring's paragraphs as single lines, so the help wraps them to the terminal: typer keeps a
+    docstring's line breaks, which leaves ragged lines in any width but the source's. Lists, tables
+    and indented blocks keep their lines."""
+    paragraphs = [p.split("\n") for p in text.strip().split("\n\n")]
+    return "\n\n".join(" ".join(line.strip() for line in p) if _is_prose(p) else "\n".join(p) for p in paragraphs)
 
 
 def bad_value_line(exc: BadParameter) -> str:

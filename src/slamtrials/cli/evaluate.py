@@ -132,7 +132,6 @@ def evaluate(
         Quantile | None,
         typer.Option(
             "--distribution",
-            "--quantile",
             help="Critical value: normal or Student t with pilot-1 degrees of freedom (RUN).",
         ),
     ] = None,

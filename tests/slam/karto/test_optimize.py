@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from slamtrials.geometry import ominus
+from slamtrials.geometry import compose, ominus
 from slamtrials.slam.karto.optimize import information, optimize_pose_graph
 
 
@@ -82,3 +82,28 @@ def test_information_inverts_a_covariance():
     cov = np.array([[0.04, 0.01, 0.0], [0.01, 0.09, 0.0], [0.0, 0.0, 0.002]])
     product = information(cov) @ cov
     np.testing.assert_allclose(product, np.eye(3), atol=1e-12)
+
+
+def test_the_parameter_tolerance_is_measured_on_the_raw_coordinates_as_ceres_does():
+    # Ceres compares a step with 1e-3 of the norm of the free parameters as they are, so the same graph far
+    # from the map frame's origin (the Freiburg logs start 576 m from it) stops sooner: on MIT CSAIL every
+    # solve of slam_toolbox ends after 2 iterations. A 120-node ring, bent by heading drift as a loop
+    # closure leaves it:
+    n = 120
+    angle = np.arange(n) * 2 * math.pi / n
+    heading = (angle + 1.5 * math.pi) % (2 * math.pi) - math.pi
+    truth = np.column_stack([10 * np.cos(angle), 10 * np.sin(angle), heading])
+    source = np.array(list(range(n - 1)) + [n - 1])
+    target = np.array(list(range(1, n)) + [0])
+    means = ominus(truth[source], truth[target])
+    weights = np.repeat(information(np.diag([1e-3, 1e-3, 1e-4]))[None], n, axis=0)
+    start = truth.copy()
+    for k in range(1, n):
+        start[k] = compose(start[k - 1], means[k - 1] + np.array([0.0, 0.0, 0.002]))
+    near = optimize_pose_graph(start, source, target, means, weights)
+    far_start = start.copy()
+    far_start[:, :2] += 1000.0
+    far = optimize_pose_graph(far_start, source, target, means, weights)
+    assert far.reason == near.reason == "parameter tolerance"
+    assert far.iterations == 2 < near.iterations
+    assert far.final_cost > 100 * near.final_cost

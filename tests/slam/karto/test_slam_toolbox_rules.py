@@ -169,3 +169,14 @@ def test_the_optimizer_starts_from_its_own_copy_of_the_nodes(square_loop, monkey
         moved_since |= not np.array_equal(start, current)
         previous = result
     assert moved_since  # some node's pose had been set after it was added
+
+
+def test_karto_compares_distances_with_its_tolerance_of_1e_6(synthetic):
+    # HasMovedEnough: squared travel >= minimum^2 - KT_TOLERANCE (1e-6 in Karto's Math.h): a laser that
+    # moved 0.2 m less 2e-7 m makes a node in the slam_karto setting (0.04 - 8e-8 >= 0.04 - 1e-6)
+    odometry = [(0.0, 0.0, 0.0), (0.2 - 2e-7, 0.0, 0.0), (0.2 - 2e-7 + 0.19, 0.0, 0.0)]
+    times = [0.0, 1.0, 2.0]
+    nodes = _nodes(
+        synthetic, odometry, times, scan_throttle=False, minimum_travel_distance=0.2, minimum_time_interval=3600.0
+    )
+    assert nodes == [0, 1]

@@ -27,7 +27,16 @@ from slamtrials.slam import GridMap
 from slamtrials.worlds import World
 from slamtrials.worlds.world import cell_to_world
 
-__all__ = ["known_free_area", "local_mapped_fraction", "mapped_fraction", "observed_fraction", "reachable_cell_centres"]
+__all__ = [
+    "known_cells",
+    "known_free_area",
+    "known_share",
+    "local_map_points",
+    "local_mapped_fraction",
+    "mapped_fraction",
+    "observed_fraction",
+    "reachable_cell_centres",
+]
 
 
 def reachable_cell_centres(world: World, reachable: NDArray[np.bool_] | None = None) -> NDArray[np.float64]:
@@ -68,6 +77,41 @@ def mapped_fraction(
     return float(np.mean(_lookup(grid, transform_points(map_from_world, centres)) != UNKNOWN))
 
 
+def local_map_points(
+    world: World,
+    estimate: NDArray[np.float64],
+    truth: NDArray[np.float64],
+    reachable: NDArray[np.bool_] | None = None,
+    stride: int = 5,
+) -> NDArray[np.float64]:
+    """float64 ``[K, 2]``: the centres of the ``reachable`` world cells carried into the map frame, each
+    through the trajectory pose nearest to it (``[0, 2]`` without poses).
+
+    ``estimate`` and ``truth`` are float64 ``[T, 3]``: the SLAM trajectory (map frame) and the true one
+    (world frame) at the same frames; every ``stride``-th pose is a candidate. For a cell nearest to true
+    pose ``k``, the map-frame point is ``estimate[k] (+) (truth[k] (-) cell)``.
+    """
+    centres = reachable_cell_centres(world, reachable)
+    truth = np.asarray(truth, dtype=np.float64)[:: max(int(stride), 1)]
+    estimate = np.asarray(estimate, dtype=np.float64)[:: max(int(stride), 1)]
+    if centres.shape[0] == 0 or truth.shape[0] == 0:
+        return np.zeros((0, 2), dtype=np.float64)
+    _, nearest = cKDTree(truth[:, :2]).query(centres)
+    map_from_world = compose(estimate, inverse(truth))[nearest]  # [K, 3], one transform per cell
+    return compose(map_from_world, np.column_stack([centres, np.zeros(centres.shape[0])]))[:, :2]
+
+
+def known_cells(grid: OccupancyGrid, points: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """bool ``[K]``: whether the map ``grid`` knows (free or occupied) the cell under each map-frame point
+    of ``points`` ``[K, 2]`` (m); False outside it."""
+    return _lookup(grid, points) != UNKNOWN
+
+
+def known_share(known: NDArray[np.bool_]) -> float:
+    """The share of True in ``known`` ``[K]``; 0.0 for ``K = 0``."""
+    return float(np.mean(known)) if known.shape[0] else 0.0
+
+
 def local_mapped_fraction(
     world: World,
     grid: OccupancyGrid,
@@ -77,21 +121,12 @@ def local_mapped_fraction(
     stride: int = 5,
 ) -> float:
     """Fraction of the ``reachable`` world cells that the SLAM map ``grid`` knows, each cell carried into
-    the map frame through the trajectory pose nearest to it.
+    the map frame through the trajectory pose nearest to it (:func:`local_map_points`).
 
     ``estimate`` and ``truth`` are float64 ``[T, 3]``: the SLAM trajectory (map frame) and the true one
-    (world frame) at the same frames; every ``stride``-th pose is a candidate. For a cell nearest to true
-    pose ``k``, the map-frame point is ``estimate[k] (+) (truth[k] (-) cell)``.
+    (world frame) at the same frames; every ``stride``-th pose is a candidate.
     """
-    centres = reachable_cell_centres(world, reachable)
-    truth = np.asarray(truth, dtype=np.float64)[:: max(int(stride), 1)]
-    estimate = np.asarray(estimate, dtype=np.float64)[:: max(int(stride), 1)]
-    if centres.shape[0] == 0 or grid.grid.size == 0 or truth.shape[0] == 0:
-        return 0.0
-    _, nearest = cKDTree(truth[:, :2]).query(centres)
-    map_from_world = compose(estimate, inverse(truth))[nearest]  # [K, 3], one transform per cell
-    points = compose(map_from_world, np.column_stack([centres, np.zeros(centres.shape[0])]))[:, :2]
-    return float(np.mean(_lookup(grid, points) != UNKNOWN))
+    return known_share(known_cells(grid, local_map_points(world, estimate, truth, reachable, stride)))
 
 
 def observed_fraction(

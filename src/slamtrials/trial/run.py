@@ -35,11 +35,15 @@ from slamtrials.sim import Simulator
 from slamtrials.slam import ChildProcessAlgorithm, get_algorithm
 from slamtrials.trial.config import TrialConfig
 from slamtrials.trial.coverage import (
+    known_cells,
     known_free_area,
-    local_mapped_fraction,
+    known_share,
+    local_map_points,
     mapped_fraction,
     observed_fraction,
 )
+from slamtrials.trial.exploration import EXPLORATION_KEY, ExplorationMeasures, exploration_measures
+from slamtrials.trial.firstknown import SAMPLE_PERIOD, FirstKnown, coverage_curve
 from slamtrials.trial.summary import TrialSummary
 from slamtrials.worlds import World
 
@@ -73,6 +77,23 @@ class TrialProgress:
 
 def _path_length(truth: np.ndarray) -> float:
     return float(np.sum(stablemath.hypot(np.diff(truth[:, 0]), np.diff(truth[:, 1]))))
+
+
+def _exploration(
+    history: FirstKnown,
+    points: NDArray[np.float64],
+    known: NDArray[np.bool_],
+    record: RunRecord,
+    reason: str,
+) -> ExplorationMeasures:
+    """The run's exploration measures: the coverage at each of ``history``'s samples (the reachable cells
+    carried into the map frame, ``points`` ``[K, 2]``, that the final map knows, ``known`` ``[K]``), at the
+    samples' simulated times and distances along the true path."""
+    frames = np.array(history.frames, dtype=np.intp)
+    steps = stablemath.hypot(np.diff(record.truth[:, 0]), np.diff(record.truth[:, 1]))
+    along = np.concatenate([[0.0], np.cumsum(steps)])  # [T] m, the true path's length up to each frame
+    curve = coverage_curve(history.first_sample(points), known, len(frames))
+    return exploration_measures(record.t[frames] - record.t[0], curve, along[frames], reason)
 
 
 def _turning(truth: np.ndarray) -> float:
@@ -114,7 +135,9 @@ def run_trial(
         through the first pose only), the mapped fraction and area of all free space connected to the
         start, distance travelled, total turning of the true heading, simulated
         duration, wall time, SLAM updates and the wall time spent in SLAM, explorer counters, snapshot
-        MSEs), ``seed``, ``world``, the drawn odometry ``bias``, the resolved ``config``, and ``cost``: what
+        MSEs), ``exploration`` (:class:`~slamtrials.trial.exploration.ExplorationMeasures`: time and distance
+        to 90 % and 99 % coverage, the coverage curve, the termination reason), ``seed``, ``world``, the drawn
+        odometry ``bias``, the resolved ``config``, and ``cost``: what
         the run cost (:class:`~slamtrials.cost.RunCost`: CPU time and peak memory of SLAM and of the whole
         run, time per SLAM update), a measurement of the machine that no result depends on.
 
@@ -147,6 +170,8 @@ def run_trial(
 
     frames: list[Frame] = []
     online: list[NDArray[np.float64]] = []
+    history = FirstKnown()  # when the maps first knew each place: the coverage curve
+    next_sample = -np.inf
     frame = sim.observe()
     next_report = 0.0
     reason = None
@@ -162,6 +187,9 @@ def run_trial(
         online.append(np.array(estimate, dtype=np.float64))
         grid = slam.occupancy()
         meter.leave(mark, update_seconds=spent if slam.updates > updates else None)
+        if frame.t >= next_sample and grid is not history.last_map:
+            history.update(len(frames) - 1, grid)
+            next_sample = frame.t + SAMPLE_PERIOD
         reason = termination.check(frame.t, grid)
         if reason is not None:
             break
@@ -187,14 +215,16 @@ def run_trial(
     final_map: OccupancyGrid = slam.occupancy()
     meter.leave(mark)
     record.map = final_map
+    if not (history.frames and history.frames[-1] == len(record) - 1 and history.last_map is final_map):
+        history.update(len(record) - 1, final_map)  # the final map is the last sample
     wall = time.perf_counter() - started
     duration = float(record.t[-1] - record.t[0])
     stats = explorer.stats
+    points = local_map_points(world, record.estimate, record.truth, reachable, config.coverage_stride)
+    known = known_cells(final_map, points)
     summary = TrialSummary(
         termination_reason=reason,
-        mapped_fraction=local_mapped_fraction(
-            world, final_map, record.estimate, record.truth, reachable, config.coverage_stride
-        ),
+        mapped_fraction=known_share(known),
         mapped_fraction_global=mapped_fraction(world, final_map, record.estimate[0], record.truth[0], reachable),
         observed_fraction=observed_fraction(
             world, record.truth, record.scans, laser, config.coverage_stride, reachable
@@ -222,6 +252,7 @@ def run_trial(
         **sim.metadata,
         "seed": int(seed),
         "trial": summary.to_dict(),
+        EXPLORATION_KEY: _exploration(history, points, known, record, reason).to_dict(),
         "config": config.model_dump(mode="json"),
         "slam_config": slam_config.model_dump(mode="json"),
         COST_KEY: cost.to_dict(),

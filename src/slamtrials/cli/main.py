@@ -66,6 +66,7 @@ def _register_commands() -> None:
         report,
         simulate,
         slam,
+        study,
         transfer,
         trial,
         validate,
@@ -81,6 +82,7 @@ def _register_commands() -> None:
     calibrate.register(app)
     trial.register(app)
     campaign.register(app)
+    study.register(app)
     config.register(app)
     report.register(app)
     validate.register(app)

@@ -19,7 +19,7 @@ from typing import Any
 
 from slamtrials.campaign.config import CampaignConfig
 from slamtrials.errors import ConfigError
-from slamtrials.study.config import StudyConfig, value_text, written_campaign
+from slamtrials.study.config import StudyConfig, set_key, value_text, written_campaign
 
 __all__ = ["Cell", "expand_cells", "set_key", "cell_folder_name", "CELLS_DIR"]
 
@@ -57,18 +57,6 @@ class Cell:
         return ", ".join(f"{k}: {value_text(v)}" for k, v in self.settings)
 
 
-def set_key(data: dict[str, Any], key: str, value: Any) -> None:
-    """Set the dotted ``key`` of the nested mapping ``data`` to ``value`` (intermediate mappings created)."""
-    parts = key.split(".")
-    node = data
-    for part in parts[:-1]:
-        child = node.get(part)
-        if not isinstance(child, dict):
-            child = node[part] = {}
-        node = child
-    node[parts[-1]] = copy.deepcopy(value)
-
-
 def cell_folder_name(name: str) -> str:
     """The folder name of a cell (characters other than letters, digits and ``._=,+-`` replaced by ``_``)."""
     return re.sub(r"[^A-Za-z0-9._=,+-]", "_", name)
@@ -87,7 +75,9 @@ def _cell_config(base: dict[str, Any], settings: tuple[tuple[str, Any], ...], na
     try:
         return CampaignConfig.from_dict(data, source=f"cell {name}")
     except ConfigError as exc:
-        raise ConfigError(f"{exc} (the cell's settings: {', '.join(f'{k}: {value_text(v)}' for k, v in settings)})")
+        raise ConfigError(
+            f"{exc} (the cell's settings: {', '.join(f'{k}: {value_text(v)}' for k, v in settings)})"
+        ) from None
 
 
 def expand_cells(study: StudyConfig) -> list[Cell]:

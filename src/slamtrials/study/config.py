@@ -37,7 +37,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from slamtrials.campaign.config import CampaignConfig
 from slamtrials.errors import ConfigError, FormatError, validation_problems
 
-__all__ = ["StudyConfig", "FIXED_KEYS", "NAME_PATTERN", "known_key", "value_text", "written_campaign"]
+__all__ = ["StudyConfig", "FIXED_KEYS", "NAME_PATTERN", "known_key", "value_text", "written_campaign", "set_key"]
 
 #: Campaign config keys that no axis or combination may set: the cells of a world must share their seeds
 #: and worlds (paired comparisons), and where a cell is stored is the study's business.
@@ -60,6 +60,18 @@ def written_campaign(config: CampaignConfig) -> dict[str, Any]:
     data = config.model_dump(mode="json", exclude={"output"})
     data["sim"] = written_form(config.sim)
     return data
+
+
+def set_key(data: dict[str, Any], key: str, value: Any) -> None:
+    """Set the dotted ``key`` of the nested mapping ``data`` to ``value`` (intermediate mappings created)."""
+    parts = key.split(".")
+    node = data
+    for part in parts[:-1]:
+        child = node.get(part)
+        if not isinstance(child, dict):
+            child = node[part] = {}
+        node = child
+    node[parts[-1]] = copy.deepcopy(value)
 
 
 def _settings_tree(config: CampaignConfig) -> dict[str, Any]:
@@ -192,6 +204,26 @@ class StudyConfig(BaseModel):
         if not (self.product and self.axes) and not self.combinations:
             raise ConfigError("the study has no cells: give axes (with product: true) or combinations")
         return base
+
+    def with_campaign_settings(self, settings: dict[str, Any]) -> StudyConfig:
+        """This study with ``{dotted key: value}`` set in its base campaign (``study run --set``), checked.
+
+        Raises
+        ------
+        ConfigError
+            A key that is not a config key, or a bad value (one line).
+        """
+        if not settings:
+            return self
+        base = self.base()
+        campaign = copy.deepcopy(self.campaign)
+        for key, value in settings.items():
+            if not known_key(base, key):
+                raise ConfigError(
+                    f"--set {key}: not a config key of the campaign ('slamtrials config dump' lists them)"
+                )
+            set_key(campaign, key, value)
+        return StudyConfig.from_dict({**self.model_dump(mode="json"), "campaign": campaign}, source="--set")
 
     @classmethod
     def from_dict(cls, data: Any, *, source: str = "study config") -> StudyConfig:

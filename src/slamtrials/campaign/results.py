@@ -32,6 +32,10 @@ class RunDetails:
     slam_cpu_s, slam_peak_mib, run_cpu_s, run_peak_mib, update_ms_median, update_ms_p90:
         What the run cost (:class:`~slamtrials.cost.RunCost`: CPU s, MiB, ms per update; not
         reproducible); None where not measured and for runs stored by earlier versions.
+    final_coverage, time_to_90_s, distance_to_90_m, time_to_99_s, distance_to_99_m:
+        How fast the run explored (:class:`~slamtrials.trial.exploration.ExplorationMeasures`: coverage
+        0..1, simulated s and true path m to 90 % and 99 % coverage, None where not reached); all None for
+        a record that no trial made and for runs stored by earlier versions.
     """
 
     frames: int
@@ -49,6 +53,11 @@ class RunDetails:
     run_peak_mib: float | None = None
     update_ms_median: float | None = None
     update_ms_p90: float | None = None
+    final_coverage: float | None = None
+    time_to_90_s: float | None = None
+    distance_to_90_m: float | None = None
+    time_to_99_s: float | None = None
+    distance_to_99_m: float | None = None
 
 
 @dataclass(frozen=True)

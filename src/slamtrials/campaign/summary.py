@@ -15,6 +15,11 @@ between-run variance, :func:`slamtrials.metric.metric_noise_share`, empty for ru
 standard errors), then the mean cost per run, over the runs that recorded one (:mod:`slamtrials.campaign.costsummary`:
 ``slam_cpu_s_mean, slam_peak_mib_mean, run_cpu_s_mean, run_peak_mib_mean, update_ms_median_mean,
 update_ms_p90_mean``: CPU s, MiB, ms per SLAM update; empty for runs of earlier versions; not reproducible).
+Then how fast the runs explored (:mod:`slamtrials.campaign.explorationsummary`): ``exploration_runs`` (the
+done runs that recorded it), ``coverage_final_mean`` (their mean final coverage, 0..1), ``reached_90``,
+``reached_99`` (how many reached 90 % and 99 % coverage), ``time_to_90_s_mean``, ``distance_to_90_m_mean``,
+``time_to_99_s_mean``, ``distance_to_99_m_mean`` (mean simulated s and true path m to it, over the runs
+that reached it); empty for runs of earlier versions.
 """
 
 from __future__ import annotations
@@ -29,6 +34,12 @@ from pathlib import Path
 
 from slamtrials.atomicfile import atomic_write_text
 from slamtrials.campaign.costsummary import COST_CSV_COLUMNS, WorldCost, cost_csv_cells, world_cost
+from slamtrials.campaign.explorationsummary import (
+    EXPLORATION_CSV_COLUMNS,
+    WorldExploration,
+    exploration_csv_cells,
+    world_exploration,
+)
 from slamtrials.campaign.store import CampaignStore, RunRow
 from slamtrials.metric.noiseshare import metric_noise_share
 from slamtrials.metric.stats import EnvironmentStats, environment_stats
@@ -59,6 +70,7 @@ CSV_COLUMNS = (
     "eps_t_metric_share",
     "eps_r_metric_share",
     *COST_CSV_COLUMNS,
+    *EXPLORATION_CSV_COLUMNS,
 )
 
 
@@ -93,6 +105,9 @@ class WorldSummary:
     cost:
         The mean cost per done run (:class:`~slamtrials.campaign.costsummary.WorldCost`); None when no run
         recorded one.
+    exploration:
+        How fast the done runs explored (:class:`~slamtrials.campaign.explorationsummary.WorldExploration`);
+        None when no run recorded it.
     """
 
     world: str
@@ -109,6 +124,7 @@ class WorldSummary:
     metric_share_r: float | None = None
     cap: int | None = None
     cost: WorldCost | None = None
+    exploration: WorldExploration | None = None
 
 
 def summarize_store(store: CampaignStore) -> list[WorldSummary]:
@@ -149,6 +165,7 @@ def summarize_store(store: CampaignStore) -> list[WorldSummary]:
                 share_r,
                 settings.max_runs if world.capped else None,
                 world_cost(json.loads(r.details) for r in done if r.details),
+                exploration=world_exploration(json.loads(r.details) for r in done if r.details),
             )
         )
     return rows
@@ -213,6 +230,7 @@ def write_summary_csv(folder: str | Path, rows: list[WorldSummary], confidence: 
                 _number(row.metric_share_t),
                 _number(row.metric_share_r),
                 *cost_csv_cells(row.cost),
+                *exploration_csv_cells(row.exploration),
             ]
         )
     return atomic_write_text(Path(folder) / SUMMARY_FILE, text.getvalue())

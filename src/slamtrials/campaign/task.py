@@ -37,6 +37,7 @@ from slamtrials.cost import RunCost
 from slamtrials.errors import SlamtrialsError
 from slamtrials.record import RunRecord
 from slamtrials.trial import TrialConfig, TrialSummary
+from slamtrials.trial.exploration import ExplorationMeasures
 from slamtrials.worlds import World
 
 __all__ = ["RunTask", "TrialFn", "run_one", "write_scored_run", "worker_name", "outcome", "failure"]
@@ -98,6 +99,7 @@ def outcome(task_world: str, index: int, record: RunRecord, score: RunScore, sta
     """What the driver stores for a done run."""
     trial = TrialSummary.of(record)
     cost = RunCost.of(record.metadata)
+    exploration = ExplorationMeasures.of(record.metadata)
     relation_set = score.relation_set
     return RunDone(
         world=task_world,
@@ -122,6 +124,7 @@ def outcome(task_world: str, index: int, record: RunRecord, score: RunScore, sta
             se_t=score.run.se_t,
             se_r=score.run.se_r,
             **(cost.figures() if cost is not None else {}),
+            **(exploration.figures() if exploration is not None else {}),
         ),
     )
 

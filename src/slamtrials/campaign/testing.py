@@ -26,6 +26,7 @@ from slamtrials.cost import COST_KEY, RunCost
 from slamtrials.geometry import compose
 from slamtrials.record import LaserGeometry, OccupancyGrid, RunRecord
 from slamtrials.trial import TrialSummary
+from slamtrials.trial.exploration import EXPLORATION_KEY, ExplorationMeasures
 
 __all__ = ["FakeTrial"]
 
@@ -49,6 +50,9 @@ class FakeTrial:
     cost:
         A cost every run records (:class:`~slamtrials.cost.RunCost`), for tests of how costs are kept and
         reported; None: no cost, as runs of earlier versions.
+    exploration:
+        Exploration measures every run records (:class:`~slamtrials.trial.exploration.ExplorationMeasures`),
+        for tests of how they are kept and reported; None: none, as runs of earlier versions.
     """
 
     mean_t: float = 0.3
@@ -58,6 +62,7 @@ class FakeTrial:
     sleep: float = 0.0
     map_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
     cost: RunCost | None = None
+    exploration: ExplorationMeasures | None = None
 
     def errors(self, seed: int) -> tuple[float, float]:
         """The ``(e_t, e_r)`` (m, rad) that the run with ``seed`` has."""
@@ -108,4 +113,6 @@ class FakeTrial:
         }
         if self.cost is not None:
             record.metadata[COST_KEY] = self.cost.to_dict()
+        if self.exploration is not None:
+            record.metadata[EXPLORATION_KEY] = self.exploration.to_dict()
         return record

@@ -3,7 +3,7 @@
 Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/bench_programs.py [--log mit-csail] [--repeats 3]``.
 
 On a log of the Freiburg benchmark (``$SLAMTRIALS_SHARED/data/<log>``), in this process and interleaved
-repeat by repeat: the built-in ``gmapping`` (slam_gmapping's defaults), ``karto`` (slam_karto's) and
+repeat by repeat: the built-in ``gmapping`` (slam_gmapping's defaults), ``karto`` (slam_toolbox's defaults) and
 ``odometry``, and MRPT's
 ``icp-slam`` as an offline program (``docs/examples/mrpt/icp_slam.sh`` through
 :func:`slamtrials.external.run_program`: the log written as CARMEN, the program run, its trajectory read

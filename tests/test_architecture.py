@@ -33,6 +33,8 @@ ALLOWED = {
     "external": {"geometry", "record", "worlds", "slam", "io"},
     "campaign": {"geometry", "record", "worlds", "sim", "slam", "explore", "trial", "metric", "io", "external"},
     "report": {"geometry", "record", "worlds", "metric", "io", "campaign", "calibration"},
+    # a study: campaigns over a grid of settings (run through campaign), its page through report
+    "study": {"geometry", "record", "worlds", "sim", "slam", "explore", "trial", "metric", "io", "campaign", "report"},
 }
 #: Top-level modules that compose layers like the CLI does (no layer may import them).
 COMPOSERS = {"demo", "evaluation", "slamrun", "repeat", "cli", "__init__", "__main__"}

@@ -51,10 +51,11 @@ class _Lines:
 
 
 def _cells_table(status, title: str):
+    from rich.console import JustifyMethod
     from rich.table import Table
 
     table = Table(title=title)
-    for column, justify in (
+    columns: tuple[tuple[str, JustifyMethod], ...] = (
         ("cell", "left"),
         ("world", "left"),
         ("status", "left"),
@@ -65,7 +66,8 @@ def _cells_table(status, title: str):
         ("+-", "right"),
         ("SLAM CPU s", "right"),
         ("SLAM MiB", "right"),
-    ):
+    )
+    for column, justify in columns:
         table.add_column(column, justify=justify, overflow="fold", min_width=len(column) if column == "cell" else None)
     for cell in status.cells:
         if cell.campaign is None:

@@ -20,6 +20,8 @@ the run folders), draws the paper's figures with :mod:`slamtrials.report.campaig
 * termination reasons and explored fraction of the runs;
 * what the runs cost: CPU time and peak memory of the SLAM algorithm and of the whole run, and the time
   per SLAM update, per run and per world (:class:`slamtrials.cost.RunCost`; also in Table I);
+* how fast the runs explored: every run's coverage curve per world, the time and distance to 90 % and 99 %
+  coverage and how the runs ended (:mod:`slamtrials.report.exploration`);
 * every run (seed, status, errors, outlier marks), and the provenance: config, root seed, versions.
 
 A campaign that is still running, has failed or capped worlds, or no finished run yet still gives a page,
@@ -69,6 +71,7 @@ from slamtrials.report.compare import (
     comparison_notes,
     world_pair_traps,
 )
+from slamtrials.report.exploration import exploration_section
 from slamtrials.report.load import CampaignData, load_campaign
 from slamtrials.report.pairing import detect_pairing
 from slamtrials.report.tables import METRICS, NOISE_SHARE_LIMIT, OUTLIER_IQR, paper_table, share_percent
@@ -1120,6 +1123,7 @@ def build_report(
         _fig4(figs, data, done),
         _termination(figs, data, done),
         _cost(figs, data, done),
+        exploration_section(figs, data, done, _table_order(data, done)),
         _runs_table(data),
         _provenance(data),
     ]
@@ -1133,6 +1137,7 @@ def build_report(
         ("fig-4", "Fig. 4"),
         ("termination", "Termination"),
         ("cost", "Cost"),
+        ("exploration", "Exploration"),
         ("runs", "Runs"),
         ("provenance", "Provenance"),
     ]

@@ -10,7 +10,9 @@ on the same relations. Each replayed run becomes a complete run folder of the ne
 names as ``frames_from``, so a replay costs no copy of them), ``estimate.tum``, the new map,
 ``relations.npz`` (the source's set) and a ``run.json`` whose ``replay`` entry names the source run
 folder, the algorithm and its configuration, and whose ``cost`` is the replay's (the SLAM run over the
-recorded frames: :class:`~slamtrials.cost.RunCost`), not the source trial's.
+recorded frames: :class:`~slamtrials.cost.RunCost`), not the source trial's, and whose ``map_quality``
+is the new map's against the world's floor plan (:mod:`slamtrials.campaign.mapscore`; where the world no
+longer loads, none, and the ``replay`` entry says why).
 
 The new campaign's config is the source's with ``slam`` changed (:func:`replay_slam_settings`: the
 source's algorithm, preset and parameters, with the given overrides on top) and ``replay_of`` set to
@@ -42,14 +44,17 @@ from slamtrials.campaign.folder import (
     prepare_resume,
 )
 from slamtrials.campaign.loop import next_step
+from slamtrials.campaign.mapscore import add_map_quality
 from slamtrials.campaign.results import RunResult
 from slamtrials.campaign.runfiles import publish_run
 from slamtrials.campaign.score import run_relation_set, score_run
 from slamtrials.campaign.store import CampaignStore, WorldInfo
 from slamtrials.campaign.summary import summarize_store, write_summary_csv
 from slamtrials.campaign.task import failure, outcome, write_scored_run
+from slamtrials.campaign.worldset import load_world_cached
 from slamtrials.cost import COST_KEY, RunCost
 from slamtrials.errors import ConfigError, SlamtrialsError
+from slamtrials.metric.mapquality import MAP_QUALITY_KEY
 from slamtrials.record import RunRecord
 from slamtrials.slam.offline import run_over_recording
 from slamtrials.slam.program import ProgramSpec
@@ -166,6 +171,9 @@ class ReplayTask:
         The relation sampling (the source campaign's).
     extra:
         Facts added to ``run.json`` under ``campaign``.
+    ref:
+        What loads the run's world (as the source campaign recorded it), for scoring the new map; None:
+        the map is not scored.
     """
 
     campaign: str
@@ -176,6 +184,7 @@ class ReplayTask:
     slam: SlamSettings
     metric: MetricSettings
     extra: dict[str, Any] = field(default_factory=dict)
+    ref: str | None = None
 
 
 def replay_slam(record: RunRecord, slam: SlamSettings, seed: int) -> RunRecord:
@@ -229,6 +238,18 @@ def _with_cost(metadata: dict[str, Any], cost: RunCost | None) -> dict[str, Any]
     return copy
 
 
+def _score_replayed_map(record: RunRecord, ref: str | None) -> str | None:
+    """Score the replayed map against its world (run.json's ``map_quality``); the reason it was not, or None."""
+    record.metadata.pop(MAP_QUALITY_KEY, None)  # the source run's was of another map
+    if ref is None:
+        return "not scored: the source campaign does not say which world the run was in"
+    try:
+        add_map_quality(record, load_world_cached(ref))
+    except SlamtrialsError as exc:
+        return f"not scored: the world {ref!r} does not load here ({exc})"
+    return None
+
+
 def replay_one(task: ReplayTask) -> RunResult:
     """Re-evaluate one recorded run (see the module docstring); return what the driver records."""
     from slamtrials.io.runfolder import read_run
@@ -241,6 +262,7 @@ def replay_one(task: ReplayTask) -> RunResult:
         score = score_run(record, task.seed, task.metric, relation_set)
     except SlamtrialsError as exc:
         return failure(task.world, task.index, exc)
+    unscored = _score_replayed_map(record, task.ref)
     record.metadata["replay"] = {
         "source_run": task.source,
         "algorithm": task.slam.algorithm,
@@ -249,6 +271,7 @@ def replay_one(task: ReplayTask) -> RunResult:
         "program": task.slam.program.model_dump(mode="json") if task.slam.program else None,
         "wall_time_s": time.perf_counter() - started,
         "note": REPLAY_NOTE,
+        **({"map_quality": unscored} if unscored else {}),
     }
     record.metadata["campaign"] = {
         "world": task.world,
@@ -303,6 +326,7 @@ class ReplayPlanner:
             self.config.slam,
             self.config.metric,
             extra={"root_seed": self.config.seed, "replay_of": str(self.source)},
+            ref=world.ref,
         )
         return replay_one, task, seed
 

@@ -36,6 +36,9 @@ class RunDetails:
         How fast the run explored (:class:`~slamtrials.trial.exploration.ExplorationMeasures`: coverage
         0..1, simulated s and true path m to 90 % and 99 % coverage, None where not reached); all None for
         a record that no trial made and for runs stored by earlier versions.
+    occupied_precision_1, occupied_recall_1, occupied_precision_2, occupied_recall_2, free_iou, ghost_free_m2:
+        The final map against the floor plan (:class:`~slamtrials.metric.mapquality.MapQuality`: shares
+        0..1, m^2); None for a run without a map and for runs stored by earlier versions.
     """
 
     frames: int
@@ -58,6 +61,12 @@ class RunDetails:
     distance_to_90_m: float | None = None
     time_to_99_s: float | None = None
     distance_to_99_m: float | None = None
+    occupied_precision_1: float | None = None
+    occupied_recall_1: float | None = None
+    occupied_precision_2: float | None = None
+    occupied_recall_2: float | None = None
+    free_iou: float | None = None
+    ghost_free_m2: float | None = None
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,10 @@ cap; empty otherwise); empty cells where a value is undefined; ``terminations`` 
 between-run variance, :func:`slamtrials.metric.metric_noise_share`, empty for runs stored without
 standard errors), then the mean cost per run, over the runs that recorded one (:mod:`slamtrials.campaign.costsummary`:
 ``slam_cpu_s_mean, slam_peak_mib_mean, run_cpu_s_mean, run_peak_mib_mean, update_ms_median_mean,
-update_ms_p90_mean``: CPU s, MiB, ms per SLAM update; empty for runs of earlier versions; not reproducible).
+update_ms_p90_mean``: CPU s, MiB, ms per SLAM update; empty for runs of earlier versions; not reproducible),
+then the mean map quality per run, over the runs that recorded one (:mod:`slamtrials.campaign.mapsummary`:
+``occupied_precision_1_mean, occupied_recall_1_mean, occupied_precision_2_mean, occupied_recall_2_mean,
+free_iou_mean, ghost_free_m2_mean``: shares 0..1, m^2; empty for runs without a map and runs of earlier versions).
 Then how fast the runs explored (:mod:`slamtrials.campaign.explorationsummary`): ``exploration_runs`` (the
 done runs that recorded it), ``coverage_final_mean`` (their mean final coverage, 0..1), ``reached_90``,
 ``reached_99`` (how many reached 90 % and 99 % coverage), ``time_to_90_s_mean``, ``distance_to_90_m_mean``,
@@ -39,6 +42,12 @@ from slamtrials.campaign.explorationsummary import (
     WorldExploration,
     exploration_csv_cells,
     world_exploration,
+)
+from slamtrials.campaign.mapsummary import (
+    MAP_QUALITY_CSV_COLUMNS,
+    WorldMapQuality,
+    map_quality_csv_cells,
+    world_map_quality,
 )
 from slamtrials.campaign.store import CampaignStore, RunRow
 from slamtrials.metric.noiseshare import metric_noise_share
@@ -70,6 +79,7 @@ CSV_COLUMNS = (
     "eps_t_metric_share",
     "eps_r_metric_share",
     *COST_CSV_COLUMNS,
+    *MAP_QUALITY_CSV_COLUMNS,
     *EXPLORATION_CSV_COLUMNS,
 )
 
@@ -108,6 +118,9 @@ class WorldSummary:
     exploration:
         How fast the done runs explored (:class:`~slamtrials.campaign.explorationsummary.WorldExploration`);
         None when no run recorded it.
+    map_quality:
+        The mean map quality per done run (:class:`~slamtrials.campaign.mapsummary.WorldMapQuality`); None
+        when no run recorded one.
     """
 
     world: str
@@ -124,6 +137,7 @@ class WorldSummary:
     metric_share_r: float | None = None
     cap: int | None = None
     cost: WorldCost | None = None
+    map_quality: WorldMapQuality | None = None
     exploration: WorldExploration | None = None
 
 
@@ -165,6 +179,7 @@ def summarize_store(store: CampaignStore) -> list[WorldSummary]:
                 share_r,
                 settings.max_runs if world.capped else None,
                 world_cost(json.loads(r.details) for r in done if r.details),
+                map_quality=world_map_quality(json.loads(r.details) for r in done if r.details),
                 exploration=world_exploration(json.loads(r.details) for r in done if r.details),
             )
         )
@@ -230,6 +245,7 @@ def write_summary_csv(folder: str | Path, rows: list[WorldSummary], confidence: 
                 _number(row.metric_share_t),
                 _number(row.metric_share_r),
                 *cost_csv_cells(row.cost),
+                *map_quality_csv_cells(row.map_quality),
                 *exploration_csv_cells(row.exploration),
             ]
         )

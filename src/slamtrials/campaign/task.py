@@ -9,8 +9,10 @@ atomically (:func:`slamtrials.campaign.runfiles.publish_run`):
 ``relations.npz`` (the run's relation set). ``run.json`` also holds, under ``campaign``, the world, run
 index, seed, ``eps_t``, ``eps_r``, their standard errors, the relation count, the scores of the online
 estimate and the odometry on the same relations, and the metric settings, besides the trial's own
-metadata (resolved trial config, termination reason, timings) and its ``cost``
-(:class:`~slamtrials.cost.RunCost`, which the catalog's ``details`` keep too).
+metadata (resolved trial config, termination reason, timings), its ``cost``
+(:class:`~slamtrials.cost.RunCost`, which the catalog's ``details`` keep too) and its ``map_quality``
+(the final map against the floor plan, :func:`slamtrials.campaign.mapscore.add_map_quality`; the
+catalog's ``details`` keep its figures).
 
 It returns a :class:`~slamtrials.campaign.results.RunDone` that the driver stores. Errors that are
 properties of the run (a :class:`~slamtrials.errors.SlamtrialsError`, e.g. a start pose in a wall) come
@@ -29,12 +31,14 @@ from pathlib import Path
 from typing import Any
 
 from slamtrials.campaign.config import MetricSettings
+from slamtrials.campaign.mapscore import add_map_quality
 from slamtrials.campaign.results import RunDetails, RunDone, RunFailed, RunResult
 from slamtrials.campaign.runfiles import publish_run, relative_run_folder
 from slamtrials.campaign.score import RunScore, score_run
 from slamtrials.campaign.worldset import load_world_cached
 from slamtrials.cost import RunCost
 from slamtrials.errors import SlamtrialsError
+from slamtrials.metric.mapquality import MapQuality
 from slamtrials.record import RunRecord
 from slamtrials.trial import TrialConfig, TrialSummary
 from slamtrials.trial.exploration import ExplorationMeasures
@@ -100,6 +104,7 @@ def outcome(task_world: str, index: int, record: RunRecord, score: RunScore, sta
     trial = TrialSummary.of(record)
     cost = RunCost.of(record.metadata)
     exploration = ExplorationMeasures.of(record.metadata)
+    quality = MapQuality.of(record.metadata)
     relation_set = score.relation_set
     return RunDone(
         world=task_world,
@@ -125,6 +130,7 @@ def outcome(task_world: str, index: int, record: RunRecord, score: RunScore, sta
             se_r=score.run.se_r,
             **(cost.figures() if cost is not None else {}),
             **(exploration.figures() if exploration is not None else {}),
+            **(quality.figures() if quality is not None else {}),
         ),
     )
 
@@ -144,6 +150,7 @@ def run_one(task: RunTask) -> RunResult:
         trial_fn = task.trial_fn or run_trial
         record = trial_fn(world, task.trial, task.seed)
         score = score_run(record, task.seed, task.metric)
+        add_map_quality(record, world)
     except SlamtrialsError as exc:
         return failure(task.world, task.index, exc)
     record.metadata["campaign"] = {

@@ -45,10 +45,12 @@ def trial(
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from slamtrials.campaign.config import MetricSettings
+    from slamtrials.campaign.mapscore import add_map_quality
     from slamtrials.campaign.profilefile import inline_profile_file
     from slamtrials.campaign.score import score_run
     from slamtrials.campaign.task import write_scored_run
     from slamtrials.cli.costtext import run_cost_text
+    from slamtrials.cli.mapqualitytext import map_quality_text
     from slamtrials.cost import RunCost
     from slamtrials.io.runfolder import RunFolder
     from slamtrials.io.yamlfile import read_yaml_mapping
@@ -87,6 +89,7 @@ def trial(
     metric = MetricSettings()
     score = score_run(record, seed, metric)
     record.metadata["evaluation"] = {**score.to_dict(), "metric": metric.model_dump(mode="json")}
+    quality = add_map_quality(record, the_world)
     write_scored_run(Path(out), record, score)
     save_run_figure(the_world, record, RunFolder(out).picture, title=f"{the_world.name}, seed {seed}")
     info = TrialSummary.of(record)
@@ -99,6 +102,7 @@ def trial(
         highlight=False,
     )
     console.print(run_cost_text(RunCost.of(record.metadata)), soft_wrap=True, highlight=False)
+    console.print(map_quality_text(quality), soft_wrap=True, highlight=False)
     odometry = score.odometry
     console.print(
         f"error over {len(score.relation_set)} relations (relations.npz): translational {score.eps_t:.4f} m "

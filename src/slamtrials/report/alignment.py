@@ -4,10 +4,7 @@ A run's ground truth is in the world frame; its SLAM estimate and final map are 
 SLAM anchors at its first pose. :func:`align_truth` finds the rigid motion (rotation and translation, no
 scale) ``map_from_world`` that puts the true positions closest to the estimated ones in the least-squares
 sense, ``argmin sum_k |R p_k + t - q_k|^2`` over the poses ``k`` where both are known, in closed form
-(the 2-D case of Kabsch / Umeyama without scale):
-
-    a_k = p_k - mean(p),  b_k = q_k - mean(q)
-    theta = atan2(sum(a_x b_y - a_y b_x), sum(a_x b_x + a_y b_y)),  t = mean(q) - R(theta) mean(p)
+(the 2-D case of Kabsch / Umeyama without scale: :func:`slamtrials.metric.rigidfit.fit_rigid_2d`).
 
 When the truth does not move (no direction to fit), it falls back to the first pose:
 ``map_from_world = estimate[0] (+) (-)truth[0]``. No random draws: the same run gives the same fit.
@@ -15,7 +12,6 @@ When the truth does not move (no direction to fit), it falls back to the first p
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Literal
 
@@ -23,6 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from slamtrials.geometry import as_poses, compose, inverse
+from slamtrials.metric.rigidfit import fit_rigid_2d
 
 __all__ = ["TruthAlignment", "fit_rigid_2d", "align_truth", "LEAST_SQUARES", "FIRST_POSE"]
 
@@ -59,37 +56,6 @@ class TruthAlignment:
     rms: float
     max_distance: float
     method: Method
-
-
-def fit_rigid_2d(source: ArrayLike, target: ArrayLike) -> NDArray[np.float64] | None:
-    """The rigid motion ``(x, y, theta)`` minimizing ``sum |R source_k + t - target_k|^2``.
-
-    Parameters
-    ----------
-    source, target:
-        ``[N, 2]`` corresponding points (m), finite.
-
-    Returns
-    -------
-    ``[3]`` the motion as a pose, or None when ``source`` has no spread (all points equal, or N = 0).
-    """
-    p = np.asarray(source, dtype=np.float64)
-    q = np.asarray(target, dtype=np.float64)
-    if p.shape != q.shape or p.ndim != 2 or p.shape[1] != 2:
-        raise ValueError(f"source {p.shape} and target {q.shape} must both be [N, 2]")
-    if len(p) == 0:
-        return None
-    p_mean, q_mean = p.mean(axis=0), q.mean(axis=0)
-    a, b = p - p_mean, q - q_mean
-    if float(np.sum(a * a)) == 0.0:
-        return None
-    s_cos = float(np.sum(a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]))
-    s_sin = float(np.sum(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]))
-    theta = math.atan2(s_sin, s_cos)
-    c, s = math.cos(theta), math.sin(theta)
-    tx = float(q_mean[0] - (c * p_mean[0] - s * p_mean[1]))
-    ty = float(q_mean[1] - (s * p_mean[0] + c * p_mean[1]))
-    return np.array([tx, ty, theta])
 
 
 def align_truth(truth: ArrayLike, estimate: ArrayLike) -> TruthAlignment:

@@ -29,8 +29,10 @@ outlier_r      among the world's done runs); False unless done
 frames, ...    the entries of the catalog's ``details`` (frames, distance_m, observed_fraction,
                slam_updates, relation_std_t, relation_std_r, relations_capped, and se_t, se_r: the standard
                errors of eps_t, eps_r, and the run's cost: slam_cpu_s, slam_peak_mib, run_cpu_s,
-               run_peak_mib, update_ms_median, update_ms_p90, :class:`slamtrials.cost.RunCost`, from this
-               version on)
+               run_peak_mib, update_ms_median, update_ms_p90, :class:`slamtrials.cost.RunCost`, and the
+               map's quality: occupied_precision_1, occupied_recall_1, occupied_precision_2,
+               occupied_recall_2, free_iou, ghost_free_m2, :class:`slamtrials.metric.mapquality.MapQuality`,
+               from this version on)
 ============== ======================================================================================
 
 ``worlds``: one row per world in campaign order: the catalog's ``worlds`` columns (``name`` as ``world``,
@@ -47,7 +49,10 @@ mean ``se^2`` over the variance of the run errors), NaN when a run has no standa
 quantile (``runs.confidence``, ``runs.distribution``), as ``slamtrials campaign status`` prints them. Last, the mean
 cost per done run (:mod:`slamtrials.campaign.costsummary`, as summary.csv): ``slam_cpu_s_mean``, ``slam_peak_mib_mean``,
 ``run_cpu_s_mean``, ``run_peak_mib_mean``, ``update_ms_median_mean``, ``update_ms_p90_mean``, NaN where no run
-recorded that figure (runs of earlier versions).
+recorded that figure (runs of earlier versions), and the mean map quality per done run
+(:mod:`slamtrials.campaign.mapsummary`): ``occupied_precision_1_mean``, ``occupied_recall_1_mean``,
+``occupied_precision_2_mean``, ``occupied_recall_2_mean``, ``free_iou_mean``, ``ghost_free_m2_mean``, NaN
+where no run recorded it.
 
 :func:`export_table` writes either table as CSV or Parquet.
 """
@@ -66,9 +71,11 @@ import pandas as pd
 
 from slamtrials.atomicfile import atomic_write, atomic_write_text
 from slamtrials.campaign.costsummary import COST_CSV_COLUMNS
+from slamtrials.campaign.mapsummary import MAP_QUALITY_CSV_COLUMNS
 from slamtrials.campaign.store import DB_FILE, RUNS_DIR, STORE_FORMAT
 from slamtrials.cost import COST_FIGURES
 from slamtrials.errors import ConfigError, FormatError
+from slamtrials.metric.mapquality import MAP_QUALITY_FIGURES
 from slamtrials.metric.quantiles import Distribution
 from slamtrials.report.tables import METRICS, metric_shares, outlier_mask, world_summary
 
@@ -124,6 +131,7 @@ WORLD_COLUMNS = (
     "confidence",
     *(f"{m}_metric_share" for m in METRICS),
     *COST_CSV_COLUMNS,
+    *MAP_QUALITY_CSV_COLUMNS,
 )
 #: The tables :func:`export_table` writes.
 TABLES = ("runs", "worlds")
@@ -318,7 +326,8 @@ def _worlds_frame(rows: list[tuple], runs: pd.DataFrame, config: dict[str, Any])
     for metric in METRICS:
         shares = metric_shares(done, metric) if len(done) else pd.Series(dtype="float64")
         worlds[f"{metric}_metric_share"] = worlds["world"].map(shares).astype("float64")
-    for name, column in zip(COST_FIGURES, COST_CSV_COLUMNS):
+    means = (*zip(COST_FIGURES, COST_CSV_COLUMNS), *zip(MAP_QUALITY_FIGURES, MAP_QUALITY_CSV_COLUMNS))
+    for name, column in means:
         done_runs = runs[runs["status"] == "done"]
         if name in done_runs.columns:
             figures = pd.to_numeric(done_runs[name], errors="coerce").astype("float64")

@@ -18,6 +18,7 @@ from slamtrials.report.compare import (
     TOO_FEW,
     adjust_pvalues,
     compare_campaigns,
+    paired_reversal,
     reversal,
     sign_test,
     welch,
@@ -225,3 +226,22 @@ def test_worlds_come_in_campaign_a_s_order():
     b = _frame({"alpha_lab": [0.2, 0.4, 0.5], "mid_office": [0.1, 0.2, 0.3], "zeta_hall": [0.1, 0.3, 0.3]})
     comparison = compare_campaigns(a, b)
     assert list(comparison.for_metric("eps_t")["world"]) == ["zeta_hall", "alpha_lab", "mid_office"]
+
+
+def test_a_paired_comparisons_trap_is_the_same_run_on_both_sides() -> None:
+    # a replay: run k of B is run k of A's recording; single-run comparisons are the pairs (a_k, b_k), so
+    # the most misleading one is the run where B is worst against A, never two different runs
+    a_values = [0.30, 0.32, 0.31, 0.29, 0.40, 0.33]
+    b_values = [0.20, 0.22, 0.21, 0.19, 0.45, 0.23]  # B better on every run but run 4
+    a, b = _frame({"w": a_values}), _frame({"w": b_values})
+    row = compare_campaigns(a, b, paired_by="run").for_metric("eps_t").iloc[0]
+    assert row["test"] == "paired t"
+    assert row["trap_run_a"] == row["trap_run_b"] == 4
+    assert row["trap_value_a"] == 0.40 and row["trap_value_b"] == 0.45
+    assert row["trap_fraction"] == pytest.approx(1 / 6)
+    # unpaired, the trap may take any run of each side: here B's run 4 against A's best run 3
+    unpaired = compare_campaigns(a, b).for_metric("eps_t").iloc[0]
+    assert (unpaired["trap_run_a"], unpaired["trap_run_b"]) == (3, 4)
+    r = paired_reversal([0.2, 0.3, 0.5], [0.4, 0.35, 0.45])
+    assert (r.i_low, r.i_high, r.fraction) == (2, 2, pytest.approx(1 / 3))
+    assert r.reversed_by == pytest.approx(0.05)

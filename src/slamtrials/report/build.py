@@ -22,6 +22,9 @@ the run folders), draws the paper's figures with :mod:`slamtrials.report.campaig
   per SLAM update, per run and per world (:class:`slamtrials.cost.RunCost`; also in Table I);
 * how fast the runs explored: every run's coverage curve per world, the time and distance to 90 % and 99 %
   coverage and how the runs ended (:mod:`slamtrials.report.exploration`);
+* how well the final maps draw the floor plans: per world, the mean occupied-cell precision and recall
+  within 1 and 2 cells, free-space IoU and ghost area, with their definitions
+  (:mod:`slamtrials.report.map_quality`);
 * every run (seed, status, errors, outlier marks), and the provenance: config, root seed, versions.
 
 A campaign that is still running, has failed or capped worlds, or no finished run yet still gives a page,
@@ -73,6 +76,7 @@ from slamtrials.report.compare import (
 )
 from slamtrials.report.exploration import exploration_section
 from slamtrials.report.load import CampaignData, load_campaign
+from slamtrials.report.map_quality import map_quality_section
 from slamtrials.report.pairing import detect_pairing
 from slamtrials.report.tables import METRICS, NOISE_SHARE_LIMIT, OUTLIER_IQR, paper_table, share_percent
 
@@ -1124,6 +1128,7 @@ def build_report(
         _termination(figs, data, done),
         _cost(figs, data, done),
         exploration_section(figs, data, done, _table_order(data, done)),
+        map_quality_section(done, _table_order(data, done)),
         _runs_table(data),
         _provenance(data),
     ]
@@ -1138,6 +1143,7 @@ def build_report(
         ("termination", "Termination"),
         ("cost", "Cost"),
         ("exploration", "Exploration"),
+        ("map-quality", "Map quality"),
         ("runs", "Runs"),
         ("provenance", "Provenance"),
     ]
@@ -1216,11 +1222,21 @@ def trap_sentences(comparison: Comparison, metric: str = "eps_t") -> list[str]:
         if diff == 0 or not np.sign(r["trap_difference"]) == -np.sign(diff):
             continue
         better, worse = (name_b, name_a) if diff < 0 else (name_a, name_b)
+        if comparison.paired:  # the same run replayed by both sides
+            single = (
+                f"but run #{r['trap_run_a']} alone ({name_a}: {r['trap_value_a']:.3f} {unit}, "
+                f"{name_b}: {r['trap_value_b']:.3f} {unit}) gives the opposite verdict; "
+                f"{r['trap_fraction']:.0%} of the runs do."
+            )
+        else:
+            single = (
+                f"but its run alone against one run of {worse} ({name_a} #{r['trap_run_a']}: {r['trap_value_a']:.3f} "
+                f"{unit}, {name_b} #{r['trap_run_b']}: {r['trap_value_b']:.3f} {unit}) gives the opposite verdict; "
+                f"{r['trap_fraction']:.0%} of all single-run pairs do."
+            )
         out.append(
-            f"{r['world']}: {better} has the lower mean {SYMBOLS[metric]} (by {abs(diff):.3g} {unit}; verdict: {r['verdict']}), "
-            f"but its run alone against one run of {worse} ({name_a} #{r['trap_run_a']}: {r['trap_value_a']:.3f} {unit}, "
-            f"{name_b} #{r['trap_run_b']}: {r['trap_value_b']:.3f} {unit}) gives the opposite verdict; "
-            f"{r['trap_fraction']:.0%} of all single-run pairs do."
+            f"{r['world']}: {better} has the lower mean {SYMBOLS[metric]} (by {abs(diff):.3g} {unit}; verdict: "
+            f"{r['verdict']}), {single}"
         )
     return out
 

@@ -557,9 +557,9 @@ def draw_comparison(ax, comparison: Comparison, metric: str = "eps_t") -> None:
 
     Worlds run top to bottom in the table's order. Each verdict is one errorbar (gid ``"verdict:<v>"``):
     B better green, A better red, no significant difference grey. The Fig. 6 trap: a hollow black diamond
-    (gid ``"trap"``) at the difference of the most misleading single-run pair, drawn where that pair
-    contradicts the means (it lies on the other side of 0), with the fraction of contradicting run pairs
-    written at the right edge.
+    (gid ``"trap"``) at the difference of the most misleading single-run pair (for a paired comparison,
+    the same run of both campaigns), drawn where that pair contradicts the means (it lies on the other
+    side of 0), with the fraction of contradicting pairs written at the right edge.
     """
     rows = comparison.for_metric(metric)
     if rows.empty:
@@ -596,7 +596,9 @@ def draw_comparison(ax, comparison: Comparison, metric: str = "eps_t") -> None:
         mfc="none",
         mec="black",
         mew=1.2,
-        label="most misleading single-run pair",
+        label="most misleading run (paired: the same run on both sides)"
+        if comparison.paired
+        else "most misleading single-run pair",
         gid="trap",
     )
     for yi, fraction in zip(y, rows["trap_fraction"].to_numpy(dtype=float)):
@@ -611,8 +613,9 @@ def draw_comparison(ax, comparison: Comparison, metric: str = "eps_t") -> None:
     ax.set_title(
         f"{name_b} vs {name_a}, {comparison.pairing}"
         + (f": {overall.verdict}" if overall else "")
-        + f"\n({level.label} intervals, {comparison.correction} correction;\nright: share of run pairs"
-        " that reverse the means)",
+        + f"\n({level.label} intervals, {comparison.correction} correction;\nright: share of "
+        + ("runs" if comparison.paired else "run pairs")
+        + " that reverse the means)",
         fontsize=8,
     )
     ax.legend(fontsize=7, loc="best")

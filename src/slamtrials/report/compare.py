@@ -73,6 +73,7 @@ __all__ = [
     "compare_campaigns",
     "comparison_notes",
     "world_pair_traps",
+    "paired_reversal",
     "sign_test",
 ]
 
@@ -223,6 +224,21 @@ def reversal(low: ArrayLike, high: ArrayLike) -> Reversal:
         return Reversal(math.nan, i, j, float(x[i] - y[j]))
     below = np.searchsorted(np.sort(y, kind="stable"), x, side="left")  # for each x_i: how many y_j < x_i
     return Reversal(float(below.sum()) / (len(x) * len(y)), i, j, float(x[i] - y[j]))
+
+
+def paired_reversal(low: ArrayLike, high: ArrayLike) -> Reversal:
+    """The Fig. 6 trap of a paired comparison: ``low [n]`` and ``high [n]`` are the same runs (run ``k``
+    of each side replayed from the same recording), ``low`` of lower mean. A single-run comparison is one
+    such pair, so ``fraction`` is the share of runs ``k`` with ``low_k > high_k`` and the most misleading
+    pair is the run where ``low_k - high_k`` is largest (``i_low == i_high``)."""
+    x = np.asarray(low, dtype=np.float64).reshape(-1)
+    y = np.asarray(high, dtype=np.float64).reshape(-1)
+    if len(x) == 0 or len(x) != len(y):
+        raise ValueError(f"need the same runs on both sides, got {len(x)} and {len(y)}")
+    k = int(np.argmax(x - y))
+    if x.mean() == y.mean():
+        return Reversal(math.nan, k, k, float(x[k] - y[k]))
+    return Reversal(float(np.count_nonzero(x > y)) / len(x), k, k, float(x[k] - y[k]))
 
 
 @dataclass(frozen=True)
@@ -401,11 +417,13 @@ def _world_row(
             "ci_high": r.ci_high,
         }
     )
+    # paired: a single-run comparison is run k of A against run k of B; unpaired: any run against any
+    trap = paired_reversal if paired else reversal
     if r.difference > 0:  # A has the lower mean: a B run below an A run contradicts it
-        rev = reversal(a, b)
+        rev = trap(a, b)
         ia, ib = rev.i_low, rev.i_high
     else:
-        rev = reversal(b, a)
+        rev = trap(b, a)
         ib, ia = rev.i_low, rev.i_high
     row.update(
         {

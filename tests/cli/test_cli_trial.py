@@ -52,6 +52,7 @@ def test_trial_writes_a_complete_run_folder(tmp_path):
     assert doc["trial"]["termination_reason"] in ("map_converged", "no_frontiers")
     assert doc["trial"]["mapped_fraction"] > 0.9
     assert f"{doc['trial']['termination_reason']} after" in result.output
+    assert f"exploration: 90 % after {doc['exploration']['time_to_90_s']:.0f} s" in result.output
     record = read_run(out)
     assert record.estimate is not None and record.estimate.shape == record.truth.shape
     # a stored run is not replaced without --overwrite, and nothing in it changes

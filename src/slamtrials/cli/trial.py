@@ -50,6 +50,7 @@ def trial(
     from slamtrials.campaign.score import score_run
     from slamtrials.campaign.task import write_scored_run
     from slamtrials.cli.costtext import run_cost_text
+    from slamtrials.cli.explorationtext import exploration_text
     from slamtrials.cli.mapqualitytext import map_quality_text
     from slamtrials.cost import RunCost
     from slamtrials.io.runfolder import RunFolder
@@ -57,6 +58,7 @@ def trial(
     from slamtrials.report.runplot import save_run_figure
     from slamtrials.sim.overrides import warn_overrides
     from slamtrials.trial import TrialConfig, TrialSummary, run_trial
+    from slamtrials.trial.exploration import ExplorationMeasures
     from slamtrials.worlds import load_world
 
     if seed < 0:
@@ -102,6 +104,7 @@ def trial(
         highlight=False,
     )
     console.print(run_cost_text(RunCost.of(record.metadata)), soft_wrap=True, highlight=False)
+    console.print(exploration_text(ExplorationMeasures.of(record.metadata)), soft_wrap=True, highlight=False)
     console.print(map_quality_text(quality), soft_wrap=True, highlight=False)
     odometry = score.odometry
     console.print(

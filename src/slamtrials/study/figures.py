@@ -101,6 +101,7 @@ def draw_cost_against_error(ax, rows: pd.DataFrame, cost: str, metric: str = "ep
     )
     for xi, yi, name in zip(x, here[f"{metric}_mean"], here["cell"], strict=True):
         ax.annotate(str(name), (xi, yi), textcoords="offset points", xytext=(4, 4), fontsize=7)
+    ax.margins(x=0.25)  # room for the labels
     ax.set_xlabel(f"{SYMBOLS[cost]} per run ({UNITS[cost]})")
     ax.set_ylabel(f"mean {SYMBOLS[metric]} ({UNITS[metric]})")
     ax.grid(True, alpha=0.3)

@@ -90,7 +90,7 @@ def main() -> None:
 
     nodes, edges = karto.graph.nodes, karto.graph.edges
     seen: set[int] = set()
-    scans = sum(deep_size(n.ranges, seen) + deep_size(n.lx, seen) + deep_size(n.ly, seen) for n in nodes)
+    scans = sum(deep_size(n.ranges, seen) + deep_size(n.readings, seen) + deep_size(n.within, seen) for n in nodes)
     node_rest = sum(deep_size(n, seen) for n in nodes) + deep_size(nodes, seen)
     edge_bytes = deep_size(edges, seen) + deep_size(karto.graph, seen)
     matchers = {name: deep_size(getattr(karto, name), seen) for name in ("sequential", "loop_matcher")}

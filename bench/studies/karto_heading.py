@@ -40,7 +40,7 @@ from slamtrials.metric.relerrors import evaluate_relations  # noqa: E402
 from slamtrials.record import Frame  # noqa: E402
 from slamtrials.slam import resolve_config  # noqa: E402
 from slamtrials.slam.karto.algorithm import Karto  # noqa: E402
-from slamtrials.slam.karto.scanmatch import points_in_map  # noqa: E402
+from slamtrials.slam.karto.scanmatch import local_points, scan_points  # noqa: E402
 from slamtrials.slamrun import load_recording  # noqa: E402
 
 
@@ -107,11 +107,14 @@ def main() -> int:
                 buffer.insert(0, j)
             base = []
             for j in buffer:
-                base.append(points_in_map(compose1(ref[nodes[j].frame], slam.mount), nodes[j].lx, nodes[j].ly))
+                at = compose1(ref[nodes[j].frame], slam.mount)
+                base.append(scan_points(at, nodes[j].readings, slam.laser.angle_min, slam.laser.angle_increment))
             a, b = nodes[i - 1].frame, nodes[i].frame
             guess = compose1(ref[a], ominus1(record.odometry[a], record.odometry[b]))
+            laser_guess = compose1(guess, slam.mount)
+            own = scan_points(laser_guess, nodes[i].readings, slam.laser.angle_min, slam.laser.angle_increment)
             result = slam.sequential.match(
-                compose1(guess, slam.mount), nodes[i].lx, nodes[i].ly, base, penalize=True, refine=True
+                laser_guess, *local_points(laser_guess, *own), base, penalize=True, refine=True
             )
             error = ominus1(compose1(ref[b], slam.mount), result.pose)
             heading.append(wrap_angle1(error[2]))

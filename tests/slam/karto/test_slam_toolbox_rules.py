@@ -79,13 +79,14 @@ def test_the_matcher_sees_every_reading_and_the_barycentre_only_those_within_the
     karto.process(frame)
     node = karto.graph.nodes[0]
     ranges = np.asarray(frame.ranges, dtype=np.float64)
-    has_point = ~np.isnan(node.lx)
+    x, y, barycentre = karto._world_points(0)  # map-frame points at the node's laser pose (here the origin)
     far = (ranges > 3.0) & (ranges < synthetic.laser.range_max)
     assert far.any() and (ranges <= 3.0).any()
-    np.testing.assert_array_equal(has_point, ranges < synthetic.laser.range_max)
+    np.testing.assert_array_equal(~np.isnan(x), ranges < synthetic.laser.range_max)
     near = ranges <= 3.0
-    assert np.hypot(*node.barycenter) <= 3.0
-    np.testing.assert_allclose(node.barycenter, [node.lx[near].mean(), node.ly[near].mean()], atol=1e-12)
+    np.testing.assert_array_equal(node.within, near)
+    assert np.hypot(*barycentre) <= 3.0
+    np.testing.assert_allclose(barycentre, [x[near].mean(), y[near].mean()], atol=1e-12)
 
 
 def test_the_response_is_divided_by_the_readings_not_the_points(synthetic):

@@ -43,7 +43,6 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from slamtrials import stablemath
 from slamtrials.errors import ConfigError
 from slamtrials.geometry import compose, compose1, inverse, ominus, ominus1, wrap_angle1
 from slamtrials.record import LaserGeometry, Reading, Trajectory
@@ -256,7 +255,6 @@ class Karto:
         self._gate_odometry = np.zeros(3)
         self._anchor: list[int] = []
         self._estimates: list[NDArray[np.float64]] = []
-        self._angles: NDArray[np.float64] | None = None
         # The optimizer's own copy of every node's base pose, its starting point. As slam_toolbox's
         # CeresSolver keeps one (AddNode stores the scan's corrected pose when the vertex is added, right
         # after sequential matching; Compute starts from it and overwrites it with its result), a pose
@@ -351,29 +349,20 @@ class Karto:
         pose: NDArray[np.float64],
         ranges: NDArray[np.float64],
     ) -> ScanNode:
-        if self._angles is None or self._angles.shape[0] != ranges.shape[0]:
-            self._angles = self.laser.beam_angles(ranges.shape[0])
         # The matcher's points are Karto's unfiltered point readings (LocalizedRangeScan::GetPointReadings()
         # with its default wantFiltered = false, as FindValidPoints and GridIndexLookup::ComputeOffsets call
         # it): every reading, also those beyond the range threshold. Only the barycentre is taken over the
-        # filtered ones, the readings within the range threshold (m_PointReadings).
+        # filtered ones, the readings within the range threshold (m_PointReadings). Points are computed
+        # from these where they are used (_world_points, _own_points), with Karto's arithmetic.
         has_point = np.isfinite(ranges) & (ranges > self.laser.range_min) & (ranges < self.laser.range_max)
-        r = np.where(has_point, ranges, np.nan)
-        lx, ly = r * stablemath.cos(self._angles), r * stablemath.sin(self._angles)
-        within = has_point & (ranges <= self.range_threshold)
-        count = int(within.sum())  # fsum: correctly rounded, the same on every machine
-        barycenter = np.array([math.fsum(lx[within]) / count, math.fsum(ly[within]) / count]) if count else None
         return ScanNode(
             frame=frame_index,
             t=t,
             odometry=odometry,
             pose=pose,
-            lx=lx,
-            ly=ly,
-            barycenter=barycenter,
             ranges=np.asarray(ranges, dtype=np.float32),
-            readings=r,
-            within=within,
+            readings=np.where(has_point, ranges, np.nan),
+            within=has_point & (ranges <= self.range_threshold),
         )
 
     def _is_node(self, t: float, odometry: NDArray[np.float64]) -> bool:

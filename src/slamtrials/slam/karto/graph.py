@@ -37,10 +37,6 @@ class ScanNode:
     pose:
         float64 ``[3]`` corrected base pose, map frame (changed by matching and optimisation: always by
         assigning a new array, never in place, so caches may key on the array itself).
-    lx, ly:
-        float64 ``[B]`` the scan's points in the laser frame (m), NaN where a beam has none.
-    barycenter:
-        float64 ``[2]`` mean of the points within the range threshold (laser frame), or None if none is.
     ranges:
         float32 ``[B]`` the readings (for the map).
     readings:
@@ -53,9 +49,6 @@ class ScanNode:
     t: float
     odometry: NDArray[np.float64]
     pose: NDArray[np.float64]
-    lx: NDArray[np.float64]
-    ly: NDArray[np.float64]
-    barycenter: NDArray[np.float64] | None
     ranges: NDArray[np.float32]
     readings: NDArray[np.float64]
     within: NDArray[np.bool_]

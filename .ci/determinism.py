@@ -156,10 +156,14 @@ def _environment() -> dict:
     import numpy as np
 
     features, dispatch = numpy_dispatch()
-    return {"numpy": np.__version__, "numba": numba.__version__,
-            "numpy_dispatch_in_use": [f for f in dispatch if features.get(f)],
-            "NPY_DISABLE_CPU_FEATURES": os.environ.get("NPY_DISABLE_CPU_FEATURES", ""),
-            "numba_cpu_name": numba.config.CPU_NAME or "host", "NUMBA_CACHE_DIR": os.environ.get("NUMBA_CACHE_DIR", "")}
+    return {
+        "numpy": np.__version__,
+        "numba": numba.__version__,
+        "numpy_dispatch_in_use": [f for f in dispatch if features.get(f)],
+        "NPY_DISABLE_CPU_FEATURES": os.environ.get("NPY_DISABLE_CPU_FEATURES", ""),
+        "numba_cpu_name": numba.config.CPU_NAME or "host",
+        "NUMBA_CACHE_DIR": os.environ.get("NUMBA_CACHE_DIR", ""),
+    }
 
 
 def numpy_dispatch() -> tuple[dict[str, bool], list[str]]:
@@ -215,8 +219,15 @@ def produce(out: Path) -> dict:
 
         full = load_recording(log)
         n = min(LOG_SCANS, len(full))
-        part = replace(full, t=full.t[:n], scans=full.scans[:n], odometry=full.odometry[:n], truth=full.truth[:n],
-                       stalled=full.stalled[:n], estimate=None)
+        part = replace(
+            full,
+            t=full.t[:n],
+            scans=full.scans[:n],
+            odometry=full.odometry[:n],
+            truth=full.truth[:n],
+            stalled=full.stalled[:n],
+            estimate=None,
+        )
         for algorithm in ("gmapping", "karto"):
             started = time.perf_counter()
             write_slam_outputs(run_slam(part, algorithm, seed=LOG_SEED, source=log.name), out / algorithm)
@@ -225,8 +236,12 @@ def produce(out: Path) -> dict:
     else:
         notes.append(f"no MIT CSAIL log at {log}: SLAM, calibrate and validate on a log not checked")
 
-    manifest = {"files": manifest_of(out), "notes": notes, "environment": _environment(),
-                "seconds": {k: round(v, 1) for k, v in timings.items()}}
+    manifest = {
+        "files": manifest_of(out),
+        "notes": notes,
+        "environment": _environment(),
+        "seconds": {k: round(v, 1) for k, v in timings.items()},
+    }
     (out / MANIFEST).write_text(json.dumps(manifest, indent=1) + "\n", encoding="utf-8")
     return manifest
 
@@ -243,13 +258,22 @@ def _calibrate_and_validate(full, log: Path, out: Path, timings: dict[str, float
     from slamtrials.validation.validate import ValidationSettings, validate
 
     n = min(CALIBRATION_SCANS, len(full))
-    part = replace(full, t=full.t[:n], scans=full.scans[:n], odometry=full.odometry[:n], truth=full.truth[:n],
-                   stalled=full.stalled[:n], estimate=None)
+    part = replace(
+        full,
+        t=full.t[:n],
+        scans=full.scans[:n],
+        odometry=full.odometry[:n],
+        truth=full.truth[:n],
+        stalled=full.stalled[:n],
+        estimate=None,
+    )
     started = time.perf_counter()
     reference = slam_reference(part, "gmapping", seed=LOG_SEED)
     fit = calibrate(part, reference, CalibrationSettings(bootstrap=CALIBRATION_BOOTSTRAP), seed=LOG_SEED)
-    doc = {"profile": fit.profile("determinism", "").model_dump(mode="json"),
-           "fitted": [[value.name, value.value, value.stderr] for value in fit.fitted]}
+    doc = {
+        "profile": fit.profile("determinism", "").model_dump(mode="json"),
+        "fitted": [[value.name, value.value, value.stderr] for value in fit.fitted],
+    }
     (out / "calibration").mkdir()
     (out / "calibration" / "profile.json").write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
     timings["calibration"] = time.perf_counter() - started
@@ -258,12 +282,16 @@ def _calibrate_and_validate(full, log: Path, out: Path, timings: dict[str, float
     every = read_relations(log.with_suffix(".relations"))
     inside = (every.t1 <= part.t[-1]) & (every.t2 <= part.t[-1])
     relations = replace(every, t1=every.t1[inside], t2=every.t2[inside], delta=every.delta[inside])
-    result = validate(part, relations, BUNDLED_PROFILES["realistic"],
-                      ValidationSettings(runs=VALIDATION_RUNS, reference_seed=LOG_SEED), log=log.name,
-                      relations_source=log.with_suffix(".relations").name)
+    result = validate(
+        part,
+        relations,
+        BUNDLED_PROFILES["realistic"],
+        ValidationSettings(runs=VALIDATION_RUNS, reference_seed=LOG_SEED),
+        log=log.name,
+        relations_source=log.with_suffix(".relations").name,
+    )
     (out / "validation").mkdir()
-    (out / "validation" / "validation.json").write_text(json.dumps(result.to_dict(), indent=1) + "\n",
-                                                         encoding="utf-8")
+    (out / "validation" / "validation.json").write_text(json.dumps(result.to_dict(), indent=1) + "\n", encoding="utf-8")
     timings["validation"] = time.perf_counter() - started
 
 
@@ -302,9 +330,12 @@ def _run_pass(label: str, out: Path, env: dict[str, str]) -> dict:
     manifest = json.loads((out / MANIFEST).read_text(encoding="utf-8"))
     parts = ", ".join(f"{k} {v:.0f} s" for k, v in manifest["seconds"].items())
     env_info = manifest["environment"]
-    print(f"determinism: pass '{label}': {len(manifest['files'])} files hashed in {time.perf_counter() - started:.0f} s "
-          f"({parts}); numpy dispatch in use: {' '.join(env_info['numpy_dispatch_in_use']) or 'baseline only'}; "
-          f"numba CPU: {env_info['numba_cpu_name']}", flush=True)
+    print(
+        f"determinism: pass '{label}': {len(manifest['files'])} files hashed in {time.perf_counter() - started:.0f} s "
+        f"({parts}); numpy dispatch in use: {' '.join(env_info['numpy_dispatch_in_use']) or 'baseline only'}; "
+        f"numba CPU: {env_info['numba_cpu_name']}",
+        flush=True,
+    )
     for note in manifest["notes"]:
         print(f"determinism: note: {note}", flush=True)
     return manifest
@@ -327,8 +358,11 @@ def check(work: Path, flip: str | None = None) -> int:
     for name in ("NPY_DISABLE_CPU_FEATURES", "NPY_ENABLE_CPU_FEATURES", "NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES"):
         normal_env.pop(name, None)
     baseline_env = baseline_environment(work / "numba-cache-generic")
-    print(f"determinism: second pass with NPY_DISABLE_CPU_FEATURES='{baseline_env.get('NPY_DISABLE_CPU_FEATURES', '')}' "
-          f"NUMBA_CPU_NAME=generic NUMBA_CACHE_DIR={baseline_env['NUMBA_CACHE_DIR']}", flush=True)
+    print(
+        f"determinism: second pass with NPY_DISABLE_CPU_FEATURES='{baseline_env.get('NPY_DISABLE_CPU_FEATURES', '')}' "
+        f"NUMBA_CPU_NAME=generic NUMBA_CACHE_DIR={baseline_env['NUMBA_CACHE_DIR']}",
+        flush=True,
+    )
     normal = _run_pass("as-is", work / "as-is", normal_env)
     baseline = _run_pass("baseline", work / "baseline", baseline_env)
     if flip is not None:
@@ -340,21 +374,28 @@ def check(work: Path, flip: str | None = None) -> int:
 
     problems = []
     if baseline["environment"]["numpy_dispatch_in_use"]:
-        problems.append(f"numpy still dispatches to {baseline['environment']['numpy_dispatch_in_use']} in the baseline pass")
+        problems.append(
+            f"numpy still dispatches to {baseline['environment']['numpy_dispatch_in_use']} in the baseline pass"
+        )
     if baseline["environment"]["numba_cpu_name"] != "generic":
         problems.append("numba did not compile for a generic CPU in the baseline pass")
     problems += compare(normal["files"], baseline["files"], "as-is", "baseline")
     bundled = bundled_catalog()
     catalog = {k.removeprefix("catalog/"): v for k, v in normal["files"].items() if k.startswith("catalog/")}
-    problems += [f"catalog/{line} (regenerated vs bundled in {bundled})"
-                 for line in compare(catalog, manifest_of(bundled), "regenerated", "bundled")]
+    problems += [
+        f"catalog/{line} (regenerated vs bundled in {bundled})"
+        for line in compare(catalog, manifest_of(bundled), "regenerated", "bundled")
+    ]
     if problems:
         for line in problems:
             print(f"determinism: FAIL {line}", flush=True)
         print(f"determinism: {len(problems)} problem(s); the outputs are in {work}", flush=True)
         return 1
-    print(f"determinism: OK, {len(normal['files'])} files the same bit for bit in both passes, "
-          "and the regenerated catalog equals the bundled one", flush=True)
+    print(
+        f"determinism: OK, {len(normal['files'])} files the same bit for bit in both passes, "
+        "and the regenerated catalog equals the bundled one",
+        flush=True,
+    )
     return 0
 
 
@@ -364,7 +405,9 @@ def main(argv: list[str] | None = None) -> int:
     p = sub.add_parser("check", help="produce twice (as is, and at baseline) and compare")
     p.add_argument("--work", type=Path, help="folder for both passes (default: a temporary one)")
     p.add_argument("--keep", action="store_true", help="keep the temporary folder")
-    p.add_argument("--flip", metavar="FILE", help="self-test: flip a byte of FILE (e.g. trial/map.pgm) in the second pass")
+    p.add_argument(
+        "--flip", metavar="FILE", help="self-test: flip a byte of FILE (e.g. trial/map.pgm) in the second pass"
+    )
     p = sub.add_parser("produce", help="write the outputs and their manifest into OUT")
     p.add_argument("out", type=Path)
     p = sub.add_parser("compare", help="compare two manifest.json files")

@@ -32,6 +32,8 @@ _PUBLIC = {
     "RunRecord": "slamtrials.record",
     "evaluate_run": "slamtrials.evaluation",
     "evaluate_files": "slamtrials.evaluation",
+    "score_map": "slamtrials.campaign.mapscore",
+    "MapQuality": "slamtrials.metric.mapquality",
     "write_run": "slamtrials.io.runfolder",
     "read_run": "slamtrials.io.runfolder",
     "SlamtrialsError": "slamtrials.errors",

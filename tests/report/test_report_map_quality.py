@@ -84,6 +84,7 @@ def test_the_report_shows_the_worlds_means_as_the_worlds_table_holds_them(tmp_pa
     page = build_report(tmp_path / "c", repeats=10, pdf=False).read_text(encoding="utf-8")
     ((name, runs, *cells),) = _rows(page, "map-quality-table")
     assert name == "room" and runs == "5" and 'href="#map-quality"' in page
+    assert page.count('<section id="map-quality">') == 1 and page.count('href="#map-quality"') == 1
     for cell, column in zip(cells, MAP_QUALITY_CSV_COLUMNS):
         expected = means[column]
         digits = 2 if column.startswith("ghost") else 3

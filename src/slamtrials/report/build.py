@@ -25,9 +25,6 @@ the run folders), draws the paper's figures with :mod:`slamtrials.report.campaig
 * how well the final maps draw the floor plans: per world, the mean occupied-cell precision and recall
   within 1 and 2 cells, free-space IoU and ghost area, with their definitions
   (:mod:`slamtrials.report.map_quality`);
-* how well the final maps draw the floor plans: per world, the mean occupied-cell precision and recall
-  within 1 and 2 cells, free-space IoU and ghost area, with their definitions
-  (:mod:`slamtrials.report.map_quality`);
 * every run (seed, status, errors, outlier marks), and the provenance: config, root seed, versions.
 
 A campaign that is still running, has failed or capped worlds, or no finished run yet still gives a page,
@@ -79,7 +76,6 @@ from slamtrials.report.compare import (
 )
 from slamtrials.report.exploration import exploration_section
 from slamtrials.report.load import CampaignData, load_campaign
-from slamtrials.report.map_quality import map_quality_section
 from slamtrials.report.map_quality import map_quality_section
 from slamtrials.report.pairing import detect_pairing
 from slamtrials.report.tables import METRICS, NOISE_SHARE_LIMIT, OUTLIER_IQR, paper_table, share_percent
@@ -1133,7 +1129,6 @@ def build_report(
         _cost(figs, data, done),
         exploration_section(figs, data, done, _table_order(data, done)),
         map_quality_section(done, _table_order(data, done)),
-        map_quality_section(done, _table_order(data, done)),
         _runs_table(data),
         _provenance(data),
     ]
@@ -1148,7 +1143,6 @@ def build_report(
         ("termination", "Termination"),
         ("cost", "Cost"),
         ("exploration", "Exploration"),
-        ("map-quality", "Map quality"),
         ("map-quality", "Map quality"),
         ("runs", "Runs"),
         ("provenance", "Provenance"),

@@ -77,7 +77,12 @@ def test_the_report_shows_the_worlds_means_as_the_worlds_table_holds_them(tmp_pa
     world = World(occupied, 0.05, name="room", start=np.array([1.0, 1.5, 0.0]))
     ref = str(save_rosmap(world, tmp_path / "room.yaml"))
     config = CampaignConfig.from_dict(
-        {"worlds": [ref], "seed": 2, "slam": {"algorithm": "odometry", "preset": None}, "runs": {"initial": 5, "max_runs": 5}}
+        {
+            "worlds": [ref],
+            "seed": 2,
+            "slam": {"algorithm": "odometry", "preset": None},
+            "runs": {"initial": 5, "max_runs": 5},
+        }
     )
     run_campaign(config, tmp_path / "c", scheduler=client, trial_fn=FakeTrial())
     means = load_campaign(tmp_path / "c").worlds.iloc[0]

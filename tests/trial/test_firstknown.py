@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from slamtrials.record import OCCUPIED, UNKNOWN, OccupancyGrid
-from slamtrials.trial.firstknown import FirstKnown, coverage_curve
+from slamtrials.trial.firstknown import SAMPLE_PERIOD, SECONDS_PER_CELL, FirstKnown, coverage_curve, sample_period
 
 RES = 0.5
 
@@ -68,3 +68,9 @@ def test_the_coverage_curve():
     assert curve[-1] == np.mean(known)
     assert coverage_curve(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=bool), 3).tolist() == [0.0, 0.0, 0.0]
     assert coverage_curve(first, known, 0).size == 0
+
+
+def test_the_sample_period_grows_with_the_map():
+    assert sample_period(grid(100, 100)) == SAMPLE_PERIOD
+    assert sample_period(grid(2000, 1000)) == pytest.approx(2e6 * SECONDS_PER_CELL)
+    assert 2e6 * SECONDS_PER_CELL > SAMPLE_PERIOD

@@ -28,7 +28,7 @@ __all__ = ["exploration_section", "read_exploration", "EXPLORATION_TEXT"]
 EXPLORATION_TEXT = (
     "Coverage at a time t: the share of the free area the robot's footprint can reach from the start that the "
     "final SLAM map knows (free or occupied) and that the SLAM map of time t already knew, sampled whenever "
-    "SLAM published a new map (at most once a simulated second); it ends at the explored fraction above. Time "
+    "SLAM published a new map (at most once a simulated second, or 4 s per million map cells); it ends at the explored fraction above. Time "
     "and distance to 90 % (99 %): the simulated seconds and the length of the true path from the start to "
     "the first sample at or above that coverage, averaged over the runs that reached it (as Explore-Bench "
     "reports exploration). In a replay they are the source runs' (the robot explored with the first "

@@ -33,10 +33,13 @@ def draw_coverage_curves(ax, runs: Mapping[int, ExplorationMeasures], *, title: 
     for threshold, style in _THRESHOLDS:
         percent = round(100 * threshold)
         ax.axhline(100.0 * threshold, ls=style, lw=0.8, color="0.4", label=f"{percent} %", gid=f"threshold:{percent}")
+    for threshold, _ in _THRESHOLDS:
+        percent = round(100 * threshold)
         reached = [(f.time_to(threshold), 100.0 * threshold) for f in runs.values() if f.time_to(threshold) is not None]
         if reached:
             xs, ys = zip(*reached)
-            ax.plot(xs, ys, "o", ms=3, color="tab:orange", alpha=0.8, gid=f"reached:{percent}")
+            label = "first reached" if threshold == _THRESHOLDS[0][0] else None
+            ax.plot(xs, ys, "o", ms=3, color="tab:orange", alpha=0.8, label=label, gid=f"reached:{percent}")
     ax.set_xlim(0.0, right * 1.02 if right > 0 else 1.0)
     ax.set_ylim(0.0, 102.0)
     ax.set_xlabel("simulated time (s)")

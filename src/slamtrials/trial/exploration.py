@@ -5,7 +5,7 @@
 can reach from the start, as ``trial.mapped_fraction`` counts them) that the final SLAM map knows (free or
 occupied) and that the SLAM map published at or before ``t`` already knew
 (:mod:`slamtrials.trial.firstknown`); so the curve never decreases and ends at ``mapped_fraction``. From
-the curve, sampled at the SLAM map's publications (at most one a simulated second):
+the curve, sampled at the SLAM map's publications (:func:`~slamtrials.trial.firstknown.sample_period`):
 
 * ``time_to_90_s``, ``time_to_99_s``: simulated seconds from the start to the first sample whose
   coverage is at least 0.90 (0.99); None when the run never got there;

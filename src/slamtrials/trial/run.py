@@ -43,7 +43,7 @@ from slamtrials.trial.coverage import (
     observed_fraction,
 )
 from slamtrials.trial.exploration import EXPLORATION_KEY, ExplorationMeasures, exploration_measures
-from slamtrials.trial.firstknown import SAMPLE_PERIOD, FirstKnown, coverage_curve
+from slamtrials.trial.firstknown import FirstKnown, coverage_curve, sample_period
 from slamtrials.trial.summary import TrialSummary
 from slamtrials.worlds import World
 
@@ -189,7 +189,7 @@ def run_trial(
         meter.leave(mark, update_seconds=spent if slam.updates > updates else None)
         if frame.t >= next_sample and grid is not history.last_map:
             history.update(len(frames) - 1, grid)
-            next_sample = frame.t + SAMPLE_PERIOD
+            next_sample = frame.t + sample_period(grid)
         reason = termination.check(frame.t, grid)
         if reason is not None:
             break

@@ -61,7 +61,7 @@ class ExplorationMeasures:
     ----------
     time_to_90_s, distance_to_90_m:
         Simulated time (s) and true path length (m) from the start until the coverage first reached
-        0.90; None when it never did.
+        0.90, to the millisecond and millimetre; None when it never did.
     time_to_99_s, distance_to_99_m:
         The same for 0.99.
     final_coverage:
@@ -196,8 +196,8 @@ def exploration_measures(
             f"t, coverage and distance must be [S] alike, got {t.shape}, {coverage.shape}, {distance.shape}"
         )
     crossings = [first_reaching(coverage, threshold) for threshold in THRESHOLDS]
-    times = [None if k is None else float(t[k]) for k in crossings]
-    lengths = [None if k is None else float(distance[k]) for k in crossings]
+    times = [None if k is None else round(float(t[k]), 3) for k in crossings]  # as the curve's times
+    lengths = [None if k is None else round(float(distance[k]), 3) for k in crossings]
     kept = decimate(t.shape[0], tuple(k for k in crossings if k is not None), max_points)
     return ExplorationMeasures(
         time_to_90_s=times[0],

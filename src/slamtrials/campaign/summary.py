@@ -32,7 +32,7 @@ import io
 import json
 import math
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from slamtrials.atomicfile import atomic_write_text
@@ -114,7 +114,7 @@ class WorldSummary:
         an earlier version) or fewer than 2 runs are done.
     cost:
         The mean cost per done run (:class:`~slamtrials.campaign.costsummary.WorldCost`); None when no run
-        recorded one.
+        recorded one. Left out of equality (not reproducible).
     exploration:
         How fast the done runs explored (:class:`~slamtrials.campaign.explorationsummary.WorldExploration`);
         None when no run recorded it.
@@ -136,7 +136,9 @@ class WorldSummary:
     metric_share_t: float | None = None
     metric_share_r: float | None = None
     cap: int | None = None
-    cost: WorldCost | None = None
+    # what the runs cost differs from machine to machine and run to run: not part of the results, so two
+    # summaries of the same runs are equal whatever their costs
+    cost: WorldCost | None = field(default=None, compare=False)
     map_quality: WorldMapQuality | None = None
     exploration: WorldExploration | None = None
 

@@ -9,11 +9,11 @@ Runs stored by earlier versions recorded none: a world without any has no :class
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from slamtrials.campaign.detailmeans import csv_cells, figure_means
 from slamtrials.cost import COST_FIGURES
 
 __all__ = ["WorldCost", "world_cost", "COST_CSV_COLUMNS", "cost_csv_cells"]
@@ -51,26 +51,13 @@ class WorldCost:
         return tuple(getattr(self, name) for name in COST_FIGURES)
 
 
-def _number(value: Any) -> float | None:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        return None
-    return float(value)
-
-
 def world_cost(details: Iterable[Mapping[str, Any]]) -> WorldCost | None:
     """The mean cost over the runs whose ``details`` (the catalog's JSON of each done run) hold one; None
     when none does."""
-    rows = [d for d in details if any(_number(d.get(name)) is not None for name in COST_FIGURES)]
-    if not rows:
-        return None
-    means: dict[str, float | None] = {}
-    for name in COST_FIGURES:
-        values = [v for v in (_number(d.get(name)) for d in rows) if v is not None]
-        means[name] = math.fsum(values) / len(values) if values else None
-    return WorldCost(runs=len(rows), **means)
+    found = figure_means(details, COST_FIGURES)
+    return None if found is None else WorldCost(runs=found[0], **found[1])
 
 
 def cost_csv_cells(cost: WorldCost | None) -> list[str]:
     """The :data:`COST_CSV_COLUMNS` cells of a summary.csv row (empty where unknown)."""
-    values = cost.means() if cost is not None else (None,) * len(COST_FIGURES)
-    return ["" if value is None else repr(value) for value in values]
+    return csv_cells(None if cost is None else cost.means(), len(COST_FIGURES))

@@ -15,6 +15,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from slamtrials.campaign.detailmeans import csv_cells, figure, mean_of
 from slamtrials.trial.exploration import EXPLORATION_KEY, ExplorationMeasures
 
 __all__ = [
@@ -79,41 +80,28 @@ class WorldExploration:
         )
 
 
-def _number(value: Any) -> float | None:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        return None
-    return float(value)
-
-
-def _mean(values: list[float | None]) -> float | None:
-    kept = [v for v in values if v is not None]
-    return math.fsum(kept) / len(kept) if kept else None
-
-
 def world_exploration(details: Iterable[Mapping[str, Any]]) -> WorldExploration | None:
     """The exploration of the runs whose ``details`` (the catalog's JSON of each done run) hold measures
     (a ``final_coverage``); None when none does."""
-    rows = [d for d in details if _number(d.get("final_coverage")) is not None]
+    rows = [d for d in details if figure(d.get("final_coverage")) is not None]
     if not rows:
         return None
     figures = {
-        name: [_number(d.get(name)) for d in rows]
+        name: [figure(d.get(name)) for d in rows]
         for name in ("time_to_90_s", "distance_to_90_m", "time_to_99_s", "distance_to_99_m")
     }
     return WorldExploration(
         runs=len(rows),
         coverage_final=math.fsum(float(d["final_coverage"]) for d in rows) / len(rows),
         reached_90=sum(v is not None for v in figures["time_to_90_s"]),
-        time_to_90_s=_mean(figures["time_to_90_s"]),
-        distance_to_90_m=_mean(figures["distance_to_90_m"]),
+        time_to_90_s=mean_of(figures["time_to_90_s"]),
+        distance_to_90_m=mean_of(figures["distance_to_90_m"]),
         reached_99=sum(v is not None for v in figures["time_to_99_s"]),
-        time_to_99_s=_mean(figures["time_to_99_s"]),
-        distance_to_99_m=_mean(figures["distance_to_99_m"]),
+        time_to_99_s=mean_of(figures["time_to_99_s"]),
+        distance_to_99_m=mean_of(figures["distance_to_99_m"]),
     )
 
 
 def exploration_csv_cells(exploration: WorldExploration | None) -> list[str]:
     """The :data:`EXPLORATION_CSV_COLUMNS` cells of a summary.csv row (empty where unknown)."""
-    if exploration is None:
-        return [""] * len(EXPLORATION_CSV_COLUMNS)
-    return ["" if v is None else str(v) if isinstance(v, int) else repr(v) for v in exploration.cells()]
+    return csv_cells(None if exploration is None else exploration.cells(), len(EXPLORATION_CSV_COLUMNS))

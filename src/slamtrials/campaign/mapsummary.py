@@ -9,11 +9,11 @@ earlier versions, recorded none: a world without any has no :class:`WorldMapQual
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from slamtrials.campaign.detailmeans import csv_cells, figure_means
 from slamtrials.metric.mapquality import MAP_QUALITY_FIGURES
 
 __all__ = ["WorldMapQuality", "world_map_quality", "MAP_QUALITY_CSV_COLUMNS", "map_quality_csv_cells"]
@@ -51,26 +51,13 @@ class WorldMapQuality:
         return tuple(getattr(self, name) for name in MAP_QUALITY_FIGURES)
 
 
-def _number(value: Any) -> float | None:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        return None
-    return float(value)
-
-
 def world_map_quality(details: Iterable[Mapping[str, Any]]) -> WorldMapQuality | None:
     """The mean map quality over the runs whose ``details`` (the catalog's JSON of each done run) hold one;
     None when none does."""
-    rows = [d for d in details if any(_number(d.get(name)) is not None for name in MAP_QUALITY_FIGURES)]
-    if not rows:
-        return None
-    means: dict[str, float | None] = {}
-    for name in MAP_QUALITY_FIGURES:
-        values = [v for v in (_number(d.get(name)) for d in rows) if v is not None]
-        means[name] = math.fsum(values) / len(values) if values else None
-    return WorldMapQuality(runs=len(rows), **means)
+    found = figure_means(details, MAP_QUALITY_FIGURES)
+    return None if found is None else WorldMapQuality(runs=found[0], **found[1])
 
 
 def map_quality_csv_cells(quality: WorldMapQuality | None) -> list[str]:
     """The :data:`MAP_QUALITY_CSV_COLUMNS` cells of a summary.csv row (empty where unknown)."""
-    values = quality.means() if quality is not None else (None,) * len(MAP_QUALITY_FIGURES)
-    return ["" if value is None else repr(value) for value in values]
+    return csv_cells(None if quality is None else quality.means(), len(MAP_QUALITY_FIGURES))

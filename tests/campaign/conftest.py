@@ -43,3 +43,23 @@ def rooms(tmp_path_factory):
     """Two tiny worlds as map_server files: ``room_a`` (4 x 3 m) and ``room_b`` (3 x 3 m)."""
     folder = tmp_path_factory.mktemp("worlds")
     return [write_room(folder, "room_a"), write_room(folder, "room_b", width_m=3.0, height_m=3.0)]
+
+
+def _five_run_config(worlds: list[str]):
+    from slamtrials.campaign import CampaignConfig
+
+    return CampaignConfig.from_dict(
+        {
+            "worlds": list(worlds),
+            "seed": 3,
+            "slam": {"algorithm": "odometry", "preset": None},
+            "runs": {"initial": 5, "max_runs": 5},
+        }
+    )
+
+
+@pytest.fixture(scope="session")
+def five_run_config():
+    """``five_run_config(worlds)``: a campaign config of exactly 5 runs per world (seed 3, the odometry
+    algorithm), for campaigns whose trials a FakeTrial makes."""
+    return _five_run_config

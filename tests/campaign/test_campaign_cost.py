@@ -8,7 +8,7 @@ import json
 
 import pytest
 
-from slamtrials.campaign import CampaignConfig, load_summary, run_campaign
+from slamtrials.campaign import load_summary, run_campaign
 from slamtrials.campaign.costsummary import COST_CSV_COLUMNS, world_cost
 from slamtrials.campaign.replay import replay_campaign
 from slamtrials.campaign.store import CampaignStore
@@ -18,21 +18,10 @@ from slamtrials.cost import COST_FIGURES, IN_PROCESS, RunCost
 COST = RunCost(2.0, 40.0, 3.0, 250.0, 20.0, 30.0, updates_timed=5)
 
 
-def _config(rooms) -> CampaignConfig:
-    return CampaignConfig.from_dict(
-        {
-            "worlds": rooms[:1],
-            "seed": 3,
-            "slam": {"algorithm": "odometry", "preset": None},
-            "runs": {"initial": 5, "max_runs": 5},
-        }
-    )
-
-
 @pytest.fixture(scope="module")
-def costed(tmp_path_factory, rooms, client):
+def costed(tmp_path_factory, rooms, client, five_run_config):
     folder = tmp_path_factory.mktemp("costed") / "c"
-    run_campaign(_config(rooms), folder, scheduler=client, trial_fn=FakeTrial(cost=COST))
+    run_campaign(five_run_config(rooms[:1]), folder, scheduler=client, trial_fn=FakeTrial(cost=COST))
     return folder
 
 
@@ -47,8 +36,8 @@ def test_the_catalog_and_summary_csv_keep_the_runs_cost(costed):
     assert [float(csv_row[c]) for c in COST_CSV_COLUMNS] == [2.0, 40.0, 3.0, 250.0, 20.0, 30.0]
 
 
-def test_runs_without_cost_leave_the_cells_empty(tmp_path, rooms, client):
-    run_campaign(_config(rooms), tmp_path / "c", scheduler=client, trial_fn=FakeTrial())
+def test_runs_without_cost_leave_the_cells_empty(tmp_path, rooms, client, five_run_config):
+    run_campaign(five_run_config(rooms[:1]), tmp_path / "c", scheduler=client, trial_fn=FakeTrial())
     (row,) = load_summary(tmp_path / "c")
     assert row.cost is None
     (csv_row,) = csv.DictReader((tmp_path / "c" / "summary.csv").open())

@@ -8,7 +8,7 @@ import json
 
 import pytest
 
-from slamtrials.campaign import CampaignConfig, load_summary, run_campaign
+from slamtrials.campaign import load_summary, run_campaign
 from slamtrials.campaign.explorationsummary import EXPLORATION_CSV_COLUMNS, world_exploration
 from slamtrials.campaign.store import CampaignStore
 from slamtrials.campaign.testing import FakeTrial
@@ -17,21 +17,10 @@ from slamtrials.trial.exploration import EXPLORATION_FIGURES, exploration_measur
 MEASURES = exploration_measures([0.0, 30.0, 60.0, 90.0], [0.1, 0.92, 0.97, 0.98], [0.0, 9.0, 17.0, 25.0], "fake")
 
 
-def _config(rooms) -> CampaignConfig:
-    return CampaignConfig.from_dict(
-        {
-            "worlds": rooms[:1],
-            "seed": 3,
-            "slam": {"algorithm": "odometry", "preset": None},
-            "runs": {"initial": 5, "max_runs": 5},
-        }
-    )
-
-
 @pytest.fixture(scope="module")
-def explored(tmp_path_factory, rooms, client):
+def explored(tmp_path_factory, rooms, client, five_run_config):
     folder = tmp_path_factory.mktemp("explored") / "c"
-    run_campaign(_config(rooms), folder, scheduler=client, trial_fn=FakeTrial(exploration=MEASURES))
+    run_campaign(five_run_config(rooms[:1]), folder, scheduler=client, trial_fn=FakeTrial(exploration=MEASURES))
     return folder
 
 
@@ -49,8 +38,8 @@ def test_the_catalog_and_summary_csv_keep_how_the_runs_explored(explored):
     assert cells[:1] + cells[2:] == ["5", "5", "30.0", "9.0", "0", "", ""]
 
 
-def test_runs_without_exploration_measures_leave_the_cells_empty(tmp_path, rooms, client):
-    run_campaign(_config(rooms), tmp_path / "c", scheduler=client, trial_fn=FakeTrial())
+def test_runs_without_exploration_measures_leave_the_cells_empty(tmp_path, rooms, client, five_run_config):
+    run_campaign(five_run_config(rooms[:1]), tmp_path / "c", scheduler=client, trial_fn=FakeTrial())
     (row,) = load_summary(tmp_path / "c")
     assert row.exploration is None
     (csv_row,) = csv.DictReader((tmp_path / "c" / "summary.csv").open())

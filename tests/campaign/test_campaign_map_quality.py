@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
-from slamtrials.campaign import CampaignConfig, load_summary, run_campaign
+from slamtrials.campaign import load_summary, run_campaign
 from slamtrials.campaign.mapscore import floor_plan, score_map
 from slamtrials.campaign.mapsummary import MAP_QUALITY_CSV_COLUMNS, world_map_quality
 from slamtrials.campaign.replay import replay_campaign
@@ -54,21 +54,10 @@ class PerfectMapTrial:
         return record
 
 
-def _config(worlds: list[str]) -> CampaignConfig:
-    return CampaignConfig.from_dict(
-        {
-            "worlds": worlds,
-            "seed": 3,
-            "slam": {"algorithm": "odometry", "preset": None},
-            "runs": {"initial": 5, "max_runs": 5},
-        }
-    )
-
-
 @pytest.fixture(scope="module")
-def mapped(tmp_path_factory, rooms, client):
+def mapped(tmp_path_factory, rooms, client, five_run_config):
     folder = tmp_path_factory.mktemp("mapped") / "c"
-    run_campaign(_config(rooms[:1]), folder, scheduler=client, trial_fn=PerfectMapTrial())
+    run_campaign(five_run_config(rooms[:1]), folder, scheduler=client, trial_fn=PerfectMapTrial())
     return folder
 
 
@@ -116,9 +105,11 @@ def test_a_replay_scores_its_own_map_not_the_source_s(mapped, tmp_path, client):
         assert "map_quality" not in doc["replay"]
 
 
-def test_a_replay_whose_world_no_longer_loads_says_so_and_stores_none(tmp_path, client):
+def test_a_replay_whose_world_no_longer_loads_says_so_and_stores_none(tmp_path, client, five_run_config):
     plans = tmp_path / "plans"
-    run_campaign(_config([write_room(plans, "moved")]), tmp_path / "c", scheduler=client, trial_fn=PerfectMapTrial())
+    run_campaign(
+        five_run_config([write_room(plans, "moved")]), tmp_path / "c", scheduler=client, trial_fn=PerfectMapTrial()
+    )
     shutil.rmtree(plans)
     load_world_cached.cache_clear()
     replay_campaign(tmp_path / "c", tmp_path / "r", scheduler=client)

@@ -3,98 +3,47 @@ worlds table's means; a campaign of runs that recorded no cost shows them as mis
 
 from __future__ import annotations
 
-import html
-import re
-
 import numpy as np
 import pandas as pd
 import pytest
 from matplotlib.figure import Figure
 
-from slamtrials.campaign import CampaignConfig, run_campaign
 from slamtrials.campaign.costsummary import COST_CSV_COLUMNS
 from slamtrials.campaign.testing import FakeTrial
 from slamtrials.cost import RunCost
 from slamtrials.report import cost_figures as costf
 from slamtrials.report.build import build_report
 from slamtrials.report.load import load_campaign
-from slamtrials.worlds import World
 
 COST = RunCost(2.0, 40.0, 3.0, 250.0, 20.0, 30.0, updates_timed=5)
 
 
 @pytest.fixture(scope="module")
-def client():
-    from distributed import Client, LocalCluster
-
-    with (
-        LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster,
-        Client(cluster) as c,
-    ):
-        yield c
-
-
-@pytest.fixture(scope="module")
-def rooms(tmp_path_factory):
-    """Two 3 m x 3 m rooms as map_server files."""
-    from slamtrials.worlds.formats.rosmap_save import save_rosmap
-
-    folder = tmp_path_factory.mktemp("worlds")
-    occupied = np.zeros((66, 66), dtype=bool)
-    occupied[:3, :] = occupied[-3:, :] = occupied[:, :3] = occupied[:, -3:] = True
-    return [
-        str(save_rosmap(World(occupied, 0.05, name=name, start=np.array([1.0, 1.5, 0.0])), folder / f"{name}.yaml"))
-        for name in ("room_a", "room_b")
-    ]
-
-
-def _campaign(folder, trial, rooms, client):
-    config = CampaignConfig.from_dict(
-        {
-            "worlds": rooms,
-            "seed": 2,
-            "slam": {"algorithm": "odometry", "preset": None},
-            "runs": {"initial": 5, "max_runs": 5},
-        }
-    )
-    run_campaign(config, folder, scheduler=client, trial_fn=trial)
-    return folder
-
-
-def _rows(page: str, ident: str) -> list[list[str]]:
-    body = re.search(rf'<table id="{ident}">.*?<tbody>(.*?)</tbody>', page, re.S).group(1)
-    return [
-        [html.unescape(re.sub(r"<[^>]+>", "", cell)) for cell in re.findall(r"<td[^>]*>(.*?)</td>", row, re.S)]
-        for row in re.findall(r"<tr[^>]*>(.*?)</tr>", body, re.S)
-    ]
-
-
-@pytest.fixture(scope="module")
-def costed(tmp_path_factory, rooms, client):
-    return _campaign(tmp_path_factory.mktemp("report_cost") / "c", FakeTrial(cost=COST), rooms, client)
+def costed(tmp_path_factory, fake_campaign):
+    return fake_campaign(tmp_path_factory.mktemp("report_cost") / "c", FakeTrial(cost=COST))
 
 
 @pytest.mark.slow
-def test_table_one_the_cost_section_and_the_runs_table_show_the_cost(costed):
+def test_table_one_the_cost_section_and_the_runs_table_show_the_cost(costed, table_rows):
     data = load_campaign(costed)
     assert [data.worlds[c].tolist() for c in COST_CSV_COLUMNS] == [[v, v] for v in (2.0, 40.0, 3.0, 250.0, 20.0, 30.0)]
     page = build_report(costed, repeats=10, pdf=False).read_text(encoding="utf-8")
-    for row in _rows(page, "summary-table"):
+    for row in table_rows(page, "summary-table"):
         assert row[-5:-2] == ["2.0", "20 / 30", "40"]  # SLAM CPU s, ms per update (median / p90), MiB
-    for row in _rows(page, "cost-table"):
+    for row in table_rows(page, "cost-table"):
         assert row[1:] == ["5", "2.0", "3.0", "20", "30", "67 %", "40", "250"]
-    for row in _rows(page, "runs-table"):
+    for row in table_rows(page, "runs-table"):
         assert row[-4:-1] == ["2.0", "20", "40"]
     assert 'src="figures/report_cost.png"' in page and 'href="#cost"' in page
     assert (costed / "report" / "figures" / "report_cost.png").is_file()
 
 
 @pytest.mark.slow
-def test_a_campaign_of_runs_without_cost_reports_none(tmp_path, rooms, client):
-    folder = _campaign(tmp_path / "c", FakeTrial(), rooms, client)
+def test_a_campaign_of_runs_without_cost_reports_none(tmp_path, fake_campaign, table_rows):
+    folder = fake_campaign(tmp_path / "c", FakeTrial())
     assert load_campaign(folder).worlds[list(COST_CSV_COLUMNS)].isna().all().all()
     page = build_report(folder, repeats=10, pdf=False).read_text(encoding="utf-8")
-    assert all(row[-5:-2] == ["-", "-", "-"] for row in _rows(page, "summary-table"))
+    assert all(row[-5:-2] == ["-", "-", "-"] for row in table_rows(page, "summary-table"))
     assert "No finished run recorded its cost." in page and "report_cost.png" not in page
 
 

@@ -4,7 +4,6 @@ map quality counted apart, and a campaign whose runs recorded none."""
 from __future__ import annotations
 
 import html
-import re
 
 import numpy as np
 import pandas as pd
@@ -20,14 +19,6 @@ from slamtrials.report.map_quality import map_quality_section
 from slamtrials.worlds import World
 
 
-def _rows(page: str, ident: str) -> list[list[str]]:
-    body = re.search(rf'<table id="{ident}">.*?<tbody>(.*?)</tbody>', page, re.S).group(1)
-    return [
-        [html.unescape(re.sub(r"<[^>]+>", "", cell)) for cell in re.findall(r"<td[^>]*>(.*?)</td>", row, re.S)]
-        for row in re.findall(r"<tr[^>]*>(.*?)</tr>", body, re.S)
-    ]
-
-
 def _runs() -> pd.DataFrame:
     figures = {
         "occupied_precision_1": [0.8, 0.6, 0.9, np.nan],
@@ -40,9 +31,9 @@ def _runs() -> pd.DataFrame:
     return pd.DataFrame({"world": ["a", "a", "b", "b"], **figures})  # the last run recorded none
 
 
-def test_one_row_per_world_with_the_means_of_the_runs_that_recorded_them():
+def test_one_row_per_world_with_the_means_of_the_runs_that_recorded_them(table_rows):
     page = map_quality_section(_runs(), ["b", "a"])
-    assert _rows(page, "map-quality-table") == [
+    assert table_rows(page, "map-quality-table") == [
         ["b", "1", "0.900", "0.500", "1.000", "0.600", "0.500", "0.25"],
         ["a", "2", "0.700", "0.800", "0.800", "0.900", "0.900", "2.00"],
     ]
@@ -57,19 +48,8 @@ def test_runs_without_map_quality_give_a_note_instead_of_a_table():
     assert DEFINITIONS["free_iou"] in html.unescape(page)
 
 
-@pytest.fixture(scope="module")
-def client():
-    from distributed import Client, LocalCluster
-
-    with (
-        LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster,
-        Client(cluster) as c,
-    ):
-        yield c
-
-
 @pytest.mark.slow
-def test_the_report_shows_the_worlds_means_as_the_worlds_table_holds_them(tmp_path, client):
+def test_the_report_shows_the_worlds_means_as_the_worlds_table_holds_them(tmp_path, client, table_rows):
     from slamtrials.worlds.formats.rosmap_save import save_rosmap
 
     occupied = np.zeros((66, 66), dtype=bool)
@@ -87,7 +67,7 @@ def test_the_report_shows_the_worlds_means_as_the_worlds_table_holds_them(tmp_pa
     run_campaign(config, tmp_path / "c", scheduler=client, trial_fn=FakeTrial())
     means = load_campaign(tmp_path / "c").worlds.iloc[0]
     page = build_report(tmp_path / "c", repeats=10, pdf=False).read_text(encoding="utf-8")
-    ((name, runs, *cells),) = _rows(page, "map-quality-table")
+    ((name, runs, *cells),) = table_rows(page, "map-quality-table")
     assert name == "room" and runs == "5" and 'href="#map-quality"' in page
     assert page.count('<section id="map-quality">') == 1 and page.count('href="#map-quality"') == 1
     for cell, column in zip(cells, MAP_QUALITY_CSV_COLUMNS):

@@ -80,8 +80,7 @@ def scan_points(laser_pose, readings, angle_min, angle_increment):  # pragma: no
     ``x + r cos(heading)``, ``y + r sin(heading)``.
 
     ``laser_pose`` float64 ``[3]`` (map frame), ``readings`` float64 ``[B]`` ranges (m), NaN where a
-    beam has no point. Returns map-frame ``x, y`` float64 ``[B]``, NaN where a beam has none, and the
-    sequential sum of the points flagged in ``within`` is not taken here (see :func:`barycentre`).
+    beam has no point. Returns map-frame ``x, y`` float64 ``[B]``, NaN where a beam has none.
     """
     n = readings.shape[0]
     x = np.empty(n)

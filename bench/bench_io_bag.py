@@ -1,7 +1,7 @@
 """Benchmark of ROS bag export and import: a 30-minute run (18,000 scans x 541 beams at 10 Hz), one core.
 
 Run: ``.venv/bin/python bench/bench_io_bag.py`` (``make bench`` runs all benchmarks). Prints a Markdown
-table; the latest figures are kept in bench/RESULTS.md ("ROS bags (issue 3)").
+table; the latest figures are kept in bench/RESULTS.md ("ROS bags").
 
 The run is synthetic (no simulation needed): float32 ranges in 0.1..30 m with the structure of a room
 (smooth walls plus millimetre noise), a random-walk odometry and ground truth. Each bag carries

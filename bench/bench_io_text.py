@@ -1,7 +1,7 @@
 """Benchmark of the text formats: CARMEN log and TUM trajectory export and import of a 30-minute run.
 
 Run: ``.venv/bin/python bench/bench_io_text.py`` (``make bench`` runs all benchmarks).
-Prints a Markdown table; the latest figures are kept in bench/RESULTS.md ("Text formats (issue 3)").
+Prints a Markdown table; the latest figures are kept in bench/RESULTS.md ("Text formats").
 
 The run: 18,000 frames (30 minutes at 10 Hz) of 541 beams (270 deg, 30 m, the paper's laser), ranges
 uniform in [0.1, 30] m, a random-walk trajectory. Export = ``carmen_from_run`` + ``write_carmen`` (one

@@ -1,7 +1,7 @@
 """Benchmark of the metric: relations evaluated per second, and the automatic sampling, one core.
 
 Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/bench_metric.py`` (``make bench`` runs all benchmarks).
-Prints a Markdown table; the latest figures are kept in bench/RESULTS.md ("Metric (issue 4)").
+Prints a Markdown table; the latest figures are kept in bench/RESULTS.md ("Metric").
 
 Cases:
 

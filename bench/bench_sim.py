@@ -1,7 +1,7 @@
 """Benchmark of the simulator: laser scans per second and full simulator steps per second, one core.
 
 Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/bench_sim.py`` (``make bench`` runs all benchmarks).
-Prints a Markdown table; the latest figures are kept in bench/RESULTS.md ("Simulator (issue 2)").
+Prints a Markdown table; the latest figures are kept in bench/RESULTS.md ("Simulator").
 
 Worlds (0.05 m cells):
 

@@ -37,12 +37,14 @@ class KartoConfig(BaseModel):
         Seconds between nodes: slam_toolbox's gate lets a scan through only after this long, and Karto's
         HasMovedEnough makes a node of any scan this long after the last one.
     scan_throttle:
-        slam_toolbox's gate (``shouldProcessScan``) before Karto's node rule: a scan is processed only
-        if ``minimum_time_interval`` passed since the last node and the base moved, by odometry, at least
-        ``sqrt(0.8) minimum_travel_distance`` (no heading test; the first scan passes, the next three
-        do not). Such a scan always becomes a node (the time test of HasMovedEnough), so with the gate
-        ``minimum_travel_heading`` has no effect, as in slam_toolbox. False: Karto's HasMovedEnough alone
-        (slam_karto): a node when the time interval passed, or the laser turned or moved enough.
+        slam_toolbox's gate (``shouldProcessScan``) before Karto's node rule: a scan gets through only if
+        ``minimum_time_interval`` passed since the last scan that got through and the base moved, by
+        odometry, at least ``sqrt(0.8) minimum_travel_distance`` since then (no heading test; the first
+        scan passes, the next three do not). A scan that gets through becomes a node only if Karto's
+        HasMovedEnough agrees (the laser moved ``minimum_travel_distance`` or turned
+        ``minimum_travel_heading``), with Karto's own time rule of 3600 s, since slam_toolbox never hands
+        the mapper ``minimum_time_interval``. False: Karto's HasMovedEnough alone (slam_karto), with
+        ``minimum_time_interval`` as its time rule.
     use_scan_matching:
         Correct each node by scan matching (False: nodes at their odometry poses, no graph).
     use_scan_barycenter:

@@ -60,3 +60,25 @@ def test_a_world_exploration_averages_the_runs_that_reached_each_threshold():
     assert (found.reached_90, found.time_to_90_s, found.distance_to_90_m) == (2, 120.0, 40.0)
     assert (found.reached_99, found.time_to_99_s, found.distance_to_99_m) == (1, 200.0, None)
     assert world_exploration([{}, {"final_coverage": None}]) is None
+
+
+def test_the_loaded_worlds_table_has_summary_csv_s_exploration_columns(
+    explored, tmp_path, rooms, client, five_run_config
+):
+    """report.load's worlds table (what the study's table of cells reads) holds summary.csv's exploration means."""
+    import pandas as pd
+
+    from slamtrials.report.load import WORLD_COLUMNS, load_campaign
+
+    assert set(EXPLORATION_CSV_COLUMNS) <= set(WORLD_COLUMNS)
+    worlds = load_campaign(explored).worlds
+    (csv_row,) = csv.DictReader((explored / "summary.csv").open())
+    for column in EXPLORATION_CSV_COLUMNS:
+        value = worlds[column].iloc[0]
+        if csv_row[column] == "":
+            assert pd.isna(value), column
+        else:
+            assert float(value) == float(csv_row[column]), column  # the CSV keeps every digit
+    assert worlds["reached_99"].dtype == "Int64" and worlds["time_to_90_s_mean"].dtype == "float64"
+    run_campaign(five_run_config(rooms[:1]), tmp_path / "c", scheduler=client, trial_fn=FakeTrial())
+    assert load_campaign(tmp_path / "c").worlds[list(EXPLORATION_CSV_COLUMNS)].isna().all(axis=None)

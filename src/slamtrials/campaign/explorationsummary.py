@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from slamtrials.campaign.detailmeans import csv_cells, figure, mean_of
-from slamtrials.trial.exploration import EXPLORATION_KEY, ExplorationMeasures
+from slamtrials.trial.exploration import EXPLORATION_FIGURES, EXPLORATION_KEY, ExplorationMeasures
 
 __all__ = [
     "WorldExploration",
@@ -25,6 +25,7 @@ __all__ = [
     "exploration_csv_cells",
     "ExplorationMeasures",
     "EXPLORATION_KEY",
+    "EXPLORATION_FIGURES",
 ]
 
 #: The exploration columns of summary.csv.

@@ -109,7 +109,7 @@ class IntervalLevel:
     label: str
 
 
-def interval_level(alpha: float, correction: str, p_adjusted: ArrayLike) -> IntervalLevel:
+def interval_level(alpha: float, correction: str, p_adjusted: ArrayLike, *, unit: str = "world") -> IntervalLevel:
     """The level of intervals consistent with ``correction`` (see the module docstring).
 
     Parameters
@@ -119,16 +119,20 @@ def interval_level(alpha: float, correction: str, p_adjusted: ArrayLike) -> Inte
     correction:
         ``"holm"``, ``"bh"`` or ``"none"``.
     p_adjusted:
-        The adjusted p-values ``[m']`` of the family; NaN entries (worlds without a test) do not count.
+        The adjusted p-values ``[m']`` of the family; NaN entries (worlds without a test, members left
+        out of the family) do not count.
+    unit:
+        What one member of the family is, for the label: ``"world"`` (a comparison of two campaigns),
+        ``"comparison"`` (a study's family of every axis step and world).
     """
     p = np.asarray(p_adjusted, dtype=np.float64).reshape(-1)
     m = int(np.isfinite(p).sum())
     if correction == "none" or m <= 1:
         level = 1.0 - alpha
-        return IntervalLevel(level, f"{level:.0%} per world" + (", unadjusted" if correction == "none" else ""))
+        return IntervalLevel(level, f"{level:.0%} per {unit}" + (", unadjusted" if correction == "none" else ""))
     if correction == "holm":
         level = 1.0 - alpha / m
-        return IntervalLevel(level, f"simultaneous {1 - alpha:.0%} (Bonferroni, {m} worlds: each at {_pct(level)})")
+        return IntervalLevel(level, f"simultaneous {1 - alpha:.0%} (Bonferroni, {m} {unit}s: each at {_pct(level)})")
     if correction == "bh":
         selected = int((p[np.isfinite(p)] <= alpha).sum())
         level = 1.0 - max(selected, 1) * alpha / m

@@ -52,7 +52,10 @@ cost per done run (:mod:`slamtrials.campaign.costsummary`, as summary.csv): ``sl
 recorded that figure (runs of earlier versions), and the mean map quality per done run
 (:mod:`slamtrials.campaign.mapsummary`): ``occupied_precision_1_mean``, ``occupied_recall_1_mean``,
 ``occupied_precision_2_mean``, ``occupied_recall_2_mean``, ``free_iou_mean``, ``ghost_free_m2_mean``, NaN
-where no run recorded it.
+where no run recorded it; and how fast the done runs explored, as summary.csv has it
+(:mod:`slamtrials.campaign.explorationsummary`): ``exploration_runs``, ``coverage_final_mean``,
+``reached_90``, ``time_to_90_s_mean``, ``distance_to_90_m_mean``, ``reached_99``, ``time_to_99_s_mean``,
+``distance_to_99_m_mean`` (the counts nullable integers), missing where no run recorded them.
 
 :func:`export_table` writes either table as CSV or Parquet.
 """
@@ -71,6 +74,7 @@ import pandas as pd
 
 from slamtrials.atomicfile import atomic_write, atomic_write_text
 from slamtrials.campaign.costsummary import COST_CSV_COLUMNS
+from slamtrials.campaign.explorationsummary import EXPLORATION_CSV_COLUMNS, EXPLORATION_FIGURES, world_exploration
 from slamtrials.campaign.mapsummary import MAP_QUALITY_CSV_COLUMNS
 from slamtrials.campaign.store import DB_FILE, RUNS_DIR, STORE_FORMAT
 from slamtrials.cost import COST_FIGURES
@@ -132,7 +136,10 @@ WORLD_COLUMNS = (
     *(f"{m}_metric_share" for m in METRICS),
     *COST_CSV_COLUMNS,
     *MAP_QUALITY_CSV_COLUMNS,
+    *EXPLORATION_CSV_COLUMNS,
 )
+#: The exploration columns of ``worlds`` that count runs (nullable integers; the others are float64).
+_EXPLORATION_COUNTS = ("exploration_runs", "reached_90", "reached_99")
 #: The tables :func:`export_table` writes.
 TABLES = ("runs", "worlds")
 #: The file formats :func:`export_table` writes.
@@ -334,7 +341,28 @@ def _worlds_frame(rows: list[tuple], runs: pd.DataFrame, config: dict[str, Any])
             worlds[column] = worlds["world"].map(figures.groupby(done_runs["world"]).mean()).astype("float64")
         else:
             worlds[column] = np.nan
+    _add_exploration(worlds, runs)
     return worlds[list(WORLD_COLUMNS)]
+
+
+def _add_exploration(worlds: pd.DataFrame, runs: pd.DataFrame) -> None:
+    """The exploration columns of ``worlds``: each world's done runs through
+    :func:`~slamtrials.campaign.explorationsummary.world_exploration`, as summary.csv computes them."""
+    done = runs[runs["status"] == "done"]
+    names = [name for name in EXPLORATION_FIGURES if name in done.columns]
+    found = {}
+    if names:
+        for world, group in done.groupby("world", sort=False):
+            details = [dict(zip(names, values)) for values in group[names].itertuples(index=False, name=None)]
+            exploration = world_exploration(details)
+            if exploration is not None:
+                found[world] = exploration.cells()
+    for k, column in enumerate(EXPLORATION_CSV_COLUMNS):
+        values = [found[w][k] if w in found else None for w in worlds["world"]]
+        if column in _EXPLORATION_COUNTS:
+            worlds[column] = pd.array(values, dtype="Int64")
+        else:
+            worlds[column] = pd.array([np.nan if v is None else v for v in values], dtype="float64")
 
 
 def load_campaign(path: str | Path) -> CampaignData:

@@ -12,6 +12,14 @@ applied over the whole study, per metric: every (axis step, other values, world)
 metric is one family, so the more cells and worlds a study has, the stronger the evidence a verdict
 needs. The intervals beside the verdicts are adjusted the same way
 (:func:`slamtrials.report.combine.interval_level`).
+
+Identical comparisons are left out of the family (:data:`IDENTICAL_RULE`): where every paired
+difference is exactly 0 (the setting changed nothing that these runs saw, e.g. a 15 m laser in a
+building with no wall farther away, and the shared seeds made the runs the same bit for bit), the test
+has ``p = 1`` and carries no evidence either way; counting it would only weaken the correction of the
+comparisons that do differ. Such a row keeps ``p = 1`` as its adjusted p-value, the verdict "no
+significant difference" and ``identical`` True; ``m`` (Holm's, Benjamini-Hochberg's and the intervals')
+counts the other comparisons of its metric.
 """
 
 from __future__ import annotations
@@ -37,10 +45,16 @@ from slamtrials.report.tables import METRICS
 from slamtrials.study.cells import Cell
 from slamtrials.study.config import value_text
 
-__all__ = ["PAIRED_BY", "neighbour_pairs", "compare_neighbours", "seeds_agree"]
+__all__ = ["PAIRED_BY", "IDENTICAL_RULE", "neighbour_pairs", "compare_neighbours", "seeds_agree", "identical_rows"]
 
 #: What makes run ``k`` of two cells of one world a pair.
 PAIRED_BY = "cells of one study share their seeds"
+
+#: The rule on identical comparisons, as the report states it.
+IDENTICAL_RULE = (
+    "Comparisons whose paired runs are identical (every paired difference exactly 0, p = 1) carry no evidence "
+    "and are left out of the family: m counts the others."
+)
 
 
 def neighbour_pairs(cells: Sequence[Cell], axes: Mapping[str, Sequence]) -> list[tuple[str, str, Cell, Cell]]:
@@ -80,6 +94,16 @@ def seeds_agree(a: pd.DataFrame, b: pd.DataFrame) -> bool:
     return bool((both["seed_a"] == both["seed_b"]).all())
 
 
+def identical_rows(table: pd.DataFrame) -> np.ndarray:
+    """``[rows]`` bool: the paired comparisons of at least 2 pairs whose every difference is exactly 0."""
+    if table.empty:
+        return np.zeros(0, dtype=bool)
+    std = table["std_difference"].to_numpy(dtype=np.float64)
+    difference = table["difference"].to_numpy(dtype=np.float64)
+    pairs = table["n_a"].to_numpy(dtype=np.float64)
+    return ((table["test"] == "paired t").to_numpy() & (pairs >= 2) & (std == 0.0) & (difference == 0.0)).astype(bool)
+
+
 def _verdict(p_adjusted: float, difference: float, alpha: float) -> str:
     if not math.isfinite(p_adjusted):
         return TOO_FEW
@@ -114,8 +138,9 @@ def compare_neighbours(
         One row per (axis step, other values, world, metric): ``axis``, ``others``, ``cell_a``,
         ``cell_b``, ``value_a``, ``value_b`` and the columns of
         :attr:`slamtrials.report.compare.Comparison.table` (``difference`` is ``B - A``; ``p_adjusted``,
-        ``wilcoxon_p_adjusted``, ``ci_adj_*`` and ``verdict`` over the study's family of its metric);
-        and ``{metric: the adjusted intervals' level}``.
+        ``wilcoxon_p_adjusted``, ``ci_adj_*`` and ``verdict`` over the study's family of its metric,
+        identical comparisons left out of it), ``identical`` (see the module docstring); and ``{metric: the
+        adjusted intervals' level}``.
     """
     tables = []
     for key, others, a, b in neighbour_pairs(cells, axes):
@@ -139,17 +164,22 @@ def compare_neighbours(
     if not tables:
         return pd.DataFrame(), {}
     table = pd.concat(tables, ignore_index=True)
+    table["identical"] = identical_rows(table)
     levels: dict[str, IntervalLevel] = {}
     for metric in METRICS:
         rows = table.index[table["metric"] == metric]
         if len(rows) == 0:
             continue
-        p_adj = adjust_pvalues(table.loc[rows, "p"].to_numpy(dtype=np.float64), correction)
+        identical = table.loc[rows, "identical"].to_numpy(dtype=bool)
+        family = np.where(identical, np.nan, table.loc[rows, "p"].to_numpy(dtype=np.float64))
+        p_adj = adjust_pvalues(family, correction)
+        level = interval_level(alpha, correction, p_adj, unit="comparison")
+        p_adj[identical] = 1.0
         table.loc[rows, "p_adjusted"] = p_adj
-        table.loc[rows, "wilcoxon_p_adjusted"] = adjust_pvalues(
-            table.loc[rows, "wilcoxon_p"].to_numpy(dtype=np.float64), correction
-        )
-        level = interval_level(alpha, correction, p_adj)
+        wilcoxon = np.where(identical, np.nan, table.loc[rows, "wilcoxon_p"].to_numpy(dtype=np.float64))
+        wilcoxon_adj = adjust_pvalues(wilcoxon, correction)
+        wilcoxon_adj[identical] = 1.0
+        table.loc[rows, "wilcoxon_p_adjusted"] = wilcoxon_adj
         levels[metric] = level
         diff, se, dof = (table.loc[rows, c].to_numpy(dtype=np.float64) for c in ("difference", "se", "dof"))
         half = np.full(len(rows), np.nan)

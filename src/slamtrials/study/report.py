@@ -24,7 +24,7 @@ from slamtrials.report.compare import A_BETTER, B_BETTER, Correction
 from slamtrials.report.load import CampaignData, load_campaign
 from slamtrials.report.tables import METRICS
 from slamtrials.study.cells import CELLS_DIR, Cell, expand_cells
-from slamtrials.study.comparisons import compare_neighbours
+from slamtrials.study.comparisons import IDENTICAL_RULE, compare_neighbours
 from slamtrials.study.config import value_text
 from slamtrials.study.figures import SYMBOLS, UNITS, draw_cost_against_error, draw_error_against_axis
 from slamtrials.study.folder import read_manifest
@@ -189,6 +189,8 @@ def _cells_section(table: pd.DataFrame, keys: list[str]) -> str:
 
 
 def _verdict_text(row: pd.Series) -> str:
+    if bool(row.get("identical", False)):
+        return "identical runs"
     if row["verdict"] == A_BETTER:
         return f"{row['axis']}={row['value_a']} better"
     if row["verdict"] == B_BETTER:
@@ -224,14 +226,21 @@ def _comparisons_section(comparisons: pd.DataFrame, levels: dict, alpha: float, 
             for _, r in rows.iterrows()
         ]
         level = levels.get(metric)
+        identical = int(rows["identical"].sum()) if "identical" in rows else 0
+        family = len(rows) - identical
         caption = (
             f"{SYMBOLS[metric]}: paired t-tests of run k of B against run k of A (the cells of a world share their "
-            f"seeds), {correction} over the study's {len(rows)} comparisons of {SYMBOLS[metric]} at \u03b1 = {alpha:g}"
+            f"seeds), {correction} over the study's {family} comparisons of {SYMBOLS[metric]} at \u03b1 = {alpha:g}"
+            + (f" ({identical} of identical runs left out)" if identical else "")
             + (f"; intervals {level.label}" if level is not None else "")
             + "."
         )
         parts.append(h.table(header, body, caption=caption))
-    return "\n".join(parts)
+    rule = (
+        f"The correction ({correction}) runs per metric over every axis step, combination of the other axes and "
+        f"world of the study: one family. {IDENTICAL_RULE}"
+    )
+    return h.notes([rule]) + "\n" + "\n".join(parts)
 
 
 def _summary_lines(comparisons: pd.DataFrame, table: pd.DataFrame, cells: list[Cell]) -> list[str]:
@@ -239,7 +248,11 @@ def _summary_lines(comparisons: pd.DataFrame, table: pd.DataFrame, cells: list[C
     if comparisons.empty:
         return [*lines, "no paired comparisons yet"]
     significant = comparisons[comparisons["verdict"].isin((A_BETTER, B_BETTER))]
-    lines.append(f"{len(significant)} of {len(comparisons)} paired comparisons significant after correction")
+    identical = int(comparisons["identical"].sum())
+    lines.append(
+        f"{len(significant)} of {len(comparisons)} paired comparisons significant after correction"
+        + (f" ({identical} of identical runs, left out of the correction)" if identical else "")
+    )
     for _, r in significant.iterrows():
         unit = UNITS[r["metric"]]
         lines.append(

@@ -14,7 +14,8 @@ from slamtrials.study.config import value_text
 __all__ = ["cells_table", "CELL_COLUMNS", "finished_runs"]
 
 #: Columns of :func:`cells_table` after ``cell`` and the axis keys (errors in m and rad, CPU in s, memory
-#: in MiB, update times in ms; intervals at the cell's confidence).
+#: in MiB, update times in ms; intervals at the cell's confidence; the mean coverage at the end, 0..1, and
+#: the mean simulated time, s, and distance, m, to 90 % and 99 % coverage over the runs that reached it).
 CELL_COLUMNS = (
     "world",
     "status",
@@ -32,6 +33,11 @@ CELL_COLUMNS = (
     "update_ms_median_mean",
     "run_cpu_s_mean",
     "run_peak_mib_mean",
+    "coverage_final_mean",
+    "time_to_90_s_mean",
+    "distance_to_90_m_mean",
+    "time_to_99_s_mean",
+    "distance_to_99_m_mean",
 )
 
 

@@ -85,3 +85,45 @@ def test_usage_of_a_rusage_is_seconds_and_mib():
         ru_maxrss = 2048 * 1024 if sys.platform == "darwin" else 2048  # 2 MiB
 
     assert usage_of(Rusage()) == ProcessUsage(cpu_s=1.5, peak_mib=2.0)
+
+
+def _fresh_kernel():
+    """A numba kernel made anew (never in the on-disk cache), so its first call compiles."""
+    import numba
+
+    source = "def kernel(x):\n    total = 0.0\n    for v in x:\n        total += v * v\n    return total\n"
+    namespace: dict = {}
+    exec(compile(source, f"<kernel {time.perf_counter_ns()}>", "exec"), namespace)
+    return numba.njit(cache=False)(namespace["kernel"])
+
+
+def test_compiling_in_a_call_is_left_out_of_the_cpu_figures_and_given_apart():
+    kernel = _fresh_kernel()
+    meter = CostMeter(memory=False)
+    mark = meter.enter()
+    started = time.thread_time()
+    kernel(np.ones(10))  # compiles: tens to hundreds of ms
+    _busy(0.02)
+    inside = time.thread_time() - started
+    meter.leave(mark)
+    cost = meter.finish()
+    assert cost.compile_cpu_s > 0.02  # numba's compile of even a tiny kernel takes longer than that
+    assert cost.slam_cpu_s == pytest.approx(inside - cost.compile_cpu_s, abs=0.005)
+    assert 0.02 <= cost.slam_cpu_s < 0.02 + 0.01
+    assert cost.run_cpu_s < cost.slam_cpu_s + 0.02  # the compile is out of the run's figure too
+    warm = CostMeter(memory=False)
+    mark = warm.enter()
+    kernel(np.ones(10))  # compiled already
+    warm.leave(mark)
+    assert warm.finish().compile_cpu_s == 0.0
+
+
+def test_a_compile_in_another_thread_is_not_this_run_s():
+    import threading
+
+    kernel = _fresh_kernel()
+    meter = CostMeter(memory=False)
+    other = threading.Thread(target=kernel, args=(np.ones(10),))
+    other.start()
+    other.join()
+    assert meter.finish().compile_cpu_s == 0.0

@@ -6,6 +6,9 @@ the machine code from the cache (``__pycache__`` next to the source, or ``NUMBA_
 fraction of a second. numba announces a compile through its ``"numba:compile"`` event, which fires
 only on a cache miss, so listening to it tells a compiling run from a cached one exactly.
 
+:class:`CompileTimer` adds up the CPU time one thread spends compiling, so that what a run costs can be
+told apart from what its first call in a fresh process paid to compile (:mod:`slamtrials.costmeter`).
+
 Library code does not print: this module logs each compile (INFO for the kernels a caller asked for,
 DEBUG for the kernels they call) and hands the first one to a callback; the CLI decides what to say.
 """
@@ -15,11 +18,12 @@ from __future__ import annotations
 import logging
 import threading
 import time
+import weakref
 from collections.abc import Callable
 
 from numba.core import event
 
-__all__ = ["watch_compilation"]
+__all__ = ["watch_compilation", "CompileTimer"]
 
 log = logging.getLogger(__name__)
 
@@ -83,3 +87,50 @@ def watch_compilation(on_first_compile: Callable[[str], None] | None = None) -> 
     listener = _CompileListener(on_first_compile)
     event.register("numba:compile", listener)
     return lambda: event.unregister("numba:compile", listener)
+
+
+class _ThreadCompileListener(event.Listener):
+    """Adds the thread CPU time of one thread's outermost compiles to ``seconds``."""
+
+    def __init__(self, thread: int) -> None:
+        self._thread = thread
+        self._depth = 0
+        self._started = 0.0
+        self.seconds = 0.0
+
+    def on_start(self, ev) -> None:
+        if threading.get_ident() != self._thread:
+            return
+        if self._depth == 0:
+            self._started = time.thread_time()
+        self._depth += 1
+
+    def on_end(self, ev) -> None:
+        if threading.get_ident() != self._thread or self._depth == 0:
+            return
+        self._depth -= 1
+        if self._depth == 0:
+            self.seconds += time.thread_time() - self._started
+
+
+class CompileTimer:
+    """The thread CPU seconds the thread that made it spends in numba compiles (cache misses) while it listens.
+
+    Nested compiles (a kernel compiling the kernels it calls) count once, from the outermost one's start to
+    its end; compiles in other threads are not counted. :attr:`seconds` is the total so far; :meth:`stop`
+    stops listening (so does the timer's garbage collection).
+    """
+
+    def __init__(self) -> None:
+        self._listener = _ThreadCompileListener(threading.get_ident())
+        event.register("numba:compile", self._listener)
+        self._stop = weakref.finalize(self, event.unregister, "numba:compile", self._listener)
+
+    @property
+    def seconds(self) -> float:
+        """Thread CPU seconds spent compiling so far."""
+        return self._listener.seconds
+
+    def stop(self) -> None:
+        """Stop listening; :attr:`seconds` keeps its total."""
+        self._stop()

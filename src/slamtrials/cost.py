@@ -72,7 +72,8 @@ class RunCost:
     ----------
     slam_cpu_s:
         CPU seconds (user + system) of the SLAM algorithm. In-process: the thread's CPU time inside the
-        algorithm's calls (building it, ``reset``, ``process``, ``occupancy``, ``trajectory``); an external
+        algorithm's calls (building it, ``reset``, ``process``, ``occupancy``, ``trajectory``), less the time
+        they spent compiling numba kernels (``compile_cpu_s``); an external
         program: the child process's CPU time (its ``rusage``, with the descendants it waited for).
     slam_peak_mib:
         Peak memory of the SLAM algorithm (MiB). In-process: the most resident memory the algorithm's
@@ -82,8 +83,8 @@ class RunCost:
         counts loading the algorithm's compiled kernels (:mod:`slamtrials.costmeter`). An external program: the child's
         peak resident set size (``ru_maxrss``), its interpreter and libraries included.
     run_cpu_s:
-        CPU seconds of the whole run: the thread that ran it (simulator, SLAM, explorer, coverage) plus,
-        for an external program, the child's.
+        CPU seconds of the whole run: the thread that ran it (simulator, SLAM, explorer, coverage; compiles
+        left out) plus, for an external program, the child's.
     run_peak_mib:
         Peak resident set size of the process that ran the run, during the run (MiB; the Python runtime
         and the loaded libraries included), plus an external program's own peak.
@@ -96,6 +97,10 @@ class RunCost:
     slam_process:
         Where the SLAM algorithm ran: :data:`IN_PROCESS` or :data:`CHILD_PROCESS` (an external program),
         which says what ``slam_cpu_s`` and ``slam_peak_mib`` measure.
+    compile_cpu_s:
+        CPU seconds the run's thread spent compiling numba kernels that were not in numba's on-disk cache
+        (0 on a warm cache; None where not measured). They are left out of ``slam_cpu_s`` and ``run_cpu_s``;
+        a run that compiled has its peak memory figures raised by the compiler's memory.
     """
 
     slam_cpu_s: float | None
@@ -106,6 +111,7 @@ class RunCost:
     update_ms_p90: float | None = None
     updates_timed: int = 0
     slam_process: str = IN_PROCESS
+    compile_cpu_s: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON form stored in run.json under :data:`COST_KEY` (``format`` first)."""

@@ -18,6 +18,12 @@ Resident memory is the process's, not one thread's: a process that runs two runs
 thread per worker process). Nothing measured here reaches the simulation or the algorithm: the meter
 only reads clocks and kernel counters around the calls, so results stay the same bit for bit.
 
+CPU time spent compiling numba kernels in the run's thread (a cold on-disk cache: the first run of a fresh
+install, or of a kernel whose source changed) is left out of both CPU figures and given apart
+(:attr:`~slamtrials.cost.RunCost.compile_cpu_s`, :class:`~slamtrials.compilewatch.CompileTimer`): it is
+what the install pays once, not what the run costs. Its memory cannot be told apart: a run that compiled
+reads high in peak memory.
+
 Cost: about 15 us per measured call (two reads of ``/proc/self/status``, one write), one call a frame in a
 trial (``process`` and ``occupancy`` together): under 0.5 % of a trial (bench/bench_cost.py).
 """
@@ -32,6 +38,7 @@ import weakref
 from dataclasses import dataclass
 from typing import Any
 
+from slamtrials.compilewatch import CompileTimer
 from slamtrials.cost import CHILD_PROCESS, IN_PROCESS, MIB, ProcessUsage, RunCost, update_times_ms
 
 __all__ = ["CostMeter", "CallMark", "usage_of", "ResidentMemory", "release_free_heap"]
@@ -113,11 +120,12 @@ def _kib(text: bytes, key: bytes) -> int:
 
 @dataclass(frozen=True)
 class CallMark:
-    """When a measured SLAM call began: the thread's CPU clock (s) and the process's resident set size
-    (KiB; None when memory is not measured)."""
+    """When a measured SLAM call began: the thread's CPU clock (s), the process's resident set size (KiB;
+    None when memory is not measured) and the thread's compile time so far (s)."""
 
     cpu: float
     resident_kib: int | None = None
+    compile_s: float = 0.0
 
 
 class CostMeter:
@@ -157,6 +165,7 @@ class CostMeter:
         self._slam_cpu = 0.0
         self._calls = 0
         self._updates: list[float] = []
+        self._compile = CompileTimer()
         self._started_cpu = time.thread_time()
 
     def _observe(self) -> tuple[int, int]:
@@ -172,13 +181,14 @@ class CostMeter:
         if self._memory is not None:
             _, resident = self._observe()  # the peak of the stretch since the last call belongs to the run
             self._memory.reset()
-        return CallMark(time.thread_time(), resident)
+        return CallMark(time.thread_time(), resident, self._compile.seconds)
 
     def leave(self, mark: CallMark, *, update_seconds: float | None = None) -> None:
         """End measuring the call begun at ``mark``. ``update_seconds``: the wall time (s) of the SLAM update
         the call made (the caller times ``process`` itself), counted towards
         :attr:`~slamtrials.cost.RunCost.update_ms_median`; None: the call made no update."""
-        self._slam_cpu += time.thread_time() - mark.cpu
+        compiling = self._compile.seconds - mark.compile_s
+        self._slam_cpu += time.thread_time() - mark.cpu - compiling
         self._calls += 1
         if update_seconds is not None:
             self._updates.append(update_seconds)
@@ -194,7 +204,9 @@ class CostMeter:
         and the run's include it. ``in_child``: the SLAM algorithm ran in a child process whose usage is
         unknown (``child`` None): the SLAM figures are None rather than those of the calls.
         """
-        run_cpu = time.thread_time() - self._started_cpu
+        self._compile.stop()
+        compile_cpu = self._compile.seconds
+        run_cpu = time.thread_time() - self._started_cpu - compile_cpu
         run_peak = slam_peak = None
         if self._memory is not None:
             self._observe()
@@ -208,6 +220,7 @@ class CostMeter:
             "update_ms_median": median,
             "update_ms_p90": p90,
             "updates_timed": len(self._updates),
+            "compile_cpu_s": compile_cpu,
         }
         if child is None and not in_child:
             return RunCost(self._slam_cpu, slam_peak, run_cpu, run_peak, **common, slam_process=IN_PROCESS)

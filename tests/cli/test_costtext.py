@@ -21,6 +21,9 @@ def test_a_run_s_cost_line():
     assert run_cost_text(program) == "cost: the program's process 1.5 s CPU, 30 MiB; whole run 2.0 s CPU, 300 MiB peak"
     assert run_cost_text(RunCost(0.5, None, 0.7, None)) == "cost: SLAM 0.5 s CPU, -; whole run 0.7 s CPU, - peak"
     assert run_cost_text(None) == "cost: not measured"
+    cold = RunCost(11.46, 152.2, 14.7, 502.3, 74.7, 162.4, updates_timed=282, compile_cpu_s=48.53)
+    assert run_cost_text(cold).endswith("whole run 15 s CPU, 502 MiB peak; 49 s CPU compiling kernels, left out")
+    assert "compiling" not in run_cost_text(RunCost(0.5, None, 0.7, None, compile_cpu_s=0.0))
 
 
 def test_the_worlds_cost_line_skips_worlds_without_one():

@@ -23,7 +23,8 @@ def _update_text(median: float | None, p90: float | None) -> str | None:
 
 
 def run_cost_text(cost: RunCost | None) -> str:
-    """``cost: SLAM 6.4 s CPU, 52 MiB, 25 ms per update (p90 41 ms); whole run 8.6 s CPU, 280 MiB``."""
+    """``cost: SLAM 6.4 s CPU, 52 MiB, 25 ms per update (p90 41 ms); whole run 8.6 s CPU, 280 MiB peak``, and
+    ``; 48 s CPU compiling kernels, left out`` after it when the run compiled numba kernels."""
     if cost is None:
         return "cost: not measured"
     who = "the program's process" if cost.slam_process == CHILD_PROCESS else "SLAM"
@@ -31,10 +32,13 @@ def run_cost_text(cost: RunCost | None) -> str:
     update = _update_text(cost.update_ms_median, cost.update_ms_p90)
     if update:
         parts.append(update)
-    return (
+    line = (
         f"cost: {who} {', '.join(parts)}; whole run {_round(cost.run_cpu_s, 's')} CPU, "
         f"{_round(cost.run_peak_mib, 'MiB')} peak"
     )
+    if cost.compile_cpu_s:
+        line += f"; {_round(cost.compile_cpu_s, 's')} CPU compiling kernels, left out"
+    return line
 
 
 def world_cost_line(rows: Iterable) -> str | None:

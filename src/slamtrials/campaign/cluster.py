@@ -6,6 +6,10 @@
 * ``scheduler="tcp://host:8786"``: a running Dask scheduler (e.g. one started by dask-jobqueue on
   SLURM, or ``dask scheduler`` + ``dask worker``). Its workers must see the campaign folder at the same
   path (a shared filesystem) and have slamtrials installed.
+* ``scheduler="path/to/scheduler.json"``: the same, found through the file that ``dask scheduler
+  --scheduler-file`` writes (the workers take ``--scheduler-file`` too): no address to pass around, and
+  the scheduler may listen on any free port (``--port 0``). The file is waited for, as ``dask worker``
+  waits for it, up to the connection timeout.
 * ``scheduler=<distributed.Client>``: used as it is, and left open.
 """
 
@@ -15,13 +19,14 @@ import logging
 import os
 import signal
 import threading
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
 from slamtrials.errors import ConfigError
 
-__all__ = ["dask_client", "check_workers", "CONNECT_TIMEOUT"]
+__all__ = ["dask_client", "check_workers", "is_scheduler_file", "CONNECT_TIMEOUT"]
 
 log = logging.getLogger(__name__)
 
@@ -36,6 +41,30 @@ def check_workers(workers: int | None) -> int:
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ConfigError(f"workers must be a positive integer, got {workers!r}")
     return workers
+
+
+def is_scheduler_file(scheduler: Any) -> bool:
+    """Whether ``scheduler`` names a scheduler file (a path ending in ``.json``) rather than an address."""
+    if isinstance(scheduler, os.PathLike):
+        return True
+    return isinstance(scheduler, str) and "://" not in scheduler and scheduler.lower().endswith(".json")
+
+
+def _connect(scheduler: Any, timeout: float) -> Any:
+    """A ``distributed.Client`` of a running scheduler, by address or by scheduler file."""
+    from distributed import Client
+
+    if not is_scheduler_file(scheduler):
+        return Client(str(scheduler), timeout=timeout)
+    path = os.fspath(scheduler)
+    deadline = time.monotonic() + timeout
+    while not os.path.isfile(path):  # the scheduler may be starting: wait for its file, as dask worker does
+        if time.monotonic() > deadline:
+            raise OSError(
+                f"no scheduler file {path} after {timeout:g} s (start dask scheduler --scheduler-file {path})"
+            )
+        time.sleep(0.1)
+    return Client(scheduler_file=path, timeout=timeout)
 
 
 @contextmanager
@@ -80,9 +109,9 @@ def dask_client(
         return
     if scheduler is not None:
         try:
-            client = Client(str(scheduler), timeout=timeout or CONNECT_TIMEOUT)
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise ConfigError(f"cannot connect to the Dask scheduler {scheduler!r}: {exc}") from None
+            client = _connect(scheduler, timeout or CONNECT_TIMEOUT)
+        except (OSError, TimeoutError, ValueError, KeyError) as exc:
+            raise ConfigError(f"cannot connect to the Dask scheduler {str(scheduler)!r}: {exc}") from None
         log.info("connected to Dask scheduler %s", scheduler)
         try:
             yield client

@@ -35,7 +35,9 @@ EXIT_INTERRUPTED = 130
 SchedulerOpt = Annotated[
     str | None,
     typer.Option(
-        "--scheduler", help="Address of a running Dask scheduler (e.g. tcp://host:8786); default: a local cluster."
+        "--scheduler",
+        help="Address of a running Dask scheduler (e.g. tcp://host:8786) or its scheduler file (a .json written by "
+        "dask scheduler --scheduler-file); default: a local cluster.",
     ),
 ]
 WorkersOpt = Annotated[

@@ -127,7 +127,8 @@ def slam(
         int | None, typer.Option("--workers", help="Local Dask workers for --runs (default: one per core).")
     ] = None,
     scheduler: Annotated[
-        str | None, typer.Option("--scheduler", help="Address of a running Dask scheduler for --runs.")
+        str | None,
+        typer.Option("--scheduler", help="Address (or scheduler file, .json) of a running Dask scheduler for --runs."),
     ] = None,
 ) -> None:
     """Run a SLAM algorithm (--algorithm) or program (--program) over a recording and write its

@@ -108,7 +108,11 @@ def run(
     ] = None,
     scheduler: Annotated[
         str | None,
-        typer.Option("--scheduler", help="Address of a running Dask scheduler; default: a local cluster."),
+        typer.Option(
+            "--scheduler",
+            help="Address of a running Dask scheduler (tcp://host:8786) or its scheduler file (a .json written by "
+            "dask scheduler --scheduler-file); default: a local cluster.",
+        ),
     ] = None,
     workers: Annotated[
         int | None,

@@ -115,7 +115,10 @@ def validate(
         int, typer.Option("--workers", help="Replicas at a time: 1 runs them here, more on a local Dask cluster.")
     ] = 1,
     scheduler: Annotated[
-        str | None, typer.Option("--scheduler", help="Address of a running Dask scheduler for the replicas.")
+        str | None,
+        typer.Option(
+            "--scheduler", help="Address (or scheduler file, .json) of a running Dask scheduler for the replicas."
+        ),
     ] = None,
     split: Annotated[
         bool,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from html.parser import HTMLParser
 from pathlib import Path
 
@@ -15,9 +16,11 @@ from slamtrials.campaign import CampaignConfig, run_campaign
 from slamtrials.campaign.testing import FakeTrial
 from slamtrials.errors import ConfigError, FormatError, SimulationError
 from slamtrials.report import html as h
-from slamtrials.report.build import build_report, compare_report, parse_run
+from slamtrials.report.build import build_report
 from slamtrials.report.compare import A_BETTER, B_BETTER, NO_DIFFERENCE
+from slamtrials.report.compare_page import compare_report
 from slamtrials.report.load import load_campaign
+from slamtrials.report.sampling_check import parse_run
 from slamtrials.report.tables import share_percent
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -156,6 +159,13 @@ def test_report_page_has_table_one_and_every_figure(campaign, report):
     assert [(r[0], int(r[1]), int(r[2])) for r in runs] == list(
         zip(data.runs["world"], data.runs["run"], data.runs["seed"])
     )
+
+
+def test_the_table_of_contents_lists_every_section_in_page_order(report):
+    path, _ = report
+    text = path.read_text(encoding="utf-8")
+    anchors = re.findall(r'href="#([^"]+)"', re.search(r"<nav>(.*?)</nav>", text).group(1))
+    assert anchors == re.findall(r'<section id="([^"]+)">', text) and len(anchors) == 13
 
 
 def test_report_notes_provenance_and_escaping(campaign, report):

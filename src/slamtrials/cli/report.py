@@ -172,7 +172,8 @@ def compare(
     from slamtrials.campaign.differences import campaign_differences
     from slamtrials.cli.campaign import print_differences
     from slamtrials.errors import ConfigError
-    from slamtrials.report.build import REPORT_DIR, compare_report, trap_sentences
+    from slamtrials.report.build import REPORT_DIR
+    from slamtrials.report.compare_page import compare_report, trap_sentences
 
     if not (0.0 < alpha < 1.0):
         raise ConfigError(f"--alpha must be strictly between 0 and 1, got {alpha}")

@@ -37,6 +37,7 @@ from slamtrials.report.compare import (
 )
 from slamtrials.report.tables import (
     OUTLIER_IQR,
+    UNITS,
     check_metric,
     require_columns,
     world_outliers,
@@ -57,12 +58,12 @@ __all__ = [
     "draw_termination",
     "draw_explored",
     "draw_comparison",
+    "draw_trap_pair",
     "METRIC_LABELS",
 ]
 
 #: Axis labels of the metrics, with units.
 METRIC_LABELS = {"eps_t": "translational error \u03b5t (m)", "eps_r": "rotational error \u03b5r (rad)"}
-UNITS = {"eps_t": "m", "eps_r": "rad"}
 VERDICT_COLORS = {B_BETTER: "tab:green", A_BETTER: "tab:red", NO_DIFFERENCE: "tab:gray", TOO_FEW: "lightgray"}
 GOLDEN = 0.6180339887498949
 
@@ -619,3 +620,34 @@ def draw_comparison(ax, comparison: Comparison, metric: str = "eps_t") -> None:
         fontsize=8,
     )
     ax.legend(fontsize=7, loc="best")
+
+
+def draw_trap_pair(
+    ax,
+    low: NDArray[np.float64],
+    high: NDArray[np.float64],
+    labels: tuple[str, str],
+    i_low: int,
+    i_high: int,
+    metric: str = "eps_t",
+    colors: tuple[str, str] = ("tab:blue", "tab:orange"),
+) -> None:
+    """Two samples of run errors side by side (``low``: lower mean) with their means and the most misleading
+    pair ringed (the paper's Fig. 6).
+
+    ``low`` and ``high`` are float64 ``[N]`` and ``[M]`` run errors of ``metric`` (m or rad), ``labels``
+    their names under the x axis. The pair ``(low[i_low], high[i_high])`` is the single-run comparison that
+    contradicts the means the most; it is joined by a dashed line (gid ``"trap"``) when it is reversed. The
+    means are lines with gids ``"mean:0"`` and ``"mean:1"``. ``colors`` are those of ``low`` and ``high``
+    (a comparison keeps one colour per campaign).
+    """
+    for x, values, color in ((0, low, colors[0]), (1, high, colors[1])):
+        offsets = ((np.arange(len(values)) * GOLDEN) % 1.0 - 0.5) * 0.35
+        ax.plot(x + offsets, values, "o", ms=4, color=color, alpha=0.75)
+        ax.plot([x - 0.3, x + 0.3], [values.mean()] * 2, color=color, lw=2.5, gid=f"mean:{x}")
+    if low[i_low] > high[i_high]:
+        ax.plot([0, 1], [low[i_low], high[i_high]], "k--", lw=1, gid="trap")
+        ax.plot([0, 1], [low[i_low], high[i_high]], "o", ms=11, mfc="none", mec="red", mew=1.8)
+    ax.set_xticks([0, 1], labels=list(labels), fontsize=8)
+    ax.set_xlim(-0.6, 1.6)
+    ax.set_ylabel(METRIC_LABELS[metric], fontsize=8)

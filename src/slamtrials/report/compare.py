@@ -53,7 +53,7 @@ from scipy import stats
 
 from slamtrials.report.combine import IntervalLevel, interval_level, stouffer
 from slamtrials.report.paired import PairedResult, paired_test
-from slamtrials.report.tables import METRICS, check_metric
+from slamtrials.report.tables import METRICS, UNITS, check_metric
 
 __all__ = [
     "Correction",
@@ -345,9 +345,6 @@ class Comparison:
     def for_metric(self, metric: str) -> pd.DataFrame:
         """The rows of ``table`` of one metric, indexed from 0."""
         return self.table[self.table["metric"] == metric].reset_index(drop=True)
-
-
-UNITS = {"eps_t": "m", "eps_r": "rad"}
 
 
 def _pairs(

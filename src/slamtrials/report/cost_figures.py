@@ -13,16 +13,14 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from slamtrials.report.tables import require_columns
+from slamtrials.report.tables import column_values, require_columns
 
 __all__ = ["draw_cost_per_world", "draw_update_times", "cost_values"]
 
 
 def cost_values(runs: pd.DataFrame, column: str) -> NDArray[np.float64]:
-    """The float64 values ``[R]`` of ``column`` (NaN where missing; an absent column is all NaN)."""
-    if column not in runs.columns:
-        return np.full(len(runs), np.nan)
-    return pd.to_numeric(runs[column], errors="coerce").to_numpy(dtype=np.float64, na_value=np.nan)
+    """The float64 values ``[R]`` of cost figure ``column`` (NaN where missing; an absent column is all NaN)."""
+    return column_values(runs, column)
 
 
 def _positions(names: NDArray, order: list[str]) -> NDArray[np.float64]:

@@ -12,17 +12,23 @@ from __future__ import annotations
 import json
 import math
 from collections import Counter
-from typing import Any, Protocol
+from typing import Any
 
 import pandas as pd
 
+from slamtrials.campaign.detailmeans import mean_of
 from slamtrials.campaign.explorationsummary import ExplorationMeasures
 from slamtrials.io.layout import RunFolder
 from slamtrials.report import html as h
+from slamtrials.report.campaign_view import CampaignView
 from slamtrials.report.exploration_figures import draw_coverage_curves
+from slamtrials.report.figure_writer import FigureWriter
 from slamtrials.report.load import CampaignData
 
-__all__ = ["exploration_section", "read_exploration", "EXPLORATION_TEXT"]
+__all__ = ["exploration_section", "read_exploration", "EXPLORATION_TEXT", "SECTION_ID"]
+
+#: The section's anchor.
+SECTION_ID = "exploration"
 
 #: What the section's measures are, as the page explains them.
 EXPLORATION_TEXT = (
@@ -34,14 +40,6 @@ EXPLORATION_TEXT = (
     "reports exploration). In a replay they are the source runs' (the robot explored with the first "
     "algorithm's maps)."
 )
-
-
-class FigureSink(Protocol):
-    """Makes and saves figures for the page (the report's figure writer)."""
-
-    def new(self, width: float, height: float) -> Any: ...
-
-    def save(self, fig: Any, name: str, caption: str, *, id: str | None = None, alt: str | None = None) -> str: ...
 
 
 def read_exploration(data: CampaignData, done: pd.DataFrame) -> dict[str, dict[int, ExplorationMeasures]]:
@@ -59,22 +57,19 @@ def read_exploration(data: CampaignData, done: pd.DataFrame) -> dict[str, dict[i
     return found
 
 
-def _mean(values: list[float | None]) -> float | None:
-    kept = [v for v in values if v is not None]
-    return math.fsum(kept) / len(kept) if kept else None
-
-
 def _row(world: str, runs: dict[int, ExplorationMeasures]) -> list[Any]:
+    """The table's row of ``world``: runs, and per threshold how many reached it and their mean time (s) and
+    distance (m) to it; mean final coverage; how the runs ended."""
     measures = list(runs.values())
     cells: list[Any] = [world, h.Cell(str(len(measures)), numeric=True)]
     for threshold in (0.90, 0.99):
         reached = [m for m in measures if m.reached(threshold)]
         cells += [
             h.Cell(f"{len(reached)} of {len(measures)}", numeric=True),
-            h.Cell(h.fmt_seconds(_mean([m.time_to(threshold) for m in reached])), numeric=True),
-            h.Cell(h.fmt_number(_mean([m.distance_to(threshold) for m in reached]), 1), numeric=True),
+            h.Cell(h.fmt_seconds(mean_of(m.time_to(threshold) for m in reached)), numeric=True),
+            h.Cell(h.fmt_number(mean_of(m.distance_to(threshold) for m in reached), 1), numeric=True),
         ]
-    final = _mean([m.final_coverage for m in measures if math.isfinite(m.final_coverage)])
+    final = mean_of(m.final_coverage for m in measures if math.isfinite(m.final_coverage))
     reasons = Counter(m.termination_reason for m in measures)
     cells += [
         h.Cell("-" if final is None else f"{100 * final:.1f} %", numeric=True),
@@ -83,15 +78,21 @@ def _row(world: str, runs: dict[int, ExplorationMeasures]) -> list[Any]:
     return cells
 
 
-def exploration_section(figs: FigureSink, data: CampaignData, done: pd.DataFrame, worlds: list[str]) -> str:
-    """The section (HTML, ``id="exploration"``): the coverage curves of every world in ``worlds`` (the order
-    of Table I) and the table of the measures (``id="exploration-table"``)."""
+def exploration_section(view: CampaignView, figs: FigureWriter) -> str:
+    """The section (HTML, ``id="exploration"``): the coverage curves of every world (in the order of Table I)
+    that has measures, the table of the measures (``id="exploration-table"``), a note counting the runs
+    without them, then :data:`EXPLORATION_TEXT` collapsed (``id="exploration-note"``)."""
     title = "How fast the runs explored: coverage over time"
-    explain = f'<p class="explain" id="exploration-note">{h.esc(EXPLORATION_TEXT)}</p>'
-    found = read_exploration(data, done) if len(done) else {}
-    shown = [w for w in worlds if found.get(w)]
+    explain = h.details(
+        "How coverage, time and distance are measured",
+        h.explanation(EXPLORATION_TEXT, id="exploration-note"),
+        css_class="explain",
+    )
+    done = view.done
+    found = read_exploration(view.data, done) if len(done) else {}
+    shown = [w for w in view.worlds if found.get(w)]
     if not shown:
-        return h.section(title, explain, "<p>No finished run recorded exploration measures.</p>", id="exploration")
+        return h.section(title, "<p>No finished run recorded exploration measures.</p>", explain, id=SECTION_ID)
     columns = min(3, len(shown))
     rows = math.ceil(len(shown) / columns)
     fig = figs.new(4.2 * columns, 3.2 * rows)
@@ -133,4 +134,4 @@ def exploration_section(figs: FigureSink, data: CampaignData, done: pd.DataFrame
         if missing
         else ""
     )
-    return h.section(title, explain, note, picture, table, id="exploration")
+    return h.section(title, picture, table, note, explain, id=SECTION_ID)

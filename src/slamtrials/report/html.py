@@ -22,10 +22,16 @@ __all__ = [
     "fmt_number",
     "fmt_seconds",
     "fmt_duration",
+    "fmt_percent",
+    "number_cell",
+    "seconds_cell",
     "table",
+    "scrolling",
     "figure",
     "section",
     "notes",
+    "explanation",
+    "details",
     "pre",
     "definition_list",
     "page",
@@ -53,6 +59,7 @@ pre { background: #f6f8fa; padding: 0.8em; overflow-x: auto; font-size: 0.82em; 
 dl { display: grid; grid-template-columns: max-content auto; gap: 0.2em 1em; } dt { font-weight: 600; } dd { margin: 0; }
 nav { font-size: 0.9em; } nav a { margin-right: 0.9em; }
 details summary { cursor: pointer; color: #0645ad; }
+details.explain { margin: 0.3em 0 1.2em; } details.explain > summary { font-size: 0.9em; }
 .muted { color: #777; }
 p.explain { font-size: 0.88em; color: #333; max-width: 70em; }
 """
@@ -119,6 +126,14 @@ def fmt_duration(seconds: Any) -> str:
     return f"{minutes // 60} h {minutes % 60:02d} min"
 
 
+def fmt_percent(share: Any) -> str:
+    """A share (0..1) as a percentage with no needless digits: ``0.95`` -> ``95 %``; ``?`` when not a number."""
+    try:
+        return f"{100 * float(share):g} %"
+    except (TypeError, ValueError):
+        return "?"
+
+
 @dataclass(frozen=True)
 class Cell:
     """A table cell: ``text`` (escaped when rendered), or trusted ``markup``; ``numeric`` aligns it right."""
@@ -127,6 +142,17 @@ class Cell:
     numeric: bool = False
     markup: str | None = None
     title: str | None = None
+
+
+def number_cell(value: Any, digits: int = 3) -> Cell:
+    """A right-aligned cell of ``value`` with ``digits`` decimals (:func:`fmt_number`)."""
+    return Cell(fmt_number(value, digits), numeric=True)
+
+
+def seconds_cell(value: Any) -> Cell:
+    """A right-aligned cell of a time in seconds, or of a cost figure (s, ms or MiB), rounded by
+    :func:`fmt_seconds`: one decimal below 10, whole numbers above; ``-`` where not measured."""
+    return Cell(fmt_seconds(value), numeric=True)
 
 
 def _cell(value: Any, tag: str = "td") -> str:
@@ -169,6 +195,11 @@ def table(
     return "\n".join(out)
 
 
+def scrolling(markup: str) -> str:
+    """Trusted ``markup`` (a wide table) in a block as wide as the page that scrolls sideways when it is wider."""
+    return f'<div style="overflow-x:auto">{markup}</div>'
+
+
 def figure(
     png: str | PurePosixPath,
     caption: str,
@@ -200,6 +231,19 @@ def notes(items: Iterable[str], *, id: str | None = None) -> str:
         return ""
     ident = f' id="{attr(id)}"' if id else ""
     return f'<div class="notes"{ident}><ul>' + "".join(f"<li>{esc(i)}</li>" for i in items) + "</ul></div>"
+
+
+def explanation(text: str, *, id: str | None = None) -> str:
+    """A paragraph of explanatory prose (escaped), in the page's smaller explanatory style."""
+    ident = f' id="{attr(id)}"' if id else ""
+    return f'<p class="explain"{ident}>{esc(text)}</p>'
+
+
+def details(summary: str, *parts: str, id: str | None = None, css_class: str | None = None) -> str:
+    """A collapsed ``<details>`` block: ``summary`` (escaped) is what shows, the trusted ``parts`` open on a click."""
+    ident = f' id="{attr(id)}"' if id else ""
+    cls = f' class="{attr(css_class)}"' if css_class else ""
+    return f"<details{ident}{cls}><summary>{esc(summary)}</summary>" + "\n".join(p for p in parts if p) + "</details>"
 
 
 def pre(text: str, *, id: str | None = None) -> str:

@@ -8,13 +8,12 @@ whose world did not load, runs of earlier versions) are left out of the means an
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pandas as pd
 
 from slamtrials.metric.mapquality import DEFINITIONS, GHOST_TOLERANCE_CELLS, MAP_QUALITY_FIGURES, TOLERANCES_CELLS
 from slamtrials.report import html as h
+from slamtrials.report.tables import column_values, finite_mean
 
 __all__ = ["map_quality_section", "map_quality_values", "SECTION_ID", "TITLE"]
 
@@ -35,12 +34,11 @@ _HEADINGS = {
 
 def map_quality_values(runs: pd.DataFrame, name: str) -> np.ndarray:
     """float64 ``[R]``: figure ``name`` of every run (NaN where missing; an absent column is all NaN)."""
-    if name not in runs.columns:
-        return np.full(len(runs), np.nan)
-    return pd.to_numeric(runs[name], errors="coerce").to_numpy(dtype=np.float64, na_value=np.nan)
+    return column_values(runs, name)
 
 
 def _explanation() -> str:
+    """How the maps are placed and compared, and each figure's definition, in a collapsed block."""
     tolerances = " and ".join(str(k) for k in TOLERANCES_CELLS)
     intro = (
         "Each run's final SLAM map is placed on the floor plan by the least-squares rigid fit of its estimated "
@@ -55,28 +53,29 @@ def _explanation() -> str:
         f"<li><b>{h.esc(_HEADINGS[name])}</b> (<code>{h.esc(name)}</code>): {h.esc(DEFINITIONS[name])}</li>"
         for name in MAP_QUALITY_FIGURES
     )
-    return f'<p class="explain" id="map-quality-note">{h.esc(intro)}</p><ul id="map-quality-definitions">{items}</ul>'
-
-
-def _mean(values: np.ndarray) -> float:
-    finite = values[np.isfinite(values)]
-    return float(finite.mean()) if len(finite) else math.nan
+    return h.details(
+        "How the maps are scored, and what each column is",
+        h.explanation(intro, id="map-quality-note") + f'<ul id="map-quality-definitions">{items}</ul>',
+        css_class="explain",
+    )
 
 
 def map_quality_section(done: pd.DataFrame, worlds: list[str]) -> str:
-    """The section's HTML: definitions, then one row per world of ``worlds`` (in that order) with the number
-    of runs scored and the mean of each figure over them; ``done`` holds the finished runs."""
+    """The section's HTML: one row per world of ``worlds`` (in that order) with the number of runs scored and
+    the mean of each figure over them, then how the maps are scored and the definitions, collapsed; ``done``
+    holds the finished runs."""
     scored = np.zeros(len(done), dtype=bool)
     for name in MAP_QUALITY_FIGURES:
         scored |= np.isfinite(map_quality_values(done, name))
     if not scored.any():
-        return h.section(TITLE, _explanation(), "<p>No finished run recorded its map quality.</p>", id=SECTION_ID)
+        return h.section(TITLE, "<p>No finished run recorded its map quality.</p>", _explanation(), id=SECTION_ID)
     rows = []
     for world in worlds:
         mine = done[(done["world"] == world).to_numpy() & scored]
         cells = [
             h.Cell(
-                h.fmt_number(_mean(map_quality_values(mine, name)), 2 if name == "ghost_free_m2" else 3), numeric=True
+                h.fmt_number(finite_mean(map_quality_values(mine, name)), 2 if name == "ghost_free_m2" else 3),
+                numeric=True,
             )
             for name in MAP_QUALITY_FIGURES
         ]
@@ -90,4 +89,4 @@ def map_quality_section(done: pd.DataFrame, worlds: list[str]) -> str:
         "ghost area in m\u00b2 (lower is better)."
         + (f" {unscored} finished run(s) recorded none (no map, or a world that did not load)." if unscored else ""),
     )
-    return h.section(TITLE, _explanation(), table, id=SECTION_ID)
+    return h.section(TITLE, table, _explanation(), id=SECTION_ID)

@@ -15,6 +15,7 @@ the columns ``se_t`` and ``se_r`` (the catalog's details; absent for runs of ear
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 
 import numpy as np
@@ -27,8 +28,12 @@ from slamtrials.metric.stats import environment_stats
 
 __all__ = [
     "METRICS",
+    "UNITS",
+    "SYMBOLS",
     "OUTLIER_IQR",
     "require_columns",
+    "column_values",
+    "finite_mean",
     "check_metric",
     "outlier_mask",
     "world_outliers",
@@ -42,6 +47,10 @@ __all__ = [
 
 #: The per-run error columns: translational (m) and rotational (rad).
 METRICS = ("eps_t", "eps_r")
+#: The unit of each metric.
+UNITS = {"eps_t": "m", "eps_r": "rad"}
+#: How the pages write each metric: \u03b5t, \u03b5r.
+SYMBOLS = {"eps_t": "\u03b5t", "eps_r": "\u03b5r"}
 #: Tukey's fence factor of the outlier rule.
 OUTLIER_IQR = 1.5
 #: The column of each metric's per-run standard error (m, rad).
@@ -57,6 +66,20 @@ def require_columns(runs: pd.DataFrame, columns: Iterable[str], what: str = "run
     for column in columns:
         if column not in runs.columns:
             raise ValueError(f"{what} is missing the column '{column}' (it has: {', '.join(map(str, runs.columns))})")
+
+
+def column_values(runs: pd.DataFrame, column: str) -> NDArray[np.float64]:
+    """float64 ``[R]``: ``column`` of every run as a number (NaN where missing or not a number; an absent
+    column is all NaN), for the figures a run may not have recorded (cost, map quality)."""
+    if column not in runs.columns:
+        return np.full(len(runs), np.nan)
+    return pd.to_numeric(runs[column], errors="coerce").to_numpy(dtype=np.float64, na_value=np.nan)
+
+
+def finite_mean(values: NDArray[np.float64]) -> float:
+    """The mean of the finite values of ``values`` (float64 ``[N]``); NaN when none is finite."""
+    finite = values[np.isfinite(values)]
+    return float(finite.mean()) if len(finite) else math.nan
 
 
 def check_metric(runs: pd.DataFrame, metric: str, what: str = "runs") -> NDArray[np.float64]:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ast
+import functools
 from pathlib import Path
 
 import pytest
@@ -88,7 +89,7 @@ def _layer_of(path: Path) -> str:
 
 def _imported_layers(tree: ast.AST) -> set[str]:
     layers = set()
-    for node in ast.walk(tree):
+    for node in _nodes(tree):
         if isinstance(node, ast.Import):
             names = [alias.name for alias in node.names]
         elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
@@ -105,6 +106,18 @@ def _imported_layers(tree: ast.AST) -> set[str]:
 SOURCES = sorted(PACKAGE.rglob("*.py"))
 
 
+@functools.cache
+def _tree(path: Path) -> ast.Module:
+    """The module's syntax tree, parsed once for all the checks below (none changes it)."""
+    return ast.parse(path.read_text(encoding="utf-8"))
+
+
+@functools.cache
+def _nodes(tree: ast.AST) -> tuple[ast.AST, ...]:
+    """Every node of ``tree`` (``ast.walk``'s order), listed once for all the checks that walk it."""
+    return tuple(ast.walk(tree))
+
+
 @pytest.mark.parametrize("path", SOURCES, ids=lambda p: str(p.relative_to(PACKAGE)))
 def test_layer_imports_only_layers_above_it(path: Path) -> None:
     layer = _layer_of(path)
@@ -112,7 +125,7 @@ def test_layer_imports_only_layers_above_it(path: Path) -> None:
         return
     assert layer in ALLOWED or layer in UTILITIES, f"{path}: module outside the layers of DESIGN.md"
     allowed = ALLOWED.get(layer, set()) | UTILITIES | {layer}
-    imported = _imported_layers(ast.parse(path.read_text(encoding="utf-8")))
+    imported = _imported_layers(_tree(path))
     assert imported <= allowed, f"{path}: layer '{layer}' imports {sorted(imported - allowed)}"
 
 
@@ -120,8 +133,8 @@ def test_layer_imports_only_layers_above_it(path: Path) -> None:
     "path", [p for p in SOURCES if _layer_of(p) != "cli"], ids=lambda p: str(p.relative_to(PACKAGE))
 )
 def test_library_code_never_prints_exits_or_uses_global_random_state(path: Path) -> None:
-    tree = ast.parse(path.read_text(encoding="utf-8"))
-    for node in ast.walk(tree):
+    tree = _tree(path)
+    for node in _nodes(tree):
         if isinstance(node, ast.Call):
             func = node.func
             if isinstance(func, ast.Name):
@@ -140,8 +153,8 @@ def test_library_code_never_prints_exits_or_uses_global_random_state(path: Path)
     "path", [p for p in SOURCES if _layer_of(p) in COMPUTING], ids=lambda p: str(p.relative_to(PACKAGE))
 )
 def test_computing_layers_do_no_file_io_or_plotting(path: Path) -> None:
-    tree = ast.parse(path.read_text(encoding="utf-8"))
-    for node in ast.walk(tree):
+    tree = _tree(path)
+    for node in _nodes(tree):
         if isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
             assert node.func.id != "open", f"{path}:{node.lineno}: opens a file"
         if isinstance(node, (ast.Import, ast.ImportFrom)):
@@ -153,8 +166,8 @@ def test_computing_layers_do_no_file_io_or_plotting(path: Path) -> None:
     "path", [p for p in SOURCES if _layer_of(p) in REPRODUCIBLE], ids=lambda p: str(p.relative_to(PACKAGE))
 )
 def test_reproducible_layers_take_transcendental_functions_from_stablemath(path: Path) -> None:
-    tree = ast.parse(path.read_text(encoding="utf-8"))
-    for node in ast.walk(tree):
+    tree = _tree(path)
+    for node in _nodes(tree):
         if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id in {"np", "numpy"}:
             assert node.attr not in MACHINE_DEPENDENT, (
                 f"{path}:{node.lineno}: np.{node.attr} differs between machines; use slamtrials.stablemath "
@@ -207,8 +220,8 @@ _RESULT_CHANGING_FASTMATH = {"fast", "reassoc", "contract", "afn", "arcp"}
 
 @pytest.mark.parametrize("path", SOURCES, ids=lambda p: str(p.relative_to(PACKAGE)))
 def test_numba_kernels_use_no_result_changing_fast_math(path: Path) -> None:
-    tree = ast.parse(path.read_text(encoding="utf-8"))
-    for node in ast.walk(tree):
+    tree = _tree(path)
+    for node in _nodes(tree):
         if isinstance(node, ast.keyword) and node.arg == "fastmath":
             flags = ast.literal_eval(node.value)
             assert flags is not True, f"{path}:{node.value.lineno}: fastmath=True reassociates and contracts"
@@ -246,7 +259,7 @@ def ordering_problems(tree: ast.AST) -> list[str]:
       the order of strings changes with PYTHONHASHSEED; iterate ``sorted(...)`` instead.
     """
     problems = []
-    for node in ast.walk(tree):
+    for node in _nodes(tree):
         if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute):
             name = node.func.attr
             keywords = {k.arg: k.value for k in node.keywords}
@@ -290,7 +303,7 @@ ORDERED = REPRODUCIBLE | {"report"}
     "path", [p for p in SOURCES if _layer_of(p) in ORDERED], ids=lambda p: str(p.relative_to(PACKAGE))
 )
 def test_reproducible_layers_order_ties_by_rule_not_by_sort_implementation(path: Path) -> None:
-    problems = ordering_problems(ast.parse(path.read_text(encoding="utf-8")))
+    problems = ordering_problems(_tree(path))
     assert not problems, f"{path}:" + f"\n{path}:".join(problems)
 
 
@@ -328,7 +341,7 @@ def _numba_compilers_imported(tree: ast.AST) -> set[str]:
     """The local names of numba's compiling decorators imported with ``from numba... import``."""
     return {
         alias.asname or alias.name
-        for node in ast.walk(tree)
+        for node in _nodes(tree)
         if isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] == "numba"
         for alias in node.names
         if alias.name in _NUMBA_COMPILERS
@@ -346,11 +359,11 @@ def _numba_compiler(func: ast.expr, imported: set[str]) -> bool:
 def test_numba_kernels_are_module_level_and_cached(path: Path) -> None:
     """A kernel compiles once per install, not once per process: cache=True, and at module level (numba
     cannot cache a closure or a kernel made inside a function, nor one compiled by calling njit(f))."""
-    tree = ast.parse(path.read_text(encoding="utf-8"))
+    tree = _tree(path)
     imported = _numba_compilers_imported(tree)
     top_level = {id(node) for node in tree.body}
-    decorators = {id(d) for node in ast.walk(tree) if isinstance(node, ast.FunctionDef) for d in node.decorator_list}
-    for node in ast.walk(tree):
+    decorators = {id(d) for node in _nodes(tree) if isinstance(node, ast.FunctionDef) for d in node.decorator_list}
+    for node in _nodes(tree):
         if isinstance(node, ast.FunctionDef):
             for decorator in node.decorator_list:
                 call = decorator if isinstance(decorator, ast.Call) else None

@@ -177,7 +177,9 @@ class LaserConfig(BaseModel):
         ``range_noise_std + range_noise_per_m * range``. Default 0.
     short_rate:
         Probability per beam that something not in the map (a person, a chair leg, glass) returns the beam
-        early: the reading is drawn uniformly between ``min_range`` and the true range. Default 0.
+        early, where it stands as ``short_position_power`` says (uniformly between ``min_range`` and the
+        true range by default); with ``short_range_scale`` the top of a chance that rises with the range.
+        Default 0.
     short_run_beams:
         Mean length (beams) of a run of neighbouring short readings: such things are wider than a beam,
         so real short readings come in runs (fitted: 5 to 7 beams of 0.5 degree in the shared logs). 0 (the
@@ -197,7 +199,8 @@ class LaserConfig(BaseModel):
     short_range_scale, short_range_shape:
         How the chance of a short reading grows with the range ``r`` of the beam's wall
         (:mod:`slamtrials.sim.shortrate`): ``short_rate (1 - exp(-(r / scale)^shape))``. Scale 0 (the
-        default): ``short_rate`` on every beam. Real logs: a scale of about 4.5 m and a shape of 1.4 to 1.5.
+        default): ``short_rate`` on every beam. The shared logs' fits: a scale of about 4 m, a shape of 1.2
+        to 1.6.
     short_position_power:
         Where a short reading's thing stands (:mod:`slamtrials.sim.shortdistance`): its position as a
         fraction ``v`` of the beam from ``min_range`` to the wall has density ``(a + 1) v^a``. 0 (the
@@ -210,8 +213,8 @@ class LaserConfig(BaseModel):
         Readings at depth edges (:mod:`slamtrials.sim.edges`): a beam with a neighbour within ``edge_reach``
         (rad) to either side whose wall is more than 0.3 m nearer reads that nearer wall with probability
         ``edge_chance``. Default 0 (off). A laser whose beams are farther apart than ``edge_reach`` has no
-        such neighbours (its spot does not reach the next beam), so the model does nothing there. Real logs:
-        about 0.14 within 1 degree.
+        such neighbours (its spot does not reach the next beam), so the model does nothing there. The shared
+        logs' fits: 0.15 to 0.20 within 1 degree.
 
     See :mod:`slamtrials.sim.laser_errors` for the order of the draws.
     """

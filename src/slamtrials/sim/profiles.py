@@ -156,7 +156,7 @@ def _realistic(mit: ErrorProfile, fr079: ErrorProfile) -> ErrorProfile:
     One exception: the short readings' persistence (``short_lifetime``, ``short_fleeting_share``) stays
     off, each scan's short readings drawn anew. The explorer takes the things that stay for obstacles
     (which the simulator leaves at random places, not where real things stand): with them, trials explore
-    1.5 to 2 times as long in simulated time (docs/realism.md, "Profiles"). Add them in a config to study it.
+    1.4 to 1.7 times as long in simulated time (docs/realism.md, "Profiles"). Add them in a config to study it.
     """
     pooled = mean_profile(
         "realistic",

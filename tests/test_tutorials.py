@@ -45,6 +45,35 @@ def test_cluster(tmp_path):
     assert "office_small_01" in summary and ",5," in summary.replace(" ", "")
 
 
+def _catalog(study: Path) -> dict:
+    """Per cell of a study: every run's seed, status and errors, and every world's status and run counts."""
+    from slamtrials.campaign.store import CampaignStore
+
+    found = {}
+    for cell in sorted((study / "cells").iterdir()):
+        with CampaignStore.open(cell) as store:
+            runs = {(r.world, r.idx): (r.seed, r.status, r.eps_t, r.eps_r) for r in store.runs()}
+            worlds = {w.name: (w.status, w.runs_target, w.runs_needed) for w in store.worlds()}
+        found[cell.name] = (runs, worlds)
+    return found
+
+
+@pytest.mark.slow
+def test_cluster_study(tmp_path):
+    """The page's tiny study on a dask scheduler and two dask workers (the driver and one worker killed on
+    the way, then resumed) equals the same study on a local cluster, bit for bit in the errors."""
+    _run(TUTORIALS / "cluster-study.md", tmp_path)
+    study = tmp_path / "studies" / "tiny"
+    assert (study / "report" / "index.html").is_file() and (study / "report" / "comparisons.csv").is_file()
+    assert (tmp_path / "host-a.log").is_file() and (tmp_path / "host-b.log").is_file()
+    local = [str(Path(sys.executable).parent / "slamtrials"), "study", "run", "tiny-study.yaml", "--workers", "2"]
+    done = subprocess.run([*local, "--out", "studies/local"], cwd=tmp_path, capture_output=True, text=True)
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    ours, theirs = _catalog(study), _catalog(tmp_path / "studies" / "local")
+    assert ours == theirs
+    assert sum(len(runs) for runs, _ in ours.values()) == 2 * 2 * 5  # 2 cells x 2 worlds x 5 runs, all done
+
+
 SHARED = Path(os.environ.get("SLAMTRIALS_SHARED", REPO.parent / "shared"))
 
 

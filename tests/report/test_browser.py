@@ -87,6 +87,8 @@ window.addEventListener("load", function () {
   body.setAttribute("data-images-loaded", String(images.length - broken.length));
   body.setAttribute("data-broken", broken.map(function (img) { return img.getAttribute("src"); }).join(" "));
   body.setAttribute("data-summary-rows", String(table ? table.tBodies[0].rows.length : -1));
+  // Table I inside its sideways-scrolling box: how much wider than the box it is (0: it fits, no scrolling)
+  body.setAttribute("data-summary-hidden", String(table ? table.parentElement.scrollWidth - table.parentElement.clientWidth : -1));
   body.setAttribute("data-viewport", String(width));
   body.setAttribute("data-overflow", overflowing());
   body.setAttribute("data-scroll-width", String(document.documentElement.scrollWidth));
@@ -200,6 +202,8 @@ def test_nothing_is_wider_than_a_1400_px_window(report, tmp_path):
     # blocks closed (as the page opens) and open
     assert found["overflow"] == "" and int(found["scroll-width"]) <= WIDTH, found
     assert found["overflow-open"] == "" and int(found["scroll-width-open"]) <= WIDTH, found
+    # Table I is read whole at that width: its box need not scroll sideways
+    assert int(found["summary-hidden"]) == 0, f"Table I is {found['summary-hidden']} px wider than the page"
 
 
 def test_long_explanations_are_collapsed_after_the_figures(report, tmp_path):

@@ -39,7 +39,7 @@ __all__ = [
 ]
 
 STYLE = """
-body { font-family: system-ui, -apple-system, "Segoe UI", Roboto, sans-serif; margin: 0 auto; max-width: 1250px;
+body { font-family: system-ui, -apple-system, "Segoe UI", Roboto, sans-serif; margin: 0 auto; max-width: 1320px;
        padding: 0 1.2em 3em; color: #1d1d1f; line-height: 1.45; }
 h1 { font-size: 1.6em; margin: 1em 0 0.2em; } h2 { font-size: 1.25em; margin-top: 2em; border-bottom: 1px solid #ddd; }
 h3 { font-size: 1.05em; margin: 1.2em 0 0.4em; }

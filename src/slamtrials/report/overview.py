@@ -75,6 +75,8 @@ def campaign_notes(data: CampaignData, done: pd.DataFrame) -> list[str]:
             notes.append(f"{w['world']}: short of runs{note}.")
         elif w["status"] in ("running", "pending"):
             notes.append(f"{w['world']}: {w['status']} ({w['runs_done']} runs done so far); this report is a snapshot.")
+        elif note:
+            notes.append(f"{w['world']}: {w['note']}.")
     failed = data.runs[data.runs["status"] == "failed"]
     if len(failed):
         notes.append(f"{len(failed)} run(s) failed; their errors are listed in the runs table.")

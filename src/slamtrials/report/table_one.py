@@ -6,7 +6,6 @@ layout; what the columns mean, the metric share and the outlier rule are explain
 from __future__ import annotations
 
 import math
-from collections import Counter
 from typing import Any
 
 import pandas as pd
@@ -72,8 +71,6 @@ def _summary_table(data: CampaignData, done: pd.DataFrame) -> str:
         "CPU s",
         "ms / update",
         "MiB",
-        "runs ended by",
-        "note",
     ]
     groups = [
         ("", 3),
@@ -81,9 +78,7 @@ def _summary_table(data: CampaignData, done: pd.DataFrame) -> str:
         (f"{SYMBOLS['eps_r']} (rad)", 4),
         ("", 2),
         ("SLAM cost per run", 3),
-        ("", 2),
     ]
-    reasons = done.groupby("world")["termination"].agg(lambda s: Counter(s.fillna("unknown"))) if len(done) else {}
     rows = []
     for _, w in data.worlds.iterrows():
         needed = w["runs_needed"]
@@ -120,9 +115,6 @@ def _summary_table(data: CampaignData, done: pd.DataFrame) -> str:
             ),
             h.seconds_cell(w["slam_peak_mib_mean"]),
         ]
-        counter = reasons.get(w["world"], {}) if len(done) else {}
-        cells.append(", ".join(f"{k} {v}" for k, v in sorted(counter.items())))
-        cells.append(w["note"] if isinstance(w["note"], str) else "")
         rows.append(cells)
     classes = [_ROW_CLASSES.get(status, "warn") for status in data.worlds["status"]]
     return h.table(header, rows, id="summary-table", row_classes=classes, groups=groups)
@@ -136,7 +128,8 @@ def _caption(data: CampaignData) -> str:
         f"of the {h.fmt_percent(data.confidence)} confidence interval of the mean. Runs: done (/ needed by the "
         "run-count rule when more, also where the cap stopped a world). SLAM cost per run: the mean over the runs of "
         "the SLAM algorithm's CPU time (s), of its time per update (ms, median / 90th percentile) and of its peak "
-        "memory (MiB), as the section on cost defines them; - where not measured."
+        "memory (MiB), as the section on cost defines them; - where not measured. How the runs ended is in its own "
+        "section, and a world's notes are in the overview's."
     )
 
 

@@ -66,5 +66,5 @@ def test_the_adjusted_intervals_are_labelled_by_comparisons_and_the_rule_is_stat
     html = _comparisons_section(table, levels, 0.05, "holm")
     assert "Bonferroni, 2 comparisons: each at 97.5%" in html
     assert "worlds:" not in html
-    assert "identical runs" in html and "1 of identical runs left out" in html
+    assert "identical runs" in html and "(1 comparison of identical runs left out)" in html
     assert IDENTICAL_RULE.split(" (")[0] in html  # the rule, in the page

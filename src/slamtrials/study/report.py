@@ -188,6 +188,10 @@ def _cells_section(table: pd.DataFrame, keys: list[str]) -> str:
     return h.table(header, rows, caption=f"Every cell and world: intervals at {level}; cost means per run.")
 
 
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" + ("" if n == 1 else "s")
+
+
 def _verdict_text(row: pd.Series) -> str:
     if bool(row.get("identical", False)):
         return "identical runs"
@@ -230,8 +234,9 @@ def _comparisons_section(comparisons: pd.DataFrame, levels: dict, alpha: float, 
         family = len(rows) - identical
         caption = (
             f"{SYMBOLS[metric]}: paired t-tests of run k of B against run k of A (the cells of a world share their "
-            f"seeds), {correction} over the study's {family} comparisons of {SYMBOLS[metric]} at \u03b1 = {alpha:g}"
-            + (f" ({identical} of identical runs left out)" if identical else "")
+            f"seeds), {correction} over the study's {_count(family, 'comparison')} of {SYMBOLS[metric]} at "
+            f"\u03b1 = {alpha:g}"
+            + (f" ({_count(identical, 'comparison')} of identical runs left out)" if identical else "")
             + (f"; intervals {level.label}" if level is not None else "")
             + "."
         )

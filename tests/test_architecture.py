@@ -118,6 +118,14 @@ def _nodes(tree: ast.AST) -> tuple[ast.AST, ...]:
     return tuple(ast.walk(tree))
 
 
+@pytest.fixture(scope="module", autouse=True)
+def _forget_the_trees():
+    """Let the trees go after this module: a million nodes kept alive slow every later garbage collection."""
+    yield
+    _tree.cache_clear()
+    _nodes.cache_clear()
+
+
 @pytest.mark.parametrize("path", SOURCES, ids=lambda p: str(p.relative_to(PACKAGE)))
 def test_layer_imports_only_layers_above_it(path: Path) -> None:
     layer = _layer_of(path)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import re
 import shlex
 from pathlib import Path
@@ -30,11 +31,17 @@ def _tour_commands() -> list[list[str]]:
     return commands
 
 
-def _command_words(words: list[str]) -> list[str]:
-    """The leading words of ``words`` that name a (sub)command of the CLI."""
+@functools.cache
+def _cli():
+    """The CLI's click command tree (built once: typer builds it anew on every call)."""
     import typer
 
-    command, named = typer.main.get_command(app), []
+    return typer.main.get_command(app)
+
+
+def _command_words(words: list[str]) -> list[str]:
+    """The leading words of ``words`` that name a (sub)command of the CLI."""
+    command, named = _cli(), []
     for word in words:
         if not hasattr(command, "list_commands"):
             break

@@ -59,6 +59,7 @@ def test_run_demo_runs_the_campaign_writes_the_report_and_resumes(tmp_path, clie
     assert again.report.is_file()
 
 
+@pytest.mark.slow  # a campaign and its report through the CLI; the options' checks below stay in the fast lane
 def test_demo_command_prints_the_summary_and_the_report(tmp_path, client, monkeypatch):
     import slamtrials.demo
 

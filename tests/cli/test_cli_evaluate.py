@@ -107,7 +107,7 @@ def test_bad_input_names_the_file_and_line(tmp_path):
     assert result.exit_code == 2 and "missing.txt" in result.output
 
 
-def _run(tmp_path, n: int = 400) -> tuple[Path, RunRecord]:
+def _run(tmp_path, n: int = 200) -> tuple[Path, RunRecord]:
     """A run folder: a wandering drive at 10 Hz and an odometry that drifts from it."""
     rng = np.random.default_rng(0)
     steps = np.column_stack([np.full(n - 1, 0.05), np.zeros(n - 1), rng.normal(0, 0.05, n - 1)])
@@ -224,7 +224,7 @@ def test_run_folder_with_a_sparse_estimate_uses_the_odometry_between_its_poses(t
     """A perfect estimate at every 3rd frame: the other ground-truth poses are reached from the nearest
     estimated pose through the run's odometry (1-2 % off over 0.1-0.2 s), so errors stay at millimetres;
     with the Freiburg 0.1 s tolerance the neighbouring frame's pose would be taken as is (5 cm off)."""
-    folder, record = _run(tmp_path)
+    folder, record = _run(tmp_path, n=199)  # every 3rd frame, the last one included
     write_tum(folder / "estimate.tum", Trajectory(t=record.t[::3], poses=record.truth[::3]))
     result = runner.invoke(app, ["evaluate", str(folder), "--seed", "1"])
     assert result.exit_code == 0, result.output
@@ -307,7 +307,7 @@ def test_pose_indices_map_to_file_lines(tmp_path):
 def test_the_estimate_of_another_run_of_the_same_length_is_refused(tmp_path, drive, odometry_of):
     """Same times, other turns: the time-span check cannot see it, the turn check does (exit 2, nothing
     written); the run's own estimate passes."""
-    t, truth = drive(1)
+    t, truth = drive(1, seconds=100.0)
     record = RunRecord(
         t=t,
         scans=np.zeros((len(t), 3), np.float32),
@@ -318,7 +318,7 @@ def test_the_estimate_of_another_run_of_the_same_length_is_refused(tmp_path, dri
         metadata={"seed": 0},
     )
     folder = write_run(tmp_path / "run", record)
-    _, other_truth = drive(5)
+    _, other_truth = drive(5, seconds=100.0)
     foreign = tmp_path / "run001.tum"
     write_tum(foreign, Trajectory(t=t, poses=other_truth))
     result = runner.invoke(app, ["evaluate", str(folder), "--estimate", str(foreign)])

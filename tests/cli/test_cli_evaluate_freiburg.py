@@ -191,6 +191,7 @@ def test_infinite_tolerance_is_the_programs_nearest_pose_whatever_the_gap(tmp_pa
     assert "matched 7 of 7 relations" in result.output
 
 
+@pytest.mark.slow  # real data: the whole fr079 log
 @pytest.mark.skipif(
     not (DATA / "mit-csail.relations").is_file() or not FR079.is_file(), reason="shared data not present"
 )
@@ -216,6 +217,7 @@ def test_mit_csail_odometry_as_a_test_log_matches_the_original_program(tmp_path)
     assert len(read_relations(relations)) == 1172
 
 
+@pytest.mark.slow  # a new Python process (about 2.5 s of imports)
 def test_the_cli_shows_each_tolerated_oddity_once(tmp_path):
     t, poses, relations = _synthetic(tmp_path)
     log = _test_log(tmp_path / "test.log", t, poses)

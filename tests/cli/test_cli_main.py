@@ -24,11 +24,22 @@ def test_version():
     assert result.output.strip() == f"slamtrials {__version__}"
 
 
-def test_every_command_has_help():
+@pytest.fixture(scope="module")
+def helps():
+    """``{columns: [(words, result), ...]}``: the help of every command at 60, 100 and 120 columns, rendered
+    once for the tests below (a render takes some 30 ms; the CLI has about 30 commands)."""
+    paths = list(_command_paths(typer.main.get_command(app)))
+    return {
+        columns: [(words, runner.invoke(app, [*words, "--help"], env={"COLUMNS": columns})) for words in paths]
+        for columns in ("60", "100", "120")
+    }
+
+
+def test_every_command_has_help(helps):
     paths = list(_all_command_paths(typer.main.get_command(app)))
     assert ("simulate",) in paths and ("demo",) in paths and ("worlds", "list") in paths
-    for path in paths:
-        result = runner.invoke(app, [*path, "--help"])
+    assert sorted(paths) == sorted(words for words, _ in helps["120"])
+    for path, result in helps["120"]:
         assert result.exit_code == 0, (path, result.output)
         assert "Usage" in result.output and "--help" in result.output
 
@@ -126,19 +137,17 @@ def _command_paths(group, prefix=()):
             yield from _command_paths(group.get_command(ctx, name), (*prefix, name))
 
 
-def test_boolean_flags_are_shown_as_flags_in_every_help():
+def test_boolean_flags_are_shown_as_flags_in_every_help(helps):
     """typer's rich help prints a type after every option; a flag must not read as taking a value."""
-    paths = list(_command_paths(typer.main.get_command(app)))
-    assert len(paths) > 15
-    for words in paths:
-        result = runner.invoke(app, [*words, "--help"], env={"COLUMNS": "120"})
+    assert len(helps["120"]) > 15
+    for words, result in helps["120"]:
         assert result.exit_code == 0, (words, result.output)
         assert "<bool>" not in result.output, words
     shown = runner.invoke(app, ["trial", "--help"], env={"COLUMNS": "120"}).output
     assert "--overwrite" in shown and "<int>" in shown
 
 
-def test_every_help_is_reflowed_to_the_terminal_and_cuts_no_word():
+def test_every_help_is_reflowed_to_the_terminal_and_cuts_no_word(helps):
     """A docstring's line breaks are not kept inside a paragraph (they left ragged lines), and a word
     too long for its column (an option name, a path) is folded, never cut with an ellipsis."""
     from slamtrials.cli.common import reflow
@@ -146,10 +155,8 @@ def test_every_help_is_reflowed_to_the_terminal_and_cuts_no_word():
     assert reflow("One two\nthree.\n\nA list:\n\n- a\n- b\n\n    indented\n    block") == (
         "One two three.\n\nA list:\n\n- a\n- b\n\n    indented\n    block"
     )
-    paths = list(_command_paths(typer.main.get_command(app)))
-    for words in paths:
-        for columns in ("60", "100"):
-            result = runner.invoke(app, [*words, "--help"], env={"COLUMNS": columns})
+    for columns in ("60", "100"):
+        for words, result in helps[columns]:
             assert result.exit_code == 0, (words, result.output)
             assert "…" not in result.output, (words, columns, result.output)
     # the validate docstring's second paragraph wraps as one paragraph: no line ends mid-sentence early

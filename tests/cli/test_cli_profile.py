@@ -131,7 +131,14 @@ def test_campaign_run_prints_its_profile_when_the_runs_start(tmp_path, monkeypat
     config.write_text(
         "worlds: [office_small_01]\nruns: {initial: 5, max_runs: 5}\nsim:\n  laser:\n    dropout_rate: 0.0\n"
     )
-    result = runner.invoke(app, ["campaign", "run", str(config), "--out", str(tmp_path / "c"), "--workers", "1"])
+    from distributed import LocalCluster
+
+    # an in-process cluster: a worker process would take seconds to start
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster:
+        result = runner.invoke(
+            app,
+            ["campaign", "run", str(config), "--out", str(tmp_path / "c"), "--scheduler", cluster.scheduler_address],
+        )
     assert result.exit_code == 0, result.output
     assert result.stderr.splitlines()[0] == f"profile: {DEFAULT_PROFILE} + 1 override (laser.dropout_rate)"
 

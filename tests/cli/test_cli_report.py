@@ -83,6 +83,7 @@ def one_line_error(result, *fragments):
         assert fragment in lines[0], lines[0]
 
 
+@pytest.mark.slow  # a whole report through the CLI; the report's own tests build it in the fast lane
 def test_report_command(campaigns):
     a, _ = campaigns
     result = runner.invoke(cli_app(), ["report", str(a), "--repeats", "10", "--no-pdf", "--run", "lab_small_01/2"])
@@ -93,6 +94,7 @@ def test_report_command(campaigns):
     assert "run #2 of lab_small_01" in page.read_text(encoding="utf-8")
 
 
+@pytest.mark.slow  # two comparison pages; test_compare_with_itself_warns_in_one_line keeps the command in the fast lane
 def test_compare_command(campaigns, tmp_path):
     a, b = campaigns
     result = runner.invoke(cli_app(), ["compare", str(a), str(b), "--alpha", "0.01", "--correction", "bh", "--no-pdf"])
@@ -114,6 +116,7 @@ def test_compare_command(campaigns, tmp_path):
     assert explicit.exit_code == 0 and (tmp_path / "cmp" / "compare.html").is_file()
 
 
+@pytest.mark.slow  # three comparison pages and a replay; tests/report/test_html.py compares in the fast lane
 def test_compare_a_replay_is_paired(campaigns, replayed, tmp_path):
     a, b = campaigns
     result = runner.invoke(cli_app(), ["compare", str(a), str(replayed), "--out", str(tmp_path / "p"), "--no-pdf"])
@@ -170,6 +173,7 @@ def test_compare_with_itself_warns_in_one_line(campaigns, tmp_path):
     assert warnings == [f"warning: {a} is compared with itself: every difference is 0"]
 
 
+@pytest.mark.slow  # two comparison pages
 def test_compare_shows_world_names_whole_on_a_narrow_terminal(campaigns, replayed, tmp_path):
     a, _ = campaigns
     for columns in ("80", "100"):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 from PIL import Image
 from typer.testing import CliRunner
 
@@ -23,6 +24,7 @@ def _plan(path):
     return path
 
 
+@pytest.mark.slow  # a whole trial through the CLI; tests/cli/test_cli_profile.py keeps a short one in the fast lane
 def test_trial_writes_a_complete_run_folder(tmp_path):
     plan = _plan(tmp_path / "room.png")
     config = tmp_path / "trial.yaml"

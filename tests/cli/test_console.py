@@ -1,5 +1,7 @@
 """The CLI's console prints text as given: brackets in paths and values are not taken for style tags."""
 
+import pytest
+
 from slamtrials.cli.common import make_console
 
 
@@ -10,6 +12,7 @@ def test_brackets_survive(capsys):
     assert "runs[2]/x" in out and "[0.1, 0.2]" in out and "[bold]tag[/bold]" in out
 
 
+@pytest.mark.slow  # a new Python process (about 2.5 s of imports)
 def test_python_dash_m_runs_the_command():
     import subprocess
     import sys

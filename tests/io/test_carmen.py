@@ -127,6 +127,7 @@ def test_mit_csail_relations_refer_to_laser_timestamps():
     assert nearest.max() < 1e-5  # relations print 5 decimals, the log 6
 
 
+@pytest.mark.slow  # real data: the whole MIT CSAIL log, written and read back
 @pytest.mark.skipif(not (MIT / "mit-csail.clf").is_file(), reason="shared data not present")
 def test_mit_csail_rewrites_to_the_same_log(tmp_path):
     log = read_carmen(MIT / "mit-csail.clf")

@@ -157,6 +157,7 @@ def mit_doubled(tmp_path_factory):
     return _doubled(lines, tmp_path_factory.mktemp("mixed"), "mit")
 
 
+@pytest.mark.slow  # real data: the whole MIT CSAIL log, doubled
 def test_mit_csail_with_a_robotlaser1_copy_reads_the_same_frames(mit_doubled, caplog):
     original, mixed = mit_doubled
     a, b = read_carmen(MIT / "mit-csail.clf"), read_carmen(mixed)
@@ -180,6 +181,7 @@ def _rows(output: str) -> list[str]:
     return [lines[i + 1] for i, line in enumerate(lines) if line == HEADER]
 
 
+@pytest.mark.slow  # real data: evaluate and map the whole log twice
 def test_mit_csail_doubled_evaluates_and_maps_as_the_original(mit_doubled, tmp_path, caplog):
     if not (MIT / "mit-csail.relations").is_file():
         pytest.skip("shared data not present")
@@ -200,6 +202,7 @@ def test_mit_csail_doubled_evaluates_and_maps_as_the_original(mit_doubled, tmp_p
     assert scored.exit_code == 0 and _rows(scored.output)[0].endswith(", 1172"), scored.output
 
 
+@pytest.mark.slow  # real data: GMapping twice, then import, export and import again
 def test_gmapping_and_transfer_on_a_doubled_slice_give_the_original_results(tmp_path):
     if not (MIT / "mit-csail.clf").is_file():
         pytest.skip("shared data not present")
@@ -247,6 +250,7 @@ def test_a_broken_mixed_log_is_one_line_from_the_cli(tmp_path):
         assert len(result.output.strip().splitlines()) == 1, result.output
 
 
+@pytest.mark.slow  # a new Python process (about 2.5 s of imports); the reader's warning is checked in-process above
 def test_the_cli_shows_the_skipped_stream_in_one_warning_line(tmp_path):
     log = tmp_path / "both.clf"
     log.write_text("".join(_flaser(t, 9) + _robot(t, k) for k, t in enumerate([10.0, 10.2, 10.4])))

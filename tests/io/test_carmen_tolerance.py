@@ -242,6 +242,7 @@ def test_a_corrupt_compressed_log_is_one_format_error(tmp_path):
     assert "\n" not in str(info.value)
 
 
+@pytest.mark.slow  # real data: the whole fr079 log, read twice
 @pytest.mark.skipif(not FR079.is_file(), reason="shared data not present")
 def test_fr079_bzip2_log_reads_directly():
     log = read_carmen(FR079)
@@ -259,6 +260,7 @@ def test_fr079_bzip2_log_reads_directly():
     assert record.scans.shape == (4934, 360) and record.laser.mount == (-0.04, 0.0, 0.0)
 
 
+@pytest.mark.slow  # real data: the whole MIT CSAIL log, read twice
 @pytest.mark.skipif(not MIT.is_file(), reason="shared data not present")
 def test_mit_csail_reads_the_same_compressed(tmp_path):
     packed = tmp_path / "mit-csail.clf.gz"

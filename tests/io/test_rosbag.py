@@ -174,6 +174,7 @@ json.dump({"topics": topics, "latching": latching, "messages": messages}, sys.st
 """
 
 
+@cache
 def _ros1_python() -> bool:
     try:
         return (
@@ -191,6 +192,7 @@ def _yaw(q: dict) -> float:
     return float(np.arctan2(2 * (q["w"] * q["z"] + q["x"] * q["y"]), 1 - 2 * (q["y"] ** 2 + q["z"] ** 2)))
 
 
+@pytest.mark.slow  # ROS 1's own reader in another Python
 @pytest.mark.skipif(
     not _ros1_python(), reason="ROS 1's rosbag is not importable by /usr/bin/python3 (apt-get install python3-rosbag)"
 )
@@ -280,6 +282,7 @@ def test_ros1_reader_sees_the_stage_layout(tmp_path):
     assert [m["msg"]["data"] for m in by_topic["/stall"]] == record.stalled.astype(int).tolist()
 
 
+@pytest.mark.slow  # ROS 1's own reader in another Python
 @pytest.mark.skipif(
     not _ros1_python(), reason="ROS 1's rosbag is not importable by /usr/bin/python3 (apt-get install python3-rosbag)"
 )

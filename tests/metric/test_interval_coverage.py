@@ -28,11 +28,13 @@ def _coverage(n: int, distribution: str, confidence: float = 0.99) -> float:
     return hits / REPEATS
 
 
+@pytest.mark.slow  # by simulation
 def test_student_t_covers_at_its_confidence_with_five_runs():
     # binomial sd at 4000 repeats and p = 0.99: 0.0016
     assert _coverage(5, "t") == pytest.approx(0.99, abs=0.006)
 
 
+@pytest.mark.slow  # by simulation
 def test_the_normal_quantile_undercovers_with_five_runs():
     coverage = _coverage(5, "normal")
     assert coverage == pytest.approx(0.938, abs=0.012)  # the exact figure: P(|T_4| < 2.5758) = 0.938
@@ -55,6 +57,7 @@ def _sequential_coverage(distribution: str, repeats: int = 1500) -> float:
     return hits / repeats
 
 
+@pytest.mark.slow  # by simulation
 def test_the_run_count_rule_from_five_runs_ends_with_an_interval_that_covers():
     # stopping when the interval first looks narrow enough costs some coverage: Student t about 93 % for
     # "95 %" (sd of the estimate 0.0066), the paper's normal quantile about 88 %

@@ -34,6 +34,7 @@ def test_scoring_the_sizing_estimate_reproduces_the_sampling():
     np.testing.assert_array_equal(again.first, relation_set.first)
 
 
+@pytest.mark.slow  # by simulation: 40 pairs of sets
 def test_two_estimates_on_one_set_differ_more_precisely_than_on_two_sets():
     """Paired scoring: the metric's sampling noise cancels from the difference of two estimates."""
     truth, _ = _drive(1000, seed=4)
@@ -79,6 +80,7 @@ def test_set_of_another_run_and_uncovered_frames_are_refused():
         )
 
 
+@pytest.mark.slow  # by simulation: 200 samplings
 @pytest.mark.parametrize("binding", ["t", "r"])
 def test_precise_rule_mean_falls_within_one_percent_at_its_confidence(binding):
     """The precise rule's promise, by simulation: the sampled mean is within 1 % of the all-pairs mean

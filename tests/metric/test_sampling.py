@@ -151,6 +151,7 @@ def test_sampling_options_cap_and_bad_input():
         SamplingRule(min_relations=10, max_relations=5)
 
 
+@pytest.mark.slow  # by simulation: 400 samplings
 @pytest.mark.parametrize(("confidence", "binding"), [(0.99, "t"), (0.95, "t"), (0.99, "r")])
 def test_sampled_mean_falls_within_the_margin_at_the_stated_confidence(confidence, binding):
     """The paper's Fig. 3 check, by simulation.

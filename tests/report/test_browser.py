@@ -115,9 +115,12 @@ def browser() -> str | None:
     return None
 
 
-pytestmark = pytest.mark.skipif(
-    browser() is None, reason="Chromium is not installed (apt-get install chromium chromium-driver)"
-)
+pytestmark = [
+    pytest.mark.slow,  # a report and a headless Chromium per check: about 12 s
+    pytest.mark.skipif(
+        browser() is None, reason="Chromium is not installed (apt-get install chromium chromium-driver)"
+    ),
+]
 
 
 def run_browser(tmp_path: Path, *args: str) -> subprocess.CompletedProcess:

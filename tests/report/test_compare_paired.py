@@ -192,6 +192,7 @@ def test_three_worlds_small_paired_difference_is_significant_overall_where_the_s
     assert np.isnan(welch_c.table["wilcoxon_p"]).all() and (welch_c.table["test"] == "Welch").all()
 
 
+@pytest.mark.slow  # by simulation
 def test_power_of_the_combined_test_with_three_worlds() -> None:
     rng = np.random.default_rng(5)
     reps, alpha = 300, 0.05

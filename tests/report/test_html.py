@@ -185,11 +185,27 @@ def test_report_notes_provenance_and_escaping(campaign, report):
     assert "<script" not in text
 
 
-def test_report_of_a_chosen_run_and_bad_choices(campaign, tmp_path):
-    page = build_report(campaign, tmp_path / "r", sampling_run="lab_small_01/3", repeats=10, pdf=False)
+@pytest.fixture(scope="module")
+def rebuilt(campaign, tmp_path_factory) -> tuple[Path, Path, Path]:
+    """A second page of the campaign, for Fig. 3 on a chosen run and without PDFs, built in a folder that
+    held a figure of an earlier page (``stale``) and a file of the user's (``mine``): (page, stale, mine)."""
+    out = tmp_path_factory.mktemp("rebuilt") / "r"
+    (out / "figures").mkdir(parents=True)
+    stale, mine = out / "figures" / "report_fig1_099_gone.png", out / "figures" / "notes.png"
+    stale.write_bytes(b"old")
+    mine.write_bytes(b"user's")
+    return build_report(campaign, out, sampling_run="lab_small_01/3", repeats=10, pdf=False), stale, mine
+
+
+@pytest.mark.slow  # a second whole report
+def test_report_of_a_chosen_run(rebuilt):
+    page, _, _ = rebuilt
     text = page.read_text(encoding="utf-8")
     assert "run #3 of lab_small_01" in text and "over 10 independent samplings" in text
-    assert not list((tmp_path / "r" / "figures").glob("*.pdf"))
+    assert not list((page.parent / "figures").glob("*.pdf"))
+
+
+def test_bad_choices_are_refused_before_anything_is_written(campaign, tmp_path):
     for bad, message in (
         ("lab_small_01/99", "has no run lab_small_01/99"),
         ("house_small_01/0", "is not finished"),
@@ -205,13 +221,9 @@ def test_report_of_a_chosen_run_and_bad_choices(campaign, tmp_path):
     assert parse_run("a-b.c/7") == ("a-b.c", 7) and parse_run(("w", 2)) == ("w", 2)
 
 
-def test_rebuilding_removes_only_stale_figures(campaign, tmp_path):
-    out = tmp_path / "r"
-    (out / "figures").mkdir(parents=True)
-    stale, mine = out / "figures" / "report_fig1_099_gone.png", out / "figures" / "notes.png"
-    stale.write_bytes(b"old")
-    mine.write_bytes(b"user's")
-    build_report(campaign, out, repeats=5, pdf=False)
+@pytest.mark.slow  # a second whole report
+def test_rebuilding_removes_only_stale_figures(rebuilt):
+    _, stale, mine = rebuilt
     assert not stale.exists() and mine.exists()
 
 
@@ -318,6 +330,7 @@ def test_compare_report_verdicts_statistics_and_trap(two_levels, tmp_path):
     assert swapped.for_metric("eps_t")["verdict"].tolist() == [A_BETTER, A_BETTER]
 
 
+@pytest.mark.slow  # a replay and a comparison page; the pairing's statistics are tests/report/test_compare_paired.py's
 def test_compare_report_of_a_replay_is_paired(two_levels, tmp_path):
     from distributed import Client, LocalCluster
 

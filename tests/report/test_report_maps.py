@@ -29,6 +29,10 @@ MAP_FROM_WORLD = (2.0, -1.0, 0.9)
 #: Standard errors written into the catalog per world (se_t m, se_r rad); None: not recorded for one run.
 STANDARD_ERRORS = {"office_small_01": (0.01, 0.002), "lab_small_01": (0.05, 0.015), "house_small_01": None}
 
+# a campaign over three bundled worlds and its whole report: about 6 s (tests/report/test_html.py builds a
+# report in the fast lane)
+pytestmark = pytest.mark.slow
+
 
 def with_standard_errors(folder: Path) -> None:
     """Add se_t, se_r to the details of every done run, as this version's campaigns record them; in

@@ -148,6 +148,7 @@ def test_no_noise_draws_nothing():
     assert rng.bit_generator.state == state
 
 
+@pytest.mark.slow  # by simulation: 3,300 noisy odometries
 def test_noise_of_a_step_cut_in_pieces_adds_up_to_the_noise_of_the_whole_step():
     """Cut invariance for a single step: one step of 0.2 m and 0.1 rad, or the same arc in 1, 7 or 400
     pieces (a zero-motion step among them), gives the same spread of the summed arc-length and heading errors."""

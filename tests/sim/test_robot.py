@@ -69,6 +69,7 @@ def test_arc_sagitta():
 
 
 @given(a=st.tuples(finite, finite, angle), b=st.tuples(finite, finite, angle))
+@settings(deadline=None)  # the first example may load the numba kernels from cache
 def test_scalar_pose_helpers_equal_geometry(a, b):
     np.testing.assert_allclose(compose1(a, b), compose(np.array(a), np.array(b)), atol=1e-9)
     rel = ominus1(a, b)

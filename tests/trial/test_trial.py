@@ -184,6 +184,7 @@ def test_the_termination_rule_gets_the_building_reachable_area(world, monkeypatc
     assert 25.0 < info["reachable_area_m2"] < 40.0  # two rooms of about 3.8 x 4.7 m, less the robot's margin
 
 
+@pytest.mark.slow  # a second whole trial; the paper-profile trial above stays in the fast lane
 def test_a_realistic_trial_ends_because_no_frontier_is_left(world):
     # with the realistic laser the map holds free space beyond the walls (beams without a return) and
     # phantom returns come and go; the explorer ignores both and stops when the rooms are done

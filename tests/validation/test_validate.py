@@ -65,6 +65,7 @@ def test_simulate_path_reproduces_the_simulators_frames(drive):
     assert replayed.laser == driven.laser
 
 
+@pytest.mark.slow  # by simulation: 600 replayed paths
 def test_simulate_path_draws_the_same_odometry_noise_per_metre_whatever_the_frame_rate():
     """The profile's noise is a random walk per metre (issue 32); a path replayed at 0.4 s steps
     accumulates as much of it as at 0.1 s: the arc-length error over 5 m has the same spread at both

@@ -57,7 +57,7 @@ def test_catalog_data_stays_small():
     assert total < 3_000_000
 
 
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name", [pytest.param(n, marks=[pytest.mark.slow] if n in LARGE else []) for n in NAMES])
 def test_every_world_loads_and_is_what_it_claims(name):
     world = load_catalog_world(name)
     record = catalog_entry(name)

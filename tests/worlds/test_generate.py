@@ -26,6 +26,17 @@ def world(kind: str, area: float, seed: int) -> World:
     return generate_world(kind, area, seed=seed)
 
 
+def multiwing_slow(values: list) -> list:
+    """``values`` for parametrize (a kind, or a tuple starting with one), the multiwing ones marked slow:
+    a multiwing building of a thousand m^2 or more takes half a second or more to generate (the fast
+    lane keeps multiwing in the bit-for-bit and the validity tests)."""
+    kind = lambda v: v[0] if isinstance(v, tuple) else v  # noqa: E731
+    return [
+        pytest.param(*(v if isinstance(v, tuple) else (v,)), marks=[pytest.mark.slow] if kind(v) == "multiwing" else [])
+        for v in values
+    ]
+
+
 # ----------------------------------------------------------------------------- measuring helpers
 
 
@@ -117,7 +128,7 @@ def test_same_arguments_give_the_same_world_bit_for_bit(kind):
     assert a.metadata == b.metadata
 
 
-@pytest.mark.parametrize("kind", BUILDING_KINDS)
+@pytest.mark.parametrize("kind", multiwing_slow(BUILDING_KINDS))
 def test_different_seeds_give_different_worlds(kind):
     a, b = world(kind, SMALL[kind], 1), world(kind, SMALL[kind], 2)
     assert a.occupied.shape != b.occupied.shape or not np.array_equal(a.occupied, b.occupied)
@@ -141,7 +152,13 @@ def test_small_worlds_of_every_kind_are_valid(kind, fraction, seed):
 
 @pytest.mark.parametrize(
     "kind, area, seed",
-    [("office", 3000, 1), ("school", 4000, 2), ("lab", 1500, 3), ("multiwing", 2500, 4), ("house", 400, 5)],
+    [
+        pytest.param("office", 3000, 1, marks=pytest.mark.slow),  # half a second or more each to generate and check
+        pytest.param("school", 4000, 2, marks=pytest.mark.slow),
+        pytest.param("lab", 1500, 3, marks=pytest.mark.slow),
+        pytest.param("multiwing", 2500, 4, marks=pytest.mark.slow),
+        ("house", 400, 5),
+    ],
 )
 def test_larger_worlds_are_valid_and_near_the_requested_area(kind, area, seed):
     w = world(kind, area, seed)
@@ -167,7 +184,7 @@ def test_other_resolutions_are_valid(resolution):
 # ----------------------------------------------------------------------------- realism
 
 
-@pytest.mark.parametrize("kind", ["office", "school", "lab", "multiwing"])
+@pytest.mark.parametrize("kind", multiwing_slow(["office", "school", "lab", "multiwing"]))
 def test_walls_are_a_fifth_of_a_metre_thick(kind):
     runs = wall_runs(world(kind, 3 * SMALL[kind], 1)) * 0.05
     thin = runs[runs <= 0.5]
@@ -176,7 +193,8 @@ def test_walls_are_a_fifth_of_a_metre_thick(kind):
 
 
 @pytest.mark.parametrize(
-    "kind, lo, hi", [("office", 1.6, 2.5), ("school", 2.2, 3.2), ("lab", 1.8, 2.8), ("multiwing", 1.6, 3.2)]
+    "kind, lo, hi",
+    multiwing_slow([("office", 1.6, 2.5), ("school", 2.2, 3.2), ("lab", 1.8, 2.8), ("multiwing", 1.6, 3.2)]),
 )
 def test_corridors_are_the_width_of_corridors(kind, lo, hi):
     w = world(kind, 4 * SMALL[kind], 2)
@@ -188,7 +206,7 @@ def test_corridors_are_the_width_of_corridors(kind, lo, hi):
 
 
 @pytest.mark.parametrize(
-    "kind, area", [("office", 600), ("school", 1000), ("lab", 800), ("multiwing", 2000), ("house", 150)]
+    "kind, area", multiwing_slow([("office", 600), ("school", 1000), ("lab", 800), ("multiwing", 2000), ("house", 150)])
 )
 def test_corridors_have_a_feature_every_few_metres(kind, area):
     for seed in range(2):
@@ -204,7 +222,15 @@ def corners(w: World) -> int:
 
 @pytest.mark.parametrize(
     "kind, factor, share",
-    [("office", 2.0, 0.05), ("school", 2.0, 0.05), ("lab", 2.0, 0.1), ("house", 1.5, 0.05), ("multiwing", 2.0, 0.05)],
+    multiwing_slow(
+        [
+            ("office", 2.0, 0.05),
+            ("school", 2.0, 0.05),
+            ("lab", 2.0, 0.1),
+            ("house", 1.5, 0.05),
+            ("multiwing", 2.0, 0.05),
+        ]
+    ),
 )
 def test_furniture_gives_scan_matching_features(kind, factor, share, monkeypatch):
     from slamtrials.worlds.generate import build
@@ -227,6 +253,7 @@ def test_labs_are_more_cluttered_than_schools():
     assert clutter("lab") > clutter("school")
 
 
+@pytest.mark.slow  # a 3,000 m^2 office
 def test_start_pose_is_in_a_corridor_near_the_centre():
     w = world("office", 3000, 1)
     rows, cols = np.nonzero(~w.occupied)

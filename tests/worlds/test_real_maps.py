@@ -59,7 +59,11 @@ def test_table_lists_every_map_folder(real_dir):
     assert folders == set(TABLE)
 
 
-@pytest.mark.parametrize("short_name", sorted(TABLE))
+@pytest.mark.parametrize(
+    "short_name",
+    # the maps of more than 1,500 m^2: half a second or more each
+    [pytest.param(name, marks=[pytest.mark.slow] if TABLE[name][1] > 1500 else []) for name in sorted(TABLE)],
+)
 def test_real_map_loads_with_stated_scale_area_and_a_good_start(real_dir, short_name):
     resolution, free_area, largest = TABLE[short_name]
     world = load_world(real_dir / short_name / "map.yaml")

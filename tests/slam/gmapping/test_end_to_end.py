@@ -66,6 +66,7 @@ def relative_translation_errors(estimate: np.ndarray, truth: np.ndarray, lo: flo
     return np.hypot(error[:, 0], error[:, 1])
 
 
+@pytest.mark.slow  # GMapping over the whole 77 s tour
 def test_relative_errors_well_below_odometry(world_and_record, gmapping_run):
     _, record = world_and_record
     trajectory = gmapping_run.trajectory()
@@ -84,6 +85,7 @@ def test_relative_errors_well_below_odometry(world_and_record, gmapping_run):
     assert final_gm < 0.3 and final_gm < 0.3 * final_odo  # observed 0.07 m and 1.2 m
 
 
+@pytest.mark.slow  # GMapping over the whole 77 s tour
 def test_final_map_lies_on_the_walls(world_and_record, gmapping_run):
     world, record = world_and_record
     trajectory = gmapping_run.trajectory()

@@ -24,12 +24,19 @@ def _run(square_loop, **overrides):
     return karto, online
 
 
+@pytest.fixture(scope="module")
+def default_run(square_loop):
+    """Karto with slam_toolbox's defaults over the loop, and its online estimates: one run for the tests
+    that only read it (the algorithm keeps nothing of a query)."""
+    return _run(square_loop)
+
+
 def _end_error(poses, truth):
     return math.hypot(poses[-1, 0] - truth[-1, 0], poses[-1, 1] - truth[-1, 1])
 
 
-def test_loop_closure_on_a_square_loop_reduces_the_drift(square_loop):
-    karto, online = _run(square_loop)
+def test_loop_closure_on_a_square_loop_reduces_the_drift(square_loop, default_run):
+    karto, online = default_run
     truth = square_loop.truth
     assert karto.loop_closures >= 1 and len(karto.optimizations) >= 1
     assert _end_error(square_loop.odometry, truth) > 1.0  # 3 % turn and 2 % travel drift over a 60 m lap
@@ -46,8 +53,8 @@ def test_loop_closure_on_a_square_loop_reduces_the_drift(square_loop):
     assert closed_errors.mean() < 0.8 * drifted_errors.mean() and closed_errors.max() < 0.12
 
 
-def test_trajectory_has_one_pose_per_frame_and_nodes_follow_the_update_rule(square_loop):
-    karto, online = _run(square_loop)
+def test_trajectory_has_one_pose_per_frame_and_nodes_follow_the_update_rule(square_loop, default_run):
+    karto, online = default_run
     trajectory = karto.trajectory()
     assert len(trajectory) == len(square_loop.frames)
     np.testing.assert_array_equal(trajectory.t, [f.t for f in square_loop.frames])
@@ -65,8 +72,8 @@ def test_trajectory_has_one_pose_per_frame_and_nodes_follow_the_update_rule(squa
     assert grid.grid.size > 0 and (grid.grid == 100).any() and (grid.grid == 0).any()
 
 
-def test_same_input_gives_the_same_bits(square_loop):
-    first, _ = _run(square_loop)
+def test_same_input_gives_the_same_bits(square_loop, default_run):
+    first, _ = default_run
     second, _ = _run(square_loop)
     np.testing.assert_array_equal(first.trajectory().poses, second.trajectory().poses)
     np.testing.assert_array_equal(first.occupancy().grid, second.occupancy().grid)
@@ -108,10 +115,10 @@ def test_a_trial_config_names_karto_alone():
         TrialConfig.from_dict({"slam": {"algorithm": "karto", "params": {"particles": 30}}})
 
 
-def test_every_loop_candidate_is_recorded_with_the_gates_it_met(square_loop):
+def test_every_loop_candidate_is_recorded_with_the_gates_it_met(default_run):
     # TryCloseLoop's log (slam_toolbox prints "COARSE RESPONSE", "var", "FINE RESPONSE" per candidate):
     # one record per chain tried, accepted exactly when the three gates pass, as many accepted as closed
-    karto, _ = _run(square_loop)
+    karto, _ = default_run
     c = karto.config
     checks = karto.loop_checks
     assert checks and sum(check.accepted for check in checks) == karto.loop_closures >= 1
@@ -130,7 +137,10 @@ def test_every_loop_candidate_is_recorded_with_the_gates_it_met(square_loop):
         assert check.jump >= 0.0 and (check.accepted or check.jump == 0.0)
     # the closures on this loop are right: none moves its node by more than a few centimetres
     assert max(check.jump for check in checks if check.accepted) < 0.1
-    # a coarse bound no response exceeds: every candidate is still recorded, none reaches the fine match
+
+
+@pytest.mark.slow  # a second run over the loop; the test above checks the gates on the default one
+def test_a_coarse_bound_no_response_exceeds_records_every_candidate_and_closes_none(square_loop):
     strict, _ = _run(square_loop, loop_match_minimum_response_coarse=1.0)
     assert strict.loop_closures == 0 and strict.loop_checks
     assert all(math.isnan(k.fine_response) and not k.accepted for k in strict.loop_checks)

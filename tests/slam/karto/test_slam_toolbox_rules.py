@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from slamtrials.geometry import compose1, ominus1
 from slamtrials.record import Frame
@@ -132,6 +133,7 @@ def test_frames_between_nodes_are_placed_from_the_nearest_node(square_loop):
     assert placed_from_next > 0
 
 
+@pytest.mark.slow  # karto over the whole loop, recording every optimization
 def test_the_optimizer_starts_from_its_own_copy_of_the_nodes(square_loop, monkeypatch):
     # slam_toolbox's CeresSolver keeps each node's pose from AddNode (called by AddVertex, right after
     # sequential matching) and overwrites it only with its own results: a pose set on the scan later

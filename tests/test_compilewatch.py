@@ -7,13 +7,14 @@ import os
 import pty
 import subprocess
 import sys
+import time
 
 import numba
 import pytest
 
 from slamtrials import stablemath
 from slamtrials.cli.main import COMPILING_NOTICE
-from slamtrials.compilewatch import watch_compilation
+from slamtrials.compilewatch import CompileTimer, watch_compilation
 
 
 def _twice(x):
@@ -101,3 +102,28 @@ def test_no_notice_when_stderr_is_not_a_terminal(tmp_path):
     assert done.returncode == 0, done.stderr
     assert COMPILING_NOTICE not in done.stderr
     assert "compiled slamtrials.stablemath." in done.stderr
+
+
+def test_the_compile_timer_measures_by_the_clock_it_is_given():
+    # the typing of ``late`` sleeps: wall-clock time inside the compile, no CPU time
+    from numba.extending import overload
+
+    def late():
+        pass
+
+    @overload(late)
+    def _late():
+        time.sleep(0.2)
+        return lambda: None
+
+    def kernel():
+        late()
+        return 1
+
+    cpu, wall = CompileTimer(), CompileTimer(clock=time.perf_counter)
+    try:
+        assert numba.njit(kernel)() == 1
+    finally:
+        cpu.stop()
+        wall.stop()
+    assert wall.seconds >= 0.2 > cpu.seconds > 0.0

@@ -1,7 +1,8 @@
 # The two set-up commands of the README:
 #   make demo   create .venv, install slamtrials, run the main job (writes results/demo/)
 #   make test   create .venv, install slamtrials with its test tools, run the whole test suite
-#   make test-fast   the same without the tests marked slow (about 5 minutes on 2 cores, warm numba cache)
+#   make test-fast   the same without the tests marked slow: under 2 minutes on 2 idle cores with a warm numba
+#                    cache (3,247 tests in 101 s, 2026-11-29); an unmarked test over 5 s fails (tests/conftest.py)
 PYTHON ?= $(shell command -v python3.11 || command -v python3)
 VENV   := .venv
 BIN    := $(VENV)/bin

@@ -140,9 +140,10 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config: pytest.Config)
     guard = config.stash.get(_GUARD_KEY, None)
     if guard is not None and guard.excused:
         terminalreporter.section("fast lane: tests over the time limit")
+        count = guard.misses.count
         terminalreporter.write_line(
-            f"not failed, because numba compiled {guard.misses.count} kernels its cache should hold in this "
-            "session (processes the tests start may have compiled too); run again to check:"
+            f"not failed, because numba compiled {count} function{'s' * (count != 1)} its on-disk cache should "
+            "hold in this session (processes the tests start may have compiled too); run again to check:"
         )
         for message in guard.excused:
             terminalreporter.write_line(f"  {message}")

@@ -142,7 +142,7 @@ def test_naps():
     result.stdout.fnmatch_lines(
         [
             "*fast lane: tests over the time limit*",
-            "not failed, because numba compiled 1 kernels its cache should hold in this session*",
+            "not failed, because numba compiled 1 function its on-disk cache should hold in this session*",
             "*test_cold.py::test_naps: its call took * s, over the fast lane's*",
         ]
     )

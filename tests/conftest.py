@@ -17,6 +17,22 @@ from numba.core.caching import NullCache
 from slamtrials.compilewatch import CompileTimer
 from slamtrials.geometry import compose
 
+# ----------------------------------------------------------------------------------- Dask
+
+
+@pytest.fixture(scope="session")
+def client():
+    """Two single-threaded Dask workers in this process (fast to start; tasks share the test's imports),
+    one cluster for the whole session."""
+    from distributed import Client, LocalCluster
+
+    with (
+        LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster,
+        Client(cluster) as c,
+    ):
+        yield c
+
+
 # ----------------------------------------------------------------------------------- the fast lane's guard
 
 #: The longest a test not marked slow may run, in seconds, on a machine with a core to spare (``make
@@ -114,26 +130,25 @@ def _guarded(item: pytest.Item):
     return guard
 
 
-@pytest.hookimpl(wrapper=True)
-def pytest_runtest_setup(item: pytest.Item):
+def _timed(item: pytest.Item, phase: str):
+    """The body of a hook wrapper around one phase of a test: the guard times it (if it watches the test)."""
     guard = _guarded(item)
     if guard is None:
         return (yield)
     started, compiled = time.perf_counter(), guard.compiling.seconds
-    result = yield  # a set-up that fails raises here and is reported as it is
-    guard.check(item, "set-up", started, compiled)
+    result = yield  # a phase that fails raises here and is reported as it is
+    guard.check(item, phase, started, compiled)
     return result
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_setup(item: pytest.Item):
+    return (yield from _timed(item, "set-up"))
 
 
 @pytest.hookimpl(wrapper=True)
 def pytest_runtest_call(item: pytest.Item):
-    guard = _guarded(item)
-    if guard is None:
-        return (yield)
-    started, compiled = time.perf_counter(), guard.compiling.seconds
-    result = yield  # a test that fails raises here and is reported as it is
-    guard.check(item, "call", started, compiled)
-    return result
+    return (yield from _timed(item, "call"))
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config: pytest.Config) -> None:

@@ -27,18 +27,6 @@ def write_room(folder, name: str = "room", **size) -> str:
 
 
 @pytest.fixture(scope="session")
-def client():
-    """Two single-threaded workers in this process (fast to start; tasks share the test's imports)."""
-    from distributed import Client, LocalCluster
-
-    with (
-        LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster,
-        Client(cluster) as c,
-    ):
-        yield c
-
-
-@pytest.fixture(scope="session")
 def rooms(tmp_path_factory):
     """Two tiny worlds as map_server files: ``room_a`` (4 x 3 m) and ``room_b`` (3 x 3 m)."""
     folder = tmp_path_factory.mktemp("worlds")

@@ -22,17 +22,6 @@ from slamtrials.sim.profiles import DEFAULT_PROFILE
 runner = CliRunner()
 
 
-@pytest.fixture(scope="module")
-def client():
-    from distributed import Client, LocalCluster
-
-    with (
-        LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster,
-        Client(cluster) as c,
-    ):
-        yield c
-
-
 def test_the_demo_is_the_small_campaign_with_the_papers_settings(tmp_path):
     config = demo_config(tmp_path / "d")
     assert isinstance(config, CampaignConfig) and config.worlds == list(DEMO_WORLDS) and len(DEMO_WORLDS) == 3

@@ -1,5 +1,5 @@
-"""Shared fixtures of the report tests that build small campaigns: an in-process Dask client, two tiny
-rooms, a fake campaign over them, and a reader of the report's HTML tables."""
+"""Shared fixtures of the report tests that build small campaigns (on the session's Dask client of
+tests/conftest.py): two tiny rooms, a fake campaign over them, and a reader of the report's HTML tables."""
 
 from __future__ import annotations
 
@@ -8,18 +8,6 @@ import re
 
 import numpy as np
 import pytest
-
-
-@pytest.fixture(scope="session")
-def client():
-    """Two single-threaded workers in this process."""
-    from distributed import Client, LocalCluster
-
-    with (
-        LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster,
-        Client(cluster) as c,
-    ):
-        yield c
 
 
 @pytest.fixture(scope="session")

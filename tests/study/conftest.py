@@ -28,18 +28,6 @@ def rooms(tmp_path_factory):
     return [write_room(folder, "room_a"), write_room(folder, "room_b", width_m=3.0, height_m=3.0)]
 
 
-@pytest.fixture(scope="session")
-def client():
-    """Two single-threaded workers in this process."""
-    from distributed import Client, LocalCluster
-
-    with (
-        LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0") as cluster,
-        Client(cluster) as c,
-    ):
-        yield c
-
-
 def _campaign_mapping(rooms, **changes) -> dict:
     """A base campaign of the odometry baseline, 5 runs per world."""
     return {

@@ -26,18 +26,35 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
 
+def log_replica(log: str, overrides: dict):
+    """``(record, reference, replica)``: the real log, GMapping's run on it (its defaults plus ``overrides``,
+    seed 0) and the replica built from that run, as ``slamtrials validate`` builds it."""
+    from slamtrials.external import run_offline
+    from slamtrials.slamrun import load_recording
+    from slamtrials.validation.validate import replica_from_reference
+
+    record = load_recording(log)
+    reference = run_offline(record, "gmapping", overrides=overrides, seed=0)
+    return record, reference, replica_from_reference(record, reference)
+
+
+def record_replica(replica, profile, seed: int):
+    """The replica recorded once with ``profile`` (an ErrorProfile), the simulator's stream of run ``seed``."""
+    from slamtrials.seeding import run_streams
+    from slamtrials.sim.pathreplay import simulate_path
+    from slamtrials.validation.validate import replica_config
+
+    rng = np.random.default_rng(run_streams(seed).simulator)
+    return simulate_path(replica.world, replica.t, replica.truth, replica_config(replica, profile), rng)
+
+
 def main() -> None:
     from slamtrials.calibration.fit import calibrate
     from slamtrials.calibration.laser import LASER_VALUES
     from slamtrials.calibration.reference import Reference, slam_reference
     from slamtrials.calibration.settings import CalibrationSettings
     from slamtrials.cli.slam import parse_settings
-    from slamtrials.external import run_offline
-    from slamtrials.seeding import run_streams
-    from slamtrials.sim.pathreplay import simulate_path
     from slamtrials.sim.profiles import resolve_profile
-    from slamtrials.slamrun import load_recording
-    from slamtrials.validation.validate import replica_config, replica_from_reference
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("log", help="a real log (CARMEN, optionally .bz2/.gz, or a bag)")
@@ -49,12 +66,9 @@ def main() -> None:
 
     overrides = parse_settings(args.overrides)
     started = time.perf_counter()
-    record = load_recording(args.log)
-    reference = run_offline(record, "gmapping", overrides=overrides, seed=0)
-    replica = replica_from_reference(record, reference)
+    _, _, replica = log_replica(args.log, overrides)
     profile = resolve_profile(args.profile)
-    rng = np.random.default_rng(run_streams(args.seed).simulator)
-    simulated = simulate_path(replica.world, replica.t, replica.truth, replica_config(replica, profile), rng)
+    simulated = record_replica(replica, profile, args.seed)
     settings = CalibrationSettings(bootstrap=args.bootstrap)
     against_truth = calibrate(simulated, Reference.from_world(replica.truth, replica.world, "truth"), settings)
     against_slam = calibrate(simulated, slam_reference(simulated, "gmapping", overrides=overrides, seed=0), settings)

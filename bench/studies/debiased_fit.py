@@ -31,18 +31,15 @@ DEBIASED = ("range_noise_std", "range_noise_per_m", "short_rate", "edge_chance",
 
 
 def main() -> None:
+    from calibration_bias import log_replica, record_replica
     from slamtrials.calibration.beams import beam_sample
     from slamtrials.calibration.laser import fit_laser
     from slamtrials.calibration.reference import Reference, slam_reference
     from slamtrials.calibration.settings import CalibrationSettings
     from slamtrials.cli.slam import parse_settings
-    from slamtrials.external import run_offline
     from slamtrials.io.relations import read_relations
-    from slamtrials.seeding import run_streams
-    from slamtrials.sim.pathreplay import simulate_path
     from slamtrials.sim.profiles import resolve_profile
-    from slamtrials.slamrun import load_recording
-    from slamtrials.validation.validate import ValidationSettings, replica_config, replica_from_reference, validate
+    from slamtrials.validation.validate import ValidationSettings, validate
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("log", help="a real log (CARMEN, optionally .bz2/.gz, or a bag)")
@@ -56,10 +53,8 @@ def main() -> None:
     overrides = parse_settings(args.overrides)
     settings = CalibrationSettings()
     started = time.perf_counter()
-    record = load_recording(args.log)
+    record, reference, replica = log_replica(args.log, overrides)
     relations = read_relations(args.relations)
-    reference = run_offline(record, "gmapping", overrides=overrides, seed=0)
-    replica = replica_from_reference(record, reference)
 
     def laser_fit(recording, against: Reference) -> dict[str, float]:
         sample = beam_sample(recording, against, settings.max_beams, edge_reach=settings.edge_reach)
@@ -74,8 +69,7 @@ def main() -> None:
     print(f"{args.log}: target (the log's fit) " + ", ".join(f"{k} {target[k]:.4g}" for k in DEBIASED), flush=True)
     for round_ in range(1, args.rounds + 1):
         profile = start.model_copy(update={"laser": {**start.laser, **values}})
-        rng = np.random.default_rng(run_streams(round_).simulator)
-        simulated = simulate_path(replica.world, replica.t, replica.truth, replica_config(replica, profile), rng)
+        simulated = record_replica(replica, profile, round_)
         fitted = laser_fit(simulated, slam_reference(simulated, "gmapping", overrides=overrides, seed=0))
         for name in DEBIASED:
             if fitted[name] > 0.0 and values[name] > 0.0:

@@ -65,3 +65,14 @@ def test_valid_points_keep_what_faces_the_viewpoint():
     assert kept[:-1].all() and not kept[-1]  # Karto never keeps the last point of a run
     # ... the same wall seen from behind (0, 6) turns clockwise and is dropped
     assert not find_valid_points(x, y, 0.0, 6.0).any()
+
+
+def test_valid_points_check_only_steps_longer_than_karto_square_of_a_tenth():
+    # Karto compares the squared step with math::Square(0.1) = 0.1 * 0.1, one ulp above 0.01: a step of
+    # exactly 0.1 m is not a check, so the first point stays the reference for the next step
+    assert 0.1 * 0.1 > 0.01
+    x = np.array([0.0, 0.1, -1.0])
+    y = np.array([1.0, 1.0, 1.0])
+    # seen from (0, 0), the step to (0.1, 1) turns the wrong way; were it checked (a bound of 0.01), point
+    # 0 would be dropped. Unchecked, the step to (-1, 1) turns the right way from point 0 and keeps 0 and 1.
+    np.testing.assert_array_equal(find_valid_points(x, y, 0.0, 0.0), [True, True, False])

@@ -44,6 +44,9 @@ _DISTANCE_PENALTY_GAIN = 0.2
 _ANGLE_PENALTY_GAIN = 0.2
 #: Karto's KT_TOLERANCE (Math.h): the margin of its DoubleEqual and of its distance and response tests
 KT_TOLERANCE = 1e-6
+#: FindValidPoints' least step (m^2) between checked points, math::Square(0.1) as Karto writes it: 0.1 * 0.1
+#: is one ulp above the literal 0.01, so a step of exactly 0.1 m is not checked
+_MIN_STEP_SQUARED = 0.1 * 0.1
 
 
 @njit(cache=True, nogil=True)
@@ -91,7 +94,7 @@ def find_valid_points(px, py, vx, vy):  # pragma: no cover - compiled
             first_time = False
         dx = fx - x
         dy = fy - y
-        if dx * dx + dy * dy > 0.01:
+        if dx * dx + dy * dy > _MIN_STEP_SQUARED:
             a = vy - fy
             b = fx - vx
             c = fy * vx - fx * vy

@@ -82,7 +82,16 @@ def test_same_input_gives_the_same_bits(square_loop, default_run):
 def test_laser_as_dict_or_laser_geometry(square_loop):
     as_geometry = Karto(KartoConfig(), square_loop.laser)
     as_dict = make_algorithm("karto", square_loop.laser.to_dict())
-    assert as_geometry.laser == as_dict.laser == square_loop.laser and ALGORITHMS["karto"] is Karto
+    assert as_geometry.laser == as_dict.laser and ALGORITHMS["karto"] is Karto
+    # the beam angles as a sensor_msgs/LaserScan carries them to slam_toolbox and slam_karto: float32
+    laser = square_loop.laser
+    assert as_geometry.laser.angle_min == float(np.float32(laser.angle_min)) != laser.angle_min
+    assert as_geometry.laser.angle_increment == float(np.float32(laser.angle_increment))
+    assert (as_geometry.laser.range_min, as_geometry.laser.range_max, as_geometry.laser.mount) == (
+        laser.range_min,
+        laser.range_max,
+        laser.mount,
+    )
 
 
 def test_a_frame_without_readings_is_refused(square_loop):

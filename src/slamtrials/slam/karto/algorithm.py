@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 import numpy as np
@@ -191,13 +191,21 @@ class Karto:
             "use_response_expansion": False,
             "max_laser_range": 12.0,
             "optimizer": "spa",
+            "graph_frame": "laser",
         },
     }
 
     def __init__(self, config: KartoConfig, laser: LaserGeometry | dict[str, Any]):
         laser = laser if isinstance(laser, LaserGeometry) else LaserGeometry.from_dict(laser)
         self.config = config
-        self.laser = laser
+        # slam_toolbox and slam_karto take the beam angles from a sensor_msgs/LaserScan, which holds
+        # angle_min and angle_increment as float32: Karto aims every beam from those rounded values (up to
+        # 1e-7 rad off, 2 um at 20 m: enough to move a point into the next cell now and then)
+        self.laser = replace(
+            laser,
+            angle_min=float(np.float32(laser.angle_min)),
+            angle_increment=float(np.float32(laser.angle_increment)),
+        )
         self.mount = np.asarray(laser.mount, dtype=np.float64)
         self.unmount = inverse(self.mount)
         self.range_threshold = min(float(config.max_laser_range), laser.range_max)
@@ -412,7 +420,23 @@ class Karto:
             if dx * dx + dy * dy < best:
                 closest, best = k, dx * dx + dy * dy
         if closest >= 0 and best < self.config.link_scan_maximum_distance**2 + KT_TOLERANCE:
-            self.graph.link(closest, index, self._base_pose(laser_mean), covariance)
+            self._link(closest, index, laser_mean, self._base_pose(laser_mean), covariance)
+
+    def _link(
+        self,
+        source: int,
+        target: int,
+        laser_pose: NDArray[np.float64],
+        base_pose: NDArray[np.float64],
+        covariance: NDArray[np.float64],
+    ) -> None:
+        """LinkScans: an edge from node ``source`` to node ``target`` placed at ``laser_pose`` (its base
+        at ``base_pose``). slam_toolbox's edge joins the two base poses; open_karto's (``graph_frame``
+        "laser") joins the two laser poses, as its LinkInfo takes the scans' sensor poses."""
+        if self.config.graph_frame == "laser":
+            self.graph.link(source, target, laser_pose, covariance, origin=self._laser_pose(source))
+        else:
+            self.graph.link(source, target, base_pose, covariance)
 
     def _add_edges(self, index: int, covariance: NDArray[np.float64]) -> None:
         """AddEdges: link to the previous node, the running buffer and near chains; then the weighted mean."""
@@ -422,7 +446,7 @@ class Karto:
         covariances: list[NDArray[np.float64]] = []
         if index > 0:
             laser_pose = self._laser_pose(index)
-            self.graph.link(index - 1, index, node.pose, covariance)
+            self._link(index - 1, index, laser_pose, node.pose, covariance)
             means.append(laser_pose)
             covariances.append(covariance)
             self._link_chain(self.running, index, laser_pose, covariance)
@@ -463,7 +487,11 @@ class Karto:
             np.array([information(e.covariance) for e in edges]),
         )
         self.optimizations.append((len(self.graph.nodes), len(edges), time.perf_counter() - started, result.iterations))
-        self.graph.set_poses(result.poses)
+        if self.config.graph_frame == "laser":
+            # open_karto's CorrectPoses hands each optimized pose to SetSensorPose: it becomes the laser pose
+            self.graph.set_poses(np.array([self._base_pose(pose) for pose in result.poses]).reshape(-1, 3))
+        else:
+            self.graph.set_poses(result.poses)
         self._solver_poses = [pose.copy() for pose in result.poses]
 
     def _close_loops(self, index: int) -> None:

@@ -94,6 +94,12 @@ class KartoConfig(BaseModel):
         The pose-graph solver run after each loop closure: ``ceres`` (slam_toolbox's CeresSolver set-up,
         :mod:`.optimize`) or ``spa`` (slam_karto's SpaSolver, sparse_bundle_adjustment's ``doSPA(40)``,
         :mod:`.spa`).
+    graph_frame:
+        Which poses the graph's edges join and the optimizer's results are set as. ``base``
+        (slam_toolbox): the scans' corrected base poses (its LinkInfo takes ``GetCorrectedPose``).
+        ``laser`` (open_karto, slam_karto): the scans' laser poses (LinkInfo takes ``GetSensorPose``, and
+        CorrectPoses sets each optimized pose with ``SetSensorPose``), while the optimizer starts from
+        the base poses. With the laser mounted off the base's centre the two differ.
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True)
@@ -146,6 +152,9 @@ class KartoConfig(BaseModel):
     )
 
     optimizer: Literal["ceres", "spa"] = Field("ceres", description="pose-graph solver: slam_toolbox's or slam_karto's")
+    graph_frame: Literal["base", "laser"] = Field(
+        "base", description="frame the graph's edges join and optimized poses set: slam_toolbox's or open_karto's"
+    )
 
     @field_validator("initial_pose")
     @classmethod

@@ -94,12 +94,23 @@ class PoseGraph:
         self.neighbours.append([])
         return len(self.nodes) - 1
 
-    def link(self, source: int, target: int, target_pose: NDArray[np.float64], covariance: NDArray[np.float64]) -> bool:
-        """Add an edge from ``source`` to ``target`` placing target's base at ``target_pose`` (map frame)
-        with ``covariance`` (map frame); False (and nothing added) if that pair is linked already."""
+    def link(
+        self,
+        source: int,
+        target: int,
+        target_pose: NDArray[np.float64],
+        covariance: NDArray[np.float64],
+        *,
+        origin: NDArray[np.float64] | None = None,
+    ) -> bool:
+        """Add an edge from ``source`` to ``target`` placing target at ``target_pose`` (map frame) with
+        ``covariance`` (map frame), seen from ``origin`` (default: source's base pose); False (and
+        nothing added) if that pair is linked already. The edge holds ``target_pose`` in the frame of
+        ``origin`` and the covariance rotated into it (Karto's LinkInfo)."""
         if (source, target) in self._pairs or source == target:
             return False
-        origin = self.nodes[source].pose
+        if origin is None:
+            origin = self.nodes[source].pose
         self.edges.append(
             Edge(
                 source,

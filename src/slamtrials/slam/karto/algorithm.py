@@ -20,9 +20,10 @@ Per frame (:meth:`Karto.process`):
 5. every ``map_update_interval`` seconds the published map is rebuilt from the nodes' poses
    (:mod:`.mapbuild`).
 
-Frames. Nodes hold base poses (slam_toolbox links corrected base poses); matching works on laser poses
-(base composed with the laser's mount). The map frame starts on the first frame's odometry pose, or
-``initial_pose``.
+Frames. Nodes hold base poses; matching works on laser poses (base composed with the laser's mount),
+with beams aimed from the laser's angles rounded to float32 (as a ROS LaserScan carries them). Edges join
+base poses as slam_toolbox links corrected poses, or laser poses as open_karto does (``graph_frame``).
+The map frame starts on the first frame's odometry pose, or ``initial_pose``.
 
 Estimates. :meth:`Karto.process` returns the online estimate: a node's corrected pose once it is
 processed, else the prediction of step 1. :meth:`Karto.trajectory` returns the final estimate: the

@@ -40,17 +40,23 @@ The linear systems are solved with :mod:`.sparsechol` (plain loops, no BLAS), so
 bits on every CPU. Where the C++ may round differently (in the last bits only; the mathematics is the
 same):
 
-- Ordering. ``CSparse2d::doChol`` uses the natural order up to 100 unknowns (33 free nodes) and
-  CSparse's AMD beyond. Up to 100 unknowns the matrix is laid out as ``setupCSstructure`` lays it out
-  and factored in the natural order, and :mod:`.sparsechol`'s up-looking factorisation and solves do
-  ``cs_chol``'s, ``cs_lsolve``'s and ``cs_ltsolve``'s operations in their order. Beyond, AMD is replaced
-  by :func:`.sparsechol.minimum_degree_order` over the free nodes (each node's three unknowns kept
-  together): the same solution up to rounding, so steps differ from the C++ in their last bits, and a
-  refusal that the C++ decides by a last-bit cost difference near convergence may go the other way.
-  In a real run nearly every optimization takes this path (loop closures come after dozens of nodes).
-- Eigen's 3 x 3 products sum their three terms in an order that depends on Eigen's version and
-  vectorisation (and a compiler may fuse multiply-adds); here every such sum runs left to right.
-  ``|dx|^2`` is summed in order (Eigen pairs terms with SIMD); it is only compared with 1e-16.
+- Ordering. ``CSparse2d::doChol`` calls ``cs_cholsol`` with the natural order up to 100 unknowns (33 free
+  nodes) and with AMD (``order = 1``) beyond. The matrix is laid out as ``setupCSstructure`` lays it out;
+  beyond 100 unknowns :func:`.amd.amd_order` is CSparse's own ``cs_amd(1, A)`` (ported step for step,
+  ties and all) and :func:`.amd.symmetric_permute` lays ``C = A(p, p)`` out as ``cs_symperm`` does (rows
+  unsorted), so in both cases :mod:`.sparsechol`'s up-looking factorisation and solves do ``cs_chol``'s,
+  ``cs_lsolve``'s and ``cs_ltsolve``'s operations in their order: given the same A and B the step has the
+  bits of CXSparse's ``cs_cholsol`` (checked solve by solve over the MIT CSAIL log against Debian's
+  libcxsparse 3.2.0, the library sparse_bundle_adjustment links). In a real run nearly every optimization
+  takes the AMD path (loop closures come after dozens of nodes).
+- Eigen's 3 x 3 products: here every sum of three products runs left to right. Compiled Eigen 3.4 does
+  not quite: a 3-row product's rows 0 and 1 come from its packet path, ``(a0 b0 + a1 b1) + a2 b2``, but
+  row 2 from an unrolled sum ``a0 b0 + (a1 b1 + a2 b2)``, and a build for a CPU with FMA fuses those
+  multiply-adds; so A, B and the costs may differ from the C++'s in their last bits, and near
+  convergence a last-bit cost difference can turn a refusal the other way. Such differences are
+  amplified: one ulp changed in the initial poses of MIT CSAIL's first loop closure moves the optimum
+  by 1e-10 to 1e-6 m. ``|dx|^2`` is summed in order (Eigen pairs terms with SIMD); it is only compared
+  with 1e-16.
 - CSparse fails only on a pivot ``<= 0`` and goes on with a NaN pivot; :mod:`.sparsechol` also fails on
   NaN (then, as in step 5, the step is ``B``).
 
@@ -66,8 +72,9 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
+from slamtrials.slam.karto.amd import amd_order, symmetric_permute
 from slamtrials.slam.karto.optimize import OptimizerResult
-from slamtrials.slam.karto.sparsechol import NotPositiveDefinite, cholesky, cholesky_solve, minimum_degree_order
+from slamtrials.slam.karto.sparsechol import NotPositiveDefinite, cholesky, cholesky_solve
 
 __all__ = ["optimize_spa", "MAX_ITERATIONS", "INITIAL_LAMBDA"]
 
@@ -237,43 +244,6 @@ def _values(n_free, block_ptr, block_slots, diag, off, diaginc, data):  # pragma
 
 
 @njit(cache=True, nogil=True)
-def _permuted_pattern(indptr, indices, pinv):  # pragma: no cover - compiled
-    """Upper triangle of ``P A P^T`` (``pinv[old] = new``) in compressed columns with rows ascending; returns
-    its ``indptr``, ``indices`` and, per entry, the position of its value in the original ``data``."""
-    n = indptr.shape[0] - 1
-    counts = np.zeros(n, dtype=np.int64)
-    for j in range(n):
-        for p in range(indptr[j], indptr[j + 1]):
-            counts[max(pinv[indices[p]], pinv[j])] += 1
-    new_ptr = np.zeros(n + 1, dtype=np.int64)
-    for j in range(n):
-        new_ptr[j + 1] = new_ptr[j] + counts[j]
-    fill = new_ptr[:n].copy()
-    rows = np.empty(new_ptr[n], dtype=np.int64)
-    source = np.empty(new_ptr[n], dtype=np.int64)
-    for j in range(n):
-        for p in range(indptr[j], indptr[j + 1]):
-            a = pinv[indices[p]]
-            b = pinv[j]
-            q = fill[max(a, b)]
-            fill[max(a, b)] += 1
-            rows[q] = min(a, b)
-            source[q] = p
-    for j in range(n):  # insertion sort of each column by row (rows are distinct)
-        for q in range(new_ptr[j] + 1, new_ptr[j + 1]):
-            row = rows[q]
-            src = source[q]
-            r = q - 1
-            while r >= new_ptr[j] and rows[r] > row:
-                rows[r + 1] = rows[r]
-                source[r + 1] = source[r]
-                r -= 1
-            rows[r + 1] = row
-            source[r + 1] = src
-    return new_ptr, rows, source
-
-
-@njit(cache=True, nogil=True)
 def _squared_norm(v):  # pragma: no cover - compiled
     total = 0.0
     for i in range(v.shape[0]):
@@ -300,7 +270,7 @@ def _update(poses, step):  # pragma: no cover - compiled
 
 class _System:
     """The block layout of A for one graph: which upper off-diagonal block each edge adds to, the
-    compressed-column pattern and, beyond 100 unknowns, the fill-reducing permutation."""
+    compressed-column pattern and, beyond 100 unknowns, CSparse's AMD permutation and the permuted layout."""
 
     def __init__(self, n_free: int, source: NDArray[np.int64], target: NDArray[np.int64]):
         slots: dict[tuple[int, int], int] = {}
@@ -327,12 +297,11 @@ class _System:
         self.indptr, self.indices = _pattern(n_free, block_ptr, np.array(rows, dtype=np.int64))
         self.data = np.empty(self.indices.shape[0])
         self.order: NDArray[np.int64] | None = None
-        if 3 * n_free > NATURAL_ORDER_MAX_UNKNOWNS:
-            nodes = minimum_degree_order(n_free, [(int(a) - 1, int(b) - 1) for a, b in zip(source, target) if a and b])
-            self.order = (3 * nodes[:, None] + np.arange(3)[None, :]).reshape(-1).astype(np.int64)
+        if 3 * n_free > NATURAL_ORDER_MAX_UNKNOWNS:  # cs_schol(1, A): CSparse's AMD, then cs_symperm's layout
+            self.order = amd_order(self.indptr, self.indices)
             pinv = np.empty_like(self.order)
             pinv[self.order] = np.arange(self.order.shape[0])
-            self.perm_indptr, self.perm_indices, self.perm_source = _permuted_pattern(self.indptr, self.indices, pinv)
+            self.perm_indptr, self.perm_indices, self.perm_source = symmetric_permute(self.indptr, self.indices, pinv)
 
     def solve(
         self, diag: NDArray[np.float64], off: NDArray[np.float64], rhs: NDArray[np.float64], lam: float

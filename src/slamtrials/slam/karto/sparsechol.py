@@ -6,9 +6,12 @@ poses that come out could then differ in the last bits between machines, and a t
 pose that moves a last bit changes the map, the explorer's path and everything after). The
 factorisation here is the textbook up-looking sparse Cholesky (elimination tree, row patterns by
 ``ereach``, one scalar update at a time, as in Davis' CSparse ``cs_chol``), in plain loops: the same
-operations in the same order on every machine. Its fill-reducing ordering is a minimum-degree
-ordering of the pose graph's nodes (ties to the lowest index), each node's three unknowns kept
-together.
+operations in the same order on every machine; with its triangular solves (``cs_lsolve``,
+``cs_ltsolve``) it does CSparse's operations in CSparse's order for a matrix laid out the same way.
+The fill-reducing ordering is the caller's: :func:`minimum_degree_order` (a minimum-degree ordering
+of the pose graph's nodes, ties to the lowest index, each node's three unknowns kept together) for
+:mod:`.optimize`; CSparse's own AMD (:func:`.amd.amd_order`) with ``cs_symperm``'s layout for
+slam_karto's SPA (:mod:`.spa`), as ``cs_cholsol`` orders beyond 100 unknowns.
 
 Matrices are in compressed-column form holding the UPPER triangle (row <= column) of the symmetric
 matrix, as ``(indptr, indices, data)``.

@@ -4,11 +4,11 @@ Run: ``NUMBA_NUM_THREADS=1 .venv/bin/python bench/bench_karto_memory.py [--world
 
 One trial with karto (slam_toolbox's defaults) online, the paper's robot and laser, on ``--world``
 (default: the largest bundled world, multiwing_large_01, 9,892 m^2 free; seed 2 by default, the run of
-bench/RESULTS.md: on seed 1 karto's trial stops after 1,200 s with 163 nodes). The trial's karto object is
+bench/RESULTS.md). The trial's karto object is
 caught as :func:`slamtrials.trial.run.run_trial` builds it, and after the trial its memory is counted
 by walking its attributes: every numpy array's ``nbytes`` plus ``sys.getsizeof`` of every other object
-(lists, dataclasses, floats), each object once. Reported per part: the nodes' scans (readings and
-laser-frame points), the rest of the nodes, the edges, the map (the optimized map's grids), the two
+(lists, dataclasses, floats), each object once. Reported per part: the nodes' scans (their ranges, the
+readings the matcher takes and the in-range flags), the rest of the nodes, the edges, the map (the optimized map's grids), the two
 scan matchers' lookup grids, the per-frame lists, and the process's peak resident memory (whole
 process: simulator, explorer, recorded frames, SLAM) from ``getrusage``. No tracemalloc: it would slow
 the trial several times over and count the simulator and the recording as well.
@@ -111,8 +111,8 @@ def main() -> None:
     print("| part | MB | per node (kB) |")
     print("|---|---:|---:|")
     rows = [
-        ("nodes' scans (readings float32, laser-frame points 2 x float64)", scans),
-        ("nodes' other fields (poses, odometry, barycentre, objects)", node_rest),
+        ("nodes' scans (ranges float32, readings float64, in-range flags)", scans),
+        ("nodes' other fields (poses, odometry, objects)", node_rest),
         ("edges (mean, covariance, objects) and graph", edge_bytes),
         ("sequential matcher (lookup grid, kernels)", matchers["sequential"]),
         ("loop matcher (lookup grid, kernels)", matchers["loop_matcher"]),

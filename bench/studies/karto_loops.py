@@ -48,7 +48,14 @@ def main() -> None:
     parser.add_argument("--world", default="school_medium_01")
     parser.add_argument("--seed", type=int, default=3)
     parser.add_argument("--profile", default="paper", help="the simulator's error profile")
-    parser.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE", help="karto parameter overrides")
+    parser.add_argument(
+        "--set",
+        nargs="+",
+        action="extend",
+        default=[],
+        metavar="KEY=VALUE",
+        help="karto parameter overrides (repeatable)",
+    )
     parser.add_argument("--all", action="store_true", help="print the rejected candidates too")
     args = parser.parse_args()
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+import subprocess
 import sys
 import time
 
@@ -37,33 +39,61 @@ def test_cpu_time_of_the_calls_and_of_the_run_and_the_update_times():
     assert cost.slam_peak_mib is None and cost.run_peak_mib is None  # memory not asked for
 
 
-@needs_proc
-def test_the_memory_a_call_holds_at_its_peak_counts_for_slam_and_the_run():
-    meter = CostMeter()
+# The memory tests run in a fresh interpreter: the meter reads the whole process's resident set, so in
+# the test session another thread's frees, or a garbage collection freeing earlier tests' arrays while a
+# measured call allocates, can hide that call's growth.
+_MEMORY_SCENARIOS = """
+import json, mmap, sys
+import numpy as np
+from slamtrials.costmeter import CostMeter
+
+
+def touched(mib):
+    buffer = mmap.mmap(-1, mib * 2**20)  # a new mapping, every page written
+    np.frombuffer(buffer, dtype=np.uint8)[:: mmap.PAGESIZE] = 1
+    return buffer
+
+
+meter = CostMeter()
+if sys.argv[1] == "inside":
     held = []
     mark = meter.enter()
-    held.append(np.ones(80 * 2**20 // 8))  # 80 MiB, touched
+    held.append(touched(80))  # 80 MiB, kept
     meter.leave(mark)
     mark = meter.enter()
-    scratch = np.ones(40 * 2**20 // 8)  # 40 MiB more, freed within the call
-    del scratch
+    touched(40).close()  # 40 MiB more, freed within the call
     meter.leave(mark)
-    cost = meter.finish()
-    assert 110 <= cost.slam_peak_mib <= 140
-    assert cost.run_peak_mib >= cost.slam_peak_mib
-    assert cost.run_peak_mib >= 120  # the process's whole resident memory at that peak
+else:
+    mark = meter.enter()
+    meter.leave(mark)
+    touched(60).close()  # 60 MiB outside the calls
+cost = meter.finish()
+print(json.dumps([cost.slam_peak_mib, cost.run_peak_mib]))
+"""
+
+
+def _memory_scenario(name: str) -> tuple[float, float]:
+    """``(slam_peak_mib, run_peak_mib)`` of a scenario of ``_MEMORY_SCENARIOS`` run in a new interpreter."""
+    done = subprocess.run(
+        [sys.executable, "-c", _MEMORY_SCENARIOS, name], capture_output=True, text=True, timeout=120, check=True
+    )
+    slam, run = json.loads(done.stdout.strip().splitlines()[-1])
+    return slam, run
+
+
+@needs_proc
+def test_the_memory_a_call_holds_at_its_peak_counts_for_slam_and_the_run():
+    slam_peak, run_peak = _memory_scenario("inside")
+    assert 110 <= slam_peak <= 140
+    assert run_peak >= slam_peak
+    assert run_peak >= 120  # the process's whole resident memory at that peak
 
 
 @needs_proc
 def test_memory_touched_outside_the_calls_is_the_run_s_not_slam_s():
-    meter = CostMeter()
-    mark = meter.enter()
-    meter.leave(mark)
-    outside = np.ones(60 * 2**20 // 8)
-    del outside
-    cost = meter.finish()
-    assert cost.slam_peak_mib < 20
-    assert cost.run_peak_mib > 60
+    slam_peak, run_peak = _memory_scenario("outside")
+    assert slam_peak < 20
+    assert run_peak > 60
 
 
 def test_a_child_s_usage_makes_the_slam_figures_and_adds_to_the_run_s():

@@ -60,6 +60,19 @@ def _clear_marks(mark, lemax, w, n):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
+def _scatter_new_rows(rows, start, stop, mark, seen, out, nz):  # pragma: no cover - compiled
+    """cs_scatter's pattern part: append ``rows[start:stop]`` not yet marked with ``mark`` in ``seen`` to
+    ``out[nz:]``, marking them; returns the new ``nz``."""
+    for p in range(start, stop):
+        i = rows[p]
+        if seen[i] < mark:
+            seen[i] = mark
+            out[nz] = i
+            nz += 1
+    return nz
+
+
+@njit(cache=True, nogil=True)
 def _symmetric_pattern(n, ap, ai):  # pragma: no cover - compiled
     """Pattern of ``A + A^T`` without its diagonal, built as cs_transpose, cs_add and cs_fkeep order it."""
     nnz = ap[n]
@@ -84,18 +97,8 @@ def _symmetric_pattern(n, ap, ai):  # pragma: no cover - compiled
     nz = 0
     for j in range(n):
         cp[j] = nz
-        for p in range(ap[j], ap[j + 1]):
-            i = ai[p]
-            if seen[i] < j + 1:
-                seen[i] = j + 1
-                ci[nz] = i
-                nz += 1
-        for p in range(tp[j], tp[j + 1]):
-            i = ti[p]
-            if seen[i] < j + 1:
-                seen[i] = j + 1
-                ci[nz] = i
-                nz += 1
+        nz = _scatter_new_rows(ai, ap[j], ap[j + 1], j + 1, seen, ci, nz)
+        nz = _scatter_new_rows(ti, tp[j], tp[j + 1], j + 1, seen, ci, nz)
     cp[n] = nz
     # drop the diagonal, keeping the order
     nz = 0
